@@ -1,0 +1,46 @@
+# Set-up and entry points. `make demo` and `make test` each install what is missing first.
+# As root the Debian packages are installed directly, otherwise through sudo.
+SHELL := /bin/bash
+PY := .venv/bin/python
+NP ?= 2
+OUT ?= results
+APT_PACKAGES := python3-dolfinx python3-petsc4py python3-slepc4py python3-mpi4py python3-ufl \
+    python3-basix python3-ffcx python3-numpy python3-scipy python3-matplotlib python3-pytest \
+    python3-pytest-mpi python3-pytest-timeout python3-venv python3-pip python3-setuptools \
+    python3-wheel python3-dev openmpi-bin build-essential pkg-config
+SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+MPIRUN := mpirun -n $(NP) $(shell [ "$$(id -u)" = 0 ] && echo --allow-run-as-root) --oversubscribe
+export OMPI_MCA_rmaps_base_oversubscribe := 1
+export PYTHONDONTWRITEBYTECODE := 1
+
+.PHONY: setup demo test test-serial test-mpi benchmark clean
+
+.venv/.installed: pyproject.toml
+	@missing=$$(for p in $(APT_PACKAGES); do dpkg-query -W -f='$${Status}' $$p 2>/dev/null \
+	    | grep -q "install ok installed" || echo $$p; done); \
+	if [ -n "$$missing" ]; then \
+	    echo "installing Debian packages:" $$missing; \
+	    $(SUDO) apt-get update && DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y \
+	        --no-install-recommends $$missing; fi
+	/usr/bin/python3 -m venv --system-site-packages .venv
+	$(PY) -m pip install --quiet --no-build-isolation --no-deps -e .
+	@touch $@
+
+setup: .venv/.installed
+
+demo: setup
+	$(PY) -m fenicsfriction steady block --mu-max 1.55 --steps 31 --out $(OUT)/steady-block
+
+test-serial: setup
+	$(PY) -m pytest -q tests
+
+test-mpi: setup
+	$(MPIRUN) $(PY) -m mpi4py -m pytest -q --with-mpi tests
+
+test: test-serial test-mpi
+
+benchmark: setup
+	$(PY) benchmarks/bench_steady.py --out $(OUT)/benchmarks
+
+clean:
+	rm -rf .venv results *.egg-info

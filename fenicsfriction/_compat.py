@@ -1,0 +1,89 @@
+"""Every dolfinx-version difference the package depends on, in one place.
+
+Written against dolfinx 0.5.2 (Debian 12). Differences are detected with
+``hasattr``/``try`` rather than by parsing version strings, following scifem's
+``compat.py``; a port to 0.9/0.10 should only touch this module. Renamed keyword
+arguments (``scale``/``alpha``, ``diagonal``/``diag``) are passed positionally.
+"""
+
+from __future__ import annotations
+
+import typing
+
+import numpy as np
+import ufl
+from dolfinx import fem, mesh
+
+import dolfinx.fem.petsc  # noqa: F401  (registers fem.petsc; explicit import is required from 0.6)
+
+from mpi4py import MPI
+from petsc4py import PETSc
+
+__all__ = [
+    "assemble_matrix_into",
+    "create_rectangle",
+    "interpolation_points",
+    "jit_options",
+    "petsc_vec",
+    "scalar_function_space",
+    "vector_function_space",
+]
+
+
+def vector_function_space(msh: mesh.Mesh, degree: int) -> fem.FunctionSpace:
+    """Lagrange vector space of the given degree with ``gdim`` components."""
+    if hasattr(fem, "functionspace"):  # dolfinx >= 0.8
+        return fem.functionspace(msh, ("Lagrange", degree, (msh.geometry.dim,)))
+    return fem.VectorFunctionSpace(msh, ("Lagrange", degree))
+
+
+def scalar_function_space(msh: mesh.Mesh, family: str, degree: int) -> fem.FunctionSpace:
+    """Scalar space (``family`` is e.g. ``"Lagrange"`` or ``"DG"``)."""
+    if hasattr(fem, "functionspace"):
+        return fem.functionspace(msh, (family, degree))
+    return fem.FunctionSpace(msh, (family, degree))
+
+
+def petsc_vec(u: fem.Function) -> PETSc.Vec:
+    """The PETSc vector that shares memory with a Function's dof array."""
+    x = u.x
+    return x.petsc_vec if hasattr(x, "petsc_vec") else u.vector
+
+
+def create_rectangle(comm: MPI.Comm, corner0: typing.Sequence[float],
+                     corner1: typing.Sequence[float], n: typing.Sequence[int]) -> mesh.Mesh:
+    """Quadrilateral mesh of a rectangle (``dtype`` was inserted before ``cell_type`` in 0.8)."""
+    points = [np.asarray(corner0, dtype=float), np.asarray(corner1, dtype=float)]
+    return mesh.create_rectangle(comm=comm, points=points, n=list(n),
+                                 cell_type=mesh.CellType.quadrilateral)
+
+
+def interpolation_points(V: fem.FunctionSpace) -> np.ndarray:
+    """Reference interpolation points of a space's element (method in 0.5, property later)."""
+    pts = V.element.interpolation_points
+    return pts() if callable(pts) else pts
+
+
+def jit_options(cache_dir: typing.Optional[str] = None) -> dict:
+    """Keyword arguments for ``fem.form``: the option dict was renamed in 0.7."""
+    options: dict = {"cffi_extra_compile_args": ["-O2"]}
+    if cache_dir is not None:
+        options["cache_dir"] = cache_dir
+    import inspect
+    if "jit_options" in inspect.signature(fem.form).parameters:
+        return {"jit_options": options}
+    return {"jit_params": options}
+
+
+def assemble_matrix_into(A: PETSc.Mat, a: fem.FormMetaClass, bcs: list) -> None:
+    """Assemble ``a`` into ``A`` (Dirichlet rows: identity), leaving A *unfinalised*.
+
+    The caller adds its own entries (e.g. nodal springs) and then calls ``A.assemble()``.
+    """
+    A.zeroEntries()
+    dolfinx.fem.petsc.assemble_matrix(A, a, bcs)
+
+
+def form(expr: ufl.Form) -> fem.FormMetaClass:
+    """Compile a UFL form with the package's JIT options."""
+    return fem.form(expr, **jit_options())

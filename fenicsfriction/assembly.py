@@ -1,0 +1,61 @@
+"""Assembly of a :class:`~fenicsfriction.forms.Residual` into PETSc objects.
+
+The SNES, TS and PEP drivers all go through these two functions, so UFL integrals and nodal
+springs are always assembled together and Dirichlet rows are treated one way
+(dolfinx 0.5 pattern of ``python/test/unit/nls/test_newton.py``).
+"""
+
+from __future__ import annotations
+
+import typing
+
+from dolfinx import fem
+
+import dolfinx.fem.petsc  # noqa: F401
+
+from petsc4py import PETSc
+
+from fenicsfriction import _compat
+
+__all__ = ["assemble_jacobian", "assemble_residual", "options_with_defaults"]
+
+
+def assemble_residual(b: PETSc.Vec, L: fem.FormMetaClass, a: fem.FormMetaClass, bcs: list,
+                      x: PETSc.Vec, springs: typing.Sequence = ()) -> None:
+    """b = R(x) with Dirichlet rows set to (x - g) scaled by -1, springs included.
+
+    ``x`` must already hold the state the coefficients of ``L`` see (ghosts updated).
+    """
+    with b.localForm() as b_local:
+        b_local.set(0.0)
+    dolfinx.fem.petsc.assemble_vector(b, L)
+    if bcs:
+        dolfinx.fem.petsc.apply_lifting(b, [a], [bcs], [x], -1.0)
+    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    if springs:
+        b_array, x_array = b.getArray(), x.getArray(readonly=True)
+        for spring in springs:
+            spring.add_to_residual(b_array, x_array)
+    if bcs:
+        dolfinx.fem.petsc.set_bc(b, bcs, x, -1.0)
+
+
+def assemble_jacobian(A: PETSc.Mat, a: fem.FormMetaClass, bcs: list,
+                      springs: typing.Sequence = ()) -> None:
+    """A = dR/du (bilinear form ``a``) plus nodal spring stiffnesses; Dirichlet rows identity."""
+    _compat.assemble_matrix_into(A, a, bcs)
+    for spring in springs:
+        spring.add_to_matrix(A)
+    A.assemble()
+
+
+def options_with_defaults(prefix: str, defaults: dict) -> PETSc.Options:
+    """Put ``defaults`` into the PETSc options database under ``prefix`` unless already set.
+
+    Options the user set (command line, ``PETSC_OPTIONS`` or code) always win.
+    """
+    opts = PETSc.Options(prefix)
+    for key, value in defaults.items():
+        if not opts.hasName(key):
+            opts[key] = value
+    return opts

@@ -1,0 +1,250 @@
+r"""The regularised virtual-power residual of Problem 1ε as a sum of UFL terms (SPEC §2).
+
+.. math::
+    R(u, \dot u, \ddot u; v) = \rho\langle\ddot u, v\rangle + a(u, v) + \langle P(u), v\rangle
+        + \langle D(u, \dot u), v\rangle + \langle J_\varepsilon(u, \dot u), v\rangle
+        - \langle f, v\rangle
+
+Each term is a small pure function returning a UFL form; a scene adds up the ones it needs
+(a frictionless scene has no friction term, a static one no inertia). Everything else is
+*derived* from the one residual with :func:`ufl.derivative` and :func:`ufl.replace`:
+
+* steady sliding (Problem 2): :math:`R(u_0, 0, 0; v)` and its Jacobian;
+* stability (Problem 3): :math:`M = \partial R/\partial\ddot u`, :math:`C = \partial R/\partial\dot u`,
+  :math:`\bar K = \partial R/\partial u` at :math:`(u_0, 0, 0)`.
+
+A researcher can read or extend ``Residual.form`` before anything is compiled; see
+``demos/demo_block_steady.py`` for a term added to the block and the problem re-solved.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import typing
+
+import numpy as np
+import ufl
+from dolfinx import fem
+
+from fenicsfriction import laws
+
+__all__ = [
+    "NodalSpring",
+    "Residual",
+    "body_force",
+    "elastic_support",
+    "elasticity",
+    "friction",
+    "inertia",
+    "is_speed_law",
+    "normal_compliance",
+    "normal_damping",
+    "normal_part",
+    "surface_traction",
+    "tangential_part",
+]
+
+Value = typing.Union[float, ufl.core.expr.Expr]
+
+
+# --- kinematics on Γ_C ---------------------------------------------------------------------------
+
+def normal_part(w, n) -> ufl.core.expr.Expr:
+    """:math:`w_n = w \\cdot n`."""
+    return ufl.dot(w, n)
+
+
+def tangential_part(w, n) -> ufl.core.expr.Expr:
+    """:math:`w_T = w - (w\\cdot n) n`."""
+    return w - ufl.dot(w, n) * n
+
+
+# --- bulk terms ----------------------------------------------------------------------------------
+
+def inertia(rho: Value, u_ddot, v, dx: ufl.Measure) -> ufl.Form:
+    """:math:`\\rho \\langle \\ddot u, v\\rangle`."""
+    return rho * ufl.inner(u_ddot, v) * dx
+
+
+def _lame(E: Value, nu: Value, plane_stress: bool):
+    mu = E / (2 * (1 + nu))
+    lmbda = E * nu / ((1 + nu) * (1 - 2 * nu))
+    if plane_stress:
+        lmbda = 2 * mu * lmbda / (lmbda + 2 * mu)
+    return lmbda, mu
+
+
+def elasticity(u, v, E: Value, nu: Value, dx: ufl.Measure, plane_stress: bool = False) -> ufl.Form:
+    """:math:`a_0(u, v) = \\int_\\Omega \\sigma(u):\\varepsilon(v)`, isotropic Hooke's law.
+
+    In 2D the default is plane strain (the block of seed 000); ``plane_stress=True`` switches.
+    """
+    lmbda, mu = _lame(E, nu, plane_stress)
+    eps_u, eps_v = ufl.sym(ufl.grad(u)), ufl.sym(ufl.grad(v))
+    sigma = 2 * mu * eps_u + lmbda * ufl.tr(eps_u) * ufl.Identity(len(u))
+    return ufl.inner(sigma, eps_v) * dx
+
+
+def elastic_support(u, v, K: Value, U_E, ds: ufl.Measure) -> ufl.Form:
+    """Distributed linear springs on :math:`\\Gamma_E`: :math:`\\int K (u - U^E)\\cdot v`."""
+    return ufl.inner(K * (u - U_E), v) * ds
+
+
+def body_force(b, v, dx: ufl.Measure) -> ufl.Form:
+    """Load term :math:`-\\int_\\Omega b\\cdot v` (residual sign convention: R = internal - f)."""
+    return -ufl.inner(b, v) * dx
+
+
+def surface_traction(t, v, ds: ufl.Measure) -> ufl.Form:
+    """Load term :math:`-\\int_{\\Gamma_F} t\\cdot v`."""
+    return -ufl.inner(t, v) * ds
+
+
+# --- interface terms on Γ_C (seed 000 eqs. 14-16) -------------------------------------------------
+
+def normal_compliance(u, v, n, c_n: Value, m_n: Value, g: Value, ds: ufl.Measure) -> ufl.Form:
+    """:math:`\\langle P(u), v\\rangle = \\int_{\\Gamma_C} c_n (u_n - g)_+^{m_n} v_n`."""
+    d = laws.penetration(normal_part(u, n), g)
+    return laws.normal_pressure(d, c_n, m_n) * normal_part(v, n) * ds
+
+
+def normal_damping(u, u_dot, v, n, b_n: Value, l_n: Value, g: Value,
+                   ds: ufl.Measure) -> ufl.Form:
+    """:math:`\\langle D(u,\\dot u), v\\rangle = \\int_{\\Gamma_C} b_n d^{l_n} \\dot u_n v_n`."""
+    d = laws.penetration(normal_part(u, n), g)
+    return laws.normal_damping_pressure(d, normal_part(u_dot, n), b_n, l_n) \
+        * normal_part(v, n) * ds
+
+
+def friction(u, u_dot, v, n, c_T: typing.Union[Value, typing.Callable], m_T: Value, g: Value,
+             U_T, eps: Value, ds: ufl.Measure, regularisation: str = "c1") -> ufl.Form:
+    """Regularised friction power :math:`\\langle J_\\varepsilon(u,\\dot u), v\\rangle`.
+
+    .. math:: \\int_{\\Gamma_C} c_T\\, d^{m_T}\\, \\phi_\\varepsilon'(\\dot u_T - U_T)\\cdot v_T
+
+    ``c_T`` is a number/UFL value (Coulomb: :math:`\\mu c_n`), or a callable of the relative
+    slip speed :math:`|\\dot u_T - U_T|` for a velocity-dependent law, e.g.
+    ``lambda s: c_n * PiecewiseLinearFriction()(s)``; its slope then enters every derivative.
+    """
+    d = laws.penetration(normal_part(u, n), g)
+    w = tangential_part(u_dot, n) - U_T
+    if is_speed_law(c_T):
+        c_T = c_T(ufl.sqrt(ufl.inner(w, w)))
+    direction = laws.REGULARISATIONS[regularisation][1](w, eps)
+    return laws.friction_bound(d, c_T, m_T) * ufl.inner(direction, tangential_part(v, n)) * ds
+
+
+def is_speed_law(c_T) -> bool:
+    """True when ``c_T`` is a function of the slip speed (UFL expressions are callable too)."""
+    return callable(c_T) and not isinstance(c_T, ufl.core.expr.Expr)
+
+
+# --- nodal springs (point loads are not UFL integrals in dolfinx 0.5) ----------------------------
+
+@dataclasses.dataclass
+class NodalSpring:
+    """A linear spring on one displacement component of one node: force -K (u_i - U).
+
+    It is the one contribution to the residual that is not a UFL integral (dolfinx has no
+    point measure); being linear, its Jacobian is exactly K on the node's diagonal entry and it
+    contributes to :math:`\\bar K` only. On each rank ``local_dof`` is the dof's local index
+    (unrolled, block size included) or ``-1`` where the rank does not own the dof.
+    """
+
+    stiffness: float
+    anchor: float
+    local_dof: int
+    global_dof: int
+    position: np.ndarray
+
+    @classmethod
+    def at_point(cls, V: fem.FunctionSpace, point: typing.Sequence[float], component: int,
+                 stiffness: float, anchor: float = 0.0, tol: float = 1e-10) -> "NodalSpring":
+        """Attach to the node of ``V`` at ``point`` (it must be a node of the mesh)."""
+        laws.check("stiffness", stiffness, stiffness > 0, "the spring stiffness must be > 0")
+        Vc, to_parent = V.sub(component).collapse()
+        point = np.asarray(point, dtype=float)
+        dofs = fem.locate_dofs_geometrical(
+            (V.sub(component), Vc),
+            lambda x: np.linalg.norm(x[:len(point)] - point[:, None], axis=0) < tol)[0]
+        bs, index_map = V.dofmap.index_map_bs, V.dofmap.index_map
+        owned = dofs[dofs < index_map.size_local * bs]
+        comm = V.mesh.comm
+        count = comm.allreduce(len(owned))
+        laws.check("point", point.tolist(), count == 1,
+                   f"the spring must sit on exactly one node of the mesh (found {count})")
+        local = int(owned[0]) if len(owned) else -1
+        g = -1
+        if local >= 0:
+            g = int(index_map.local_to_global(np.array([local // bs], dtype=np.int32))[0] * bs
+                    + local % bs)
+        g = comm.allreduce(g, op=__import__("mpi4py").MPI.MAX)
+        return cls(stiffness=float(stiffness), anchor=float(anchor), local_dof=local,
+                   global_dof=g, position=point)
+
+    def add_to_residual(self, b_local: np.ndarray, x_local: np.ndarray) -> None:
+        """``b += K (x_i - U)`` on the owning rank (arrays are local, owned part first)."""
+        if self.local_dof >= 0:
+            b_local[self.local_dof] += self.stiffness * (x_local[self.local_dof] - self.anchor)
+
+    def add_to_matrix(self, A) -> None:
+        """``A[i, i] += K`` (call between assembly and ``A.assemble()``)."""
+        if self.local_dof >= 0:
+            from petsc4py import PETSc
+            A.setValue(self.global_dof, self.global_dof, self.stiffness, addv=PETSc.InsertMode.ADD)
+
+    def force(self, u: fem.Function) -> float:
+        """Force exerted by the spring on the body, -K (u_i - U), on every rank."""
+        value = 0.0
+        if self.local_dof >= 0:
+            value = -self.stiffness * (u.x.array[self.local_dof] - self.anchor)
+        return u.function_space.mesh.comm.allreduce(value)
+
+
+# --- the residual and what is derived from it ----------------------------------------------------
+
+@dataclasses.dataclass
+class Residual:
+    """The one residual R(u, u̇, ü; v) of Problem 1ε and everything derived from it.
+
+    Attributes:
+        form: the full dynamic residual (UFL), linear in the test function ``v``.
+        u, u_dot, u_ddot: the fields R depends on (Functions of one space V).
+        v: the test function of ``form``.
+        bcs: Dirichlet conditions on V (homogeneous; may be empty).
+        springs: nodal springs added to R outside UFL (see :class:`NodalSpring`).
+    """
+
+    form: ufl.Form
+    u: fem.Function
+    u_dot: fem.Function
+    u_ddot: fem.Function
+    v: ufl.Argument
+    bcs: list = dataclasses.field(default_factory=list)
+    springs: list = dataclasses.field(default_factory=list)
+
+    @property
+    def V(self) -> fem.FunctionSpace:
+        return self.u.function_space
+
+    def at_rest(self, form: ufl.Form) -> ufl.Form:
+        """``form`` with u̇ = ü = 0 substituted (UFL drops the terms that vanish)."""
+        zero = ufl.zero(*self.u.ufl_shape)
+        return ufl.replace(form, {self.u_dot: zero, self.u_ddot: zero})
+
+    def steady(self) -> ufl.Form:
+        """Problem 2: the steady-sliding residual R(u0, 0, 0; v)."""
+        return self.at_rest(self.form)
+
+    def derivative(self, form: ufl.Form, field: fem.Function) -> ufl.Form:
+        """Gateaux derivative of ``form`` with respect to ``field`` (trial function of V)."""
+        return ufl.derivative(form, field, ufl.TrialFunction(self.V))
+
+    def steady_jacobian(self) -> ufl.Form:
+        """Jacobian of the steady residual with respect to u."""
+        return self.derivative(self.steady(), self.u)
+
+    def linearisation(self) -> tuple[ufl.Form, ufl.Form, ufl.Form]:
+        """(M, C, K̄) = (∂R/∂ü, ∂R/∂u̇, ∂R/∂u) at (u, 0, 0); empty forms are returned as-is."""
+        return tuple(self.at_rest(self.derivative(self.form, f))
+                     for f in (self.u_ddot, self.u_dot, self.u))

@@ -1,0 +1,260 @@
+r"""Pointwise interface laws of Martins & Oden (seed 000, eqs. 1-2) and their regularisations.
+
+Every builder takes UFL expressions (to be used in forms) or NumPy arrays/floats (to be used in
+reduced models and post-processing) and returns the same kind. Notation (SPEC §1):
+
+* :math:`d = (u_n - g)_+` penetration (approach) of the interface, :math:`g \ge 0` initial gap;
+* normal compliance :math:`c_n d^{m_n}`, normal damping :math:`b_n d^{l_n} \dot u_n`;
+* friction bound :math:`c_T d^{m_T}`; Coulomb is :math:`m_T = m_n`, :math:`c_T = \mu c_n`;
+* regularised friction direction :math:`\phi_\varepsilon'(w)` with :math:`w = \dot u_T - U_T`.
+
+Parameters are validated in one place, :class:`InterfaceLaw`; a bad value raises ``ValueError``
+naming the parameter, its value and what is allowed.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import typing
+
+import numpy as np
+import ufl
+
+__all__ = [
+    "ConstantFriction",
+    "InterfaceLaw",
+    "PiecewiseLinearFriction",
+    "REGULARISATIONS",
+    "StribeckFriction",
+    "abs_c1",
+    "abs_c1_derivative",
+    "abs_smooth",
+    "abs_smooth_derivative",
+    "check",
+    "friction_bound",
+    "normal_damping_pressure",
+    "normal_pressure",
+    "penetration",
+]
+
+Scalar = typing.Union[float, np.ndarray, ufl.core.expr.Expr]
+
+
+def check(name: str, value, ok: bool, allowed: str) -> None:
+    """Raise ``ValueError("name=value is invalid: allowed")`` unless ``ok``."""
+    if not ok:
+        raise ValueError(f"{name}={value!r} is invalid: {allowed}")
+
+
+def _is_ufl(*xs) -> bool:
+    return any(isinstance(x, ufl.core.expr.Expr) for x in xs)
+
+
+def _max(a: Scalar, b: Scalar) -> Scalar:
+    return ufl.max_value(a, b) if _is_ufl(a, b) else np.maximum(a, b)
+
+
+def _min(a: Scalar, b: Scalar) -> Scalar:
+    return ufl.min_value(a, b) if _is_ufl(a, b) else np.minimum(a, b)
+
+
+def _norm(w) -> Scalar:
+    """Euclidean norm of a UFL vector; element-wise |w| of NumPy input.
+
+    NumPy input is read as scalar tangential velocities (reduced models, one tangent direction).
+    """
+    if _is_ufl(w):
+        return ufl.sqrt(ufl.inner(w, w)) if w.ufl_shape else abs(w)
+    return np.abs(np.asarray(w, dtype=float))
+
+
+def _sqrt(x: Scalar) -> Scalar:
+    return ufl.sqrt(x) if _is_ufl(x) else np.sqrt(x)
+
+
+def _exp(x: Scalar) -> Scalar:
+    return ufl.exp(x) if _is_ufl(x) else np.exp(x)
+
+
+# --- normal response (seed 000 eq. 1) -----------------------------------------------------------
+
+def penetration(u_n: Scalar, g: Scalar = 0.0) -> Scalar:
+    """Approach of the interface :math:`d = (u_n - g)_+` (seed 000, Fig. 3)."""
+    return _max(u_n - g, 0.0)
+
+
+def normal_pressure(d: Scalar, c_n: Scalar, m_n: Scalar) -> Scalar:
+    """Elastic normal compliance :math:`-\\sigma_n^e = c_n d^{m_n}` (seed 000 eq. 1)."""
+    return c_n * d**m_n
+
+
+def normal_damping_pressure(d: Scalar, u_n_dot: Scalar, b_n: Scalar, l_n: Scalar) -> Scalar:
+    """Dissipative normal stress :math:`-\\sigma_n^d = b_n d^{l_n} \\dot u_n` (seed 000 eq. 1)."""
+    return b_n * d**l_n * u_n_dot
+
+
+def friction_bound(d: Scalar, c_T: Scalar, m_T: Scalar) -> Scalar:
+    """Maximum friction stress :math:`c_T d^{m_T}` (seed 000 eq. 2)."""
+    return c_T * d**m_T
+
+
+# --- regularisations of |w| (seed 001 eq. 15, seed 002 eq. 40) ----------------------------------
+
+def abs_c1(w, eps: Scalar) -> Scalar:
+    """C1 regularisation :math:`\\phi_\\varepsilon(w) = |w|^2/(2\\varepsilon)` for
+    :math:`|w|<\\varepsilon`, :math:`|w| - \\varepsilon/2` otherwise."""
+    r = _norm(w)
+    if _is_ufl(r, eps):
+        return ufl.conditional(ufl.lt(r, eps), r**2 / (2 * eps), r - eps / 2)
+    return np.where(r < eps, r**2 / (2 * eps), r - eps / 2)
+
+
+def abs_c1_derivative(w, eps: Scalar):
+    """:math:`\\phi_\\varepsilon'(w) = w / \\max(|w|, \\varepsilon)` (a vector like ``w``)."""
+    return w / _max(_norm(w), eps)
+
+
+def abs_smooth(w, eps: Scalar) -> Scalar:
+    """Smooth regularisation :math:`\\psi_\\varepsilon(w) = \\sqrt{|w|^2 + \\varepsilon^2}`."""
+    return _sqrt(_norm(w) ** 2 + eps**2)
+
+
+def abs_smooth_derivative(w, eps: Scalar):
+    """:math:`\\psi_\\varepsilon'(w) = w / \\sqrt{|w|^2 + \\varepsilon^2}`."""
+    return w / abs_smooth(w, eps)
+
+
+REGULARISATIONS: dict[str, tuple[typing.Callable, typing.Callable]] = {
+    "c1": (abs_c1, abs_c1_derivative),
+    "smooth": (abs_smooth, abs_smooth_derivative),
+}
+
+
+# --- velocity-dependent friction coefficients ---------------------------------------------------
+
+@dataclasses.dataclass(frozen=True)
+class ConstantFriction:
+    """Coulomb's constant coefficient :math:`\\mu(v) = \\mu`."""
+
+    mu: float
+
+    def __post_init__(self):
+        check("mu", self.mu, self.mu >= 0, "the friction coefficient must be >= 0")
+
+    def __call__(self, speed: Scalar) -> Scalar:
+        return self.mu + 0 * speed
+
+
+@dataclasses.dataclass(frozen=True)
+class PiecewiseLinearFriction:
+    """Seed 004 eq. 59: :math:`\\mu = \\mu_s - s |v|` for :math:`|v| < v_c`, then constant.
+
+    Defaults are the paper's: ``mu_s=0.75, slope=0.03, v_c=15`` (so :math:`\\mu_k = 0.3`).
+    """
+
+    mu_s: float = 0.75
+    slope: float = 0.03
+    v_c: float = 15.0
+
+    def __post_init__(self):
+        check("mu_s", self.mu_s, self.mu_s >= 0, "the static coefficient must be >= 0")
+        check("v_c", self.v_c, self.v_c > 0, "the transition speed must be > 0")
+        mu_k = self.mu_s - self.slope * self.v_c
+        check("slope", self.slope, mu_k >= 0,
+              f"mu_s - slope*v_c must be >= 0 (got {mu_k:g}): mu may not turn negative")
+
+    def __call__(self, speed: Scalar) -> Scalar:
+        return self.mu_s - self.slope * _min(speed, self.v_c)
+
+
+@dataclasses.dataclass(frozen=True)
+class StribeckFriction:
+    """Exponential Stribeck-type law :math:`\\mu = \\mu_k + (\\mu_s-\\mu_k) e^{-(|v|/v_s)^\\delta}`."""
+
+    mu_s: float
+    mu_k: float
+    v_s: float
+    exponent: float = 1.0
+
+    def __post_init__(self):
+        check("mu_k", self.mu_k, self.mu_k >= 0, "the kinetic coefficient must be >= 0")
+        check("mu_s", self.mu_s, self.mu_s >= 0, "the static coefficient must be >= 0")
+        check("v_s", self.v_s, self.v_s > 0, "the Stribeck speed must be > 0")
+        check("exponent", self.exponent, self.exponent > 0, "the exponent must be > 0")
+
+    def __call__(self, speed: Scalar) -> Scalar:
+        return self.mu_k + (self.mu_s - self.mu_k) * _exp(-((speed / self.v_s) ** self.exponent))
+
+
+FrictionCoefficient = typing.Union[ConstantFriction, PiecewiseLinearFriction, StribeckFriction]
+
+
+# --- the interface law as a validated parameter set ---------------------------------------------
+
+@dataclasses.dataclass
+class InterfaceLaw:
+    """Normal compliance and regularised Coulomb-type friction on :math:`\\Gamma_C`.
+
+    Args:
+        c_n: normal compliance coefficient [force / length^(2+m_n)] (pressure per d^m_n).
+        m_n: normal compliance exponent [-], >= 1 (experiments: 2 to 3.33).
+        mu: friction coefficient c_T / c_n [-] (Coulomb when m_T = m_n and b_n = 0).
+        m_T: friction exponent [-]; ``None`` means m_T = m_n (Coulomb).
+        b_n: normal damping coefficient [force time / length^(3+l_n)], >= 0.
+        l_n: normal damping exponent [-]; ``None`` means l_n = m_n.
+        g: initial gap [length], >= 0.
+        eps: regularisation parameter of |u̇_T - U_T| [length / time], > 0.
+        regularisation: ``"c1"`` (φ_ε, seed 001 eq. 15) or ``"smooth"`` (ψ_ε, seed 002 eq. 40).
+        friction_coefficient: optional velocity-dependent μ(|v|); when given it replaces ``mu``.
+    """
+
+    c_n: float
+    m_n: float
+    mu: float = 0.0
+    m_T: typing.Optional[float] = None
+    b_n: float = 0.0
+    l_n: typing.Optional[float] = None
+    g: float = 0.0
+    eps: float = 1e-3
+    regularisation: str = "c1"
+    friction_coefficient: typing.Optional[FrictionCoefficient] = None
+
+    def __post_init__(self):
+        if self.m_T is None:
+            self.m_T = self.m_n
+        if self.l_n is None:
+            self.l_n = self.m_n
+        self.validate()
+
+    def validate(self) -> None:
+        """Check every parameter; raise ``ValueError`` naming the first bad one."""
+        for name in ("c_n", "m_n", "mu", "m_T", "b_n", "l_n", "g", "eps"):
+            value = getattr(self, name)
+            check(name, value, isinstance(value, (int, float)) and math.isfinite(value),
+                  "must be a finite real number")
+        check("c_n", self.c_n, self.c_n > 0, "the normal compliance coefficient must be > 0")
+        check("m_n", self.m_n, self.m_n >= 1, "the normal exponent must be >= 1")
+        check("m_T", self.m_T, self.m_T >= 1, "the friction exponent must be >= 1")
+        check("mu", self.mu, self.mu >= 0, "the friction coefficient must be >= 0")
+        check("b_n", self.b_n, self.b_n >= 0, "the normal damping coefficient must be >= 0")
+        check("l_n", self.l_n, self.l_n >= 1, "the damping exponent must be >= 1")
+        check("g", self.g, self.g >= 0, "the initial gap must be >= 0")
+        check("eps", self.eps, self.eps > 0, "the regularisation parameter must be > 0")
+        check("regularisation", self.regularisation, self.regularisation in REGULARISATIONS,
+              f"must be one of {sorted(REGULARISATIONS)}")
+
+    @property
+    def coulomb(self) -> bool:
+        """True when the law is Coulomb's: m_T = m_n, no normal damping, constant μ."""
+        return self.m_T == self.m_n and self.b_n == 0 and self.friction_coefficient is None
+
+    @property
+    def c_T(self) -> float:
+        """Friction coefficient of the bound c_T = μ c_n."""
+        return self.mu * self.c_n
+
+    def uniform_penetration(self, pressure: float) -> float:
+        """Penetration under a uniform pressure p: d = (p / c_n)^(1/m_n) (no damping)."""
+        check("pressure", pressure, pressure >= 0, "must be >= 0")
+        return (pressure / self.c_n) ** (1.0 / self.m_n)

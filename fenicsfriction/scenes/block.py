@@ -1,0 +1,335 @@
+r"""The block on a moving belt of Martins & Oden (seed 000, Figs. 6-15; SPEC §4).
+
+Units are the paper's: mass 10^3 kg, length cm, time s (so force 10^3 kg cm s^-2 and stress
+10^3 kg cm^-1 s^-2). The defaults are eq. (36)-(37) with the driver spring of the FE dynamics
+(Figs. 13-15).
+
+Choices the paper leaves open, made here and changeable through the fields:
+
+* **Plane strain with breadth B0.** B0 is the block's breadth out of the plane (the
+  plane-strain thickness): every 2D integral is multiplied by B0, so forces are totals, the
+  contact pressure is force / (L B0), and ``mass``/``weight`` are totals over that breadth.
+* **Weight as a body force** ρ g = W / (L H B0), mass density ρ = M / (L H B0).
+* **Driver spring through the centre of mass.** A horizontal nodal spring of total stiffness
+  K_x on the node of the left face at height ``spring_height`` (default H/2, the height of
+  the centre of mass): its line of action is horizontal at that height, which gives the
+  tipping limit μ < L/(2 h_s) = L/H = 1.6 and a tangential mode ±i sqrt(K_x/M) that does
+  not move with μ. Mesh rows are shifted so that a node lies at that height (no shift for
+  H/2). The spring is anchored at zero displacement: its elongation is -u_x at the node.
+* **Belt** along ``belt_direction`` × e_x at ``belt_speed``; friction drags the block that
+  way and the spring holds it back.
+* **Contact** on the bottom face y = 0 (outward normal -e_y), initial gap g (default 0).
+  The contact integrals use a fixed quadrature degree so that the reported resultants are
+  computed exactly as the residual integrates them.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import typing
+
+import numpy as np
+import ufl
+from dolfinx import fem, mesh
+
+from mpi4py import MPI
+
+from fenicsfriction import _compat, laws
+from fenicsfriction.forms import (NodalSpring, Residual, body_force, elasticity, friction, inertia,
+                                  is_speed_law, normal_compliance, normal_damping, normal_part,
+                                  surface_traction, tangential_part)
+from fenicsfriction.laws import check
+
+__all__ = ["BlockModel", "BlockOnBelt"]
+
+CONTACT, TOP, LEFT, RIGHT = 1, 2, 3, 4
+
+
+@dataclasses.dataclass
+class BlockOnBelt:
+    """Parameters of the block-on-belt scene (names as in seed 000; units in brackets).
+
+    Args:
+        L: length of the block along the belt [cm].
+        H: height of the block [cm].
+        B0: breadth out of the plane, the plane-strain thickness [cm].
+        E: Young's modulus [10^3 kg cm^-1 s^-2].
+        nu: Poisson's ratio [-].
+        mass: total mass M [10^3 kg].
+        weight: total weight W, applied as a body force [10^3 kg cm s^-2].
+        top_pressure: uniform pressure on the top face [10^3 kg cm^-1 s^-2] (0 in the paper).
+        c_n, m_n: normal compliance c_n [10^3 kg cm^(-1-m_n) s^-2] and exponent [-].
+        mu: friction coefficient μ = c_T / c_n [-].
+        m_T: friction exponent [-] (None: m_n, Coulomb).
+        b_n, l_n: normal damping [10^3 kg cm^(-2-l_n) s^-1] and exponent [-] (None: m_n).
+        g: initial gap [cm].
+        eps: regularisation of |u̇_T - U_T| [cm/s].
+        regularisation: "c1" or "smooth".
+        friction_coefficient: velocity-dependent μ(|v|) replacing ``mu`` (see laws).
+        belt_speed: |U_T| [cm/s], > 0.
+        belt_direction: +1 (belt moves along +x) or -1.
+        K_x: total stiffness of the driver spring [10^3 kg s^-2].
+        spring_height: height of the spring's line of action [cm] (None: H/2).
+        refine: mesh refinement factor; the mesh has 4·refine × 3·refine cells.
+        degree: polynomial degree of the Lagrange quadrilaterals (2: nine-node Q2).
+    """
+
+    L: float = 48.8
+    H: float = 30.5
+    B0: float = 30.5
+    E: float = 1.4e6
+    nu: float = 0.25
+    mass: float = 0.45
+    weight: float = 450.0
+    top_pressure: float = 0.0
+    c_n: float = 1e10
+    m_n: float = 2.5
+    mu: float = 0.0
+    m_T: typing.Optional[float] = None
+    b_n: float = 0.0
+    l_n: typing.Optional[float] = None
+    g: float = 0.0
+    eps: float = 1e-3
+    regularisation: str = "c1"
+    friction_coefficient: typing.Optional[laws.FrictionCoefficient] = None
+    belt_speed: float = 0.287
+    belt_direction: int = 1
+    K_x: float = 11.1
+    spring_height: typing.Optional[float] = None
+    refine: int = 1
+    degree: int = 2
+
+    def __post_init__(self):
+        if self.spring_height is None:
+            self.spring_height = self.H / 2
+        self.validate()
+
+    def validate(self) -> None:
+        """Raise ``ValueError`` naming the first parameter out of its range."""
+        for name in ("L", "H", "B0", "E", "mass", "K_x", "belt_speed"):
+            value = getattr(self, name)
+            check(name, value, np.isfinite(value) and value > 0, "must be a finite number > 0")
+        check("nu", self.nu, -1 < self.nu < 0.5, "Poisson's ratio must lie in (-1, 0.5)")
+        check("weight", self.weight, self.weight >= 0, "must be >= 0")
+        check("top_pressure", self.top_pressure, self.top_pressure >= 0, "must be >= 0")
+        check("weight", self.weight, self.weight + self.top_pressure > 0,
+              "weight and top_pressure cannot both be 0: nothing presses the block on the belt")
+        check("belt_direction", self.belt_direction, self.belt_direction in (1, -1),
+              "must be +1 or -1")
+        check("spring_height", self.spring_height, 0 <= self.spring_height <= self.H,
+              f"must lie in [0, H] = [0, {self.H}]")
+        check("refine", self.refine, isinstance(self.refine, int) and self.refine >= 1,
+              "must be an integer >= 1")
+        check("degree", self.degree, self.degree in (1, 2, 3), "must be 1, 2 or 3")
+        self.law  # validates the interface parameters
+
+    @property
+    def law(self) -> laws.InterfaceLaw:
+        return laws.InterfaceLaw(c_n=self.c_n, m_n=self.m_n, mu=self.mu, m_T=self.m_T,
+                                 b_n=self.b_n, l_n=self.l_n, g=self.g, eps=self.eps,
+                                 regularisation=self.regularisation,
+                                 friction_coefficient=self.friction_coefficient)
+
+    @property
+    def contact_pressure(self) -> float:
+        """Mean contact pressure (W + p_top L B0) / (L B0) at equilibrium."""
+        return self.weight / (self.L * self.B0) + self.top_pressure
+
+    @property
+    def tipping_limit(self) -> float:
+        """μ at which the normal resultant reaches the front corner: L / (2 h_s)."""
+        return self.L / (2 * self.spring_height) if self.spring_height > 0 else np.inf
+
+    def build(self, comm: MPI.Comm = MPI.COMM_WORLD,
+              with_friction: typing.Optional[bool] = None) -> "BlockModel":
+        """Mesh, spaces, the residual and its parameters as ``fem.Constant``.
+
+        Args:
+            comm: communicator the mesh is distributed over.
+            with_friction: include the friction term; default only when μ > 0 or a
+                velocity-dependent law is given (a frictionless scene assembles no friction).
+        """
+        return BlockModel(self, comm, with_friction)
+
+
+def _node_rows_to(n_rows: int, H: float, target: float) -> np.ndarray:
+    """Heights of the n_rows+1 vertex rows, uniform except that a Q2 node lies at ``target``."""
+    rows = np.linspace(0.0, H, n_rows + 1)
+    nodes = np.linspace(0.0, H, 2 * n_rows + 1)
+    k = int(np.argmin(np.abs(nodes - target)))
+    if np.isclose(nodes[k], target, rtol=0, atol=1e-12 * H):
+        return rows
+    if k % 2 == 1:  # a mid-edge row: centre its cell row on the target if it fits
+        half = H / (2 * n_rows)
+        j = (k - 1) // 2
+        if 0 < target - half and target + half < H and 0 < j < n_rows - 1:
+            below = np.linspace(0.0, target - half, j + 1)
+            above = np.linspace(target + half, H, n_rows - j)
+            return np.concatenate([below, above])
+        k = k + 1 if k + 1 < 2 * n_rows else k - 1
+    j = k // 2
+    j = min(max(j, 1), n_rows - 1) if 0 < target < H else (0 if target == 0 else n_rows)
+    return np.concatenate([np.linspace(0.0, target, j + 1)[:-1], np.linspace(target, H, n_rows - j + 1)])
+
+
+class BlockModel:
+    """A built block scene: mesh, function space, the residual and post-processing.
+
+    Attributes:
+        scene: the parameters it was built from.
+        msh, V: mesh and vector Lagrange space.
+        residual: the one residual (see :mod:`fenicsfriction.forms`).
+        mu, eps, thickness: ``fem.Constant`` — change ``mu.value`` / ``eps.value`` and re-solve.
+        ds_contact: measure on Γ_C with the fixed quadrature degree used everywhere.
+        spring: the driver's :class:`~fenicsfriction.forms.NodalSpring`.
+    """
+
+    def __init__(self, scene: BlockOnBelt, comm: MPI.Comm, with_friction: typing.Optional[bool]):
+        self.scene = s = scene
+        law = s.law
+        if with_friction is None:
+            with_friction = s.mu > 0 or s.friction_coefficient is not None
+        self.with_friction = with_friction
+        nx, ny = 4 * s.refine, 3 * s.refine
+        self.msh = msh = _compat.create_rectangle(comm, (0.0, 0.0), (s.L, s.H), (nx, ny))
+        rows = _node_rows_to(ny, s.H, s.spring_height)
+        msh.geometry.x[:, 1] = np.interp(msh.geometry.x[:, 1], np.linspace(0, s.H, ny + 1), rows)
+        self.V = V = _compat.vector_function_space(msh, s.degree)
+
+        fdim = msh.topology.dim - 1
+        tol = 1e-10 * max(s.L, s.H)
+        marked = [(CONTACT, lambda x: np.isclose(x[1], 0.0, atol=tol)),
+                  (TOP, lambda x: np.isclose(x[1], s.H, atol=tol)),
+                  (LEFT, lambda x: np.isclose(x[0], 0.0, atol=tol)),
+                  (RIGHT, lambda x: np.isclose(x[0], s.L, atol=tol))]
+        facets, values = [], []
+        for tag, where in marked:
+            f = mesh.locate_entities_boundary(msh, fdim, where)
+            facets.append(f)
+            values.append(np.full(len(f), tag, dtype=np.int32))
+        facets, values = np.concatenate(facets), np.concatenate(values)
+        order = np.argsort(facets)
+        self.facet_tags = mesh.meshtags(msh, fdim, facets[order], values[order])
+        ds = ufl.Measure("ds", domain=msh, subdomain_data=self.facet_tags)
+        quad = 2 * s.degree + 4
+        self.ds_contact = ds(CONTACT, metadata={"quadrature_degree": quad})
+        self.dx = ufl.Measure("dx", domain=msh)
+
+        def constant(value):
+            return fem.Constant(msh, np.float64(value))
+
+        self.mu, self.eps, self.thickness = constant(s.mu), constant(s.eps), constant(s.B0)
+        self.c_n = constant(law.c_n)
+        # exponents stay Python floats: UFL differentiates d**Constant very slowly
+        self.m_n, self.m_T = float(law.m_n), float(law.m_T)
+        self.gap = constant(law.g)
+        self.belt_velocity = fem.Constant(msh, np.array([s.belt_direction * s.belt_speed, 0.0]))
+        volume = s.L * s.H * s.B0
+        self.rho = constant(s.mass / volume)
+        self.gravity = fem.Constant(msh, np.array([0.0, -s.weight / volume]))
+        self.top_traction = fem.Constant(msh, np.array([0.0, -s.top_pressure]))
+        self.normal = ufl.FacetNormal(msh)
+
+        u, u_dot, u_ddot = fem.Function(V, name="displacement"), fem.Function(V), fem.Function(V)
+        v = ufl.TestFunction(V)
+        n, ds_c = self.normal, self.ds_contact
+        terms = inertia(self.rho, u_ddot, v, self.dx) \
+            + elasticity(u, v, s.E, s.nu, self.dx) \
+            + body_force(self.gravity, v, self.dx) \
+            + normal_compliance(u, v, n, self.c_n, self.m_n, self.gap, ds_c)
+        if s.top_pressure > 0:
+            terms += surface_traction(self.top_traction, v, ds(TOP))
+        if law.b_n > 0:
+            terms += normal_damping(u, u_dot, v, n, law.b_n, law.l_n, self.gap, ds_c)
+        if with_friction:
+            terms += friction(u, u_dot, v, n, self.friction_c_T, self.m_T, self.gap,
+                              self.belt_velocity, self.eps, ds_c, law.regularisation)
+        self.spring = NodalSpring.at_point(V, (0.0, s.spring_height), 0, s.K_x)
+        self.residual = Residual(form=self.thickness * terms, u=u, u_dot=u_dot, u_ddot=u_ddot,
+                                 v=v, bcs=[], springs=[self.spring])
+        self._functionals: dict = {}
+        contact_dofs = fem.locate_dofs_topological(
+            V.sub(1), fdim, self.facet_tags.find(CONTACT))
+        self._contact_y = contact_dofs[contact_dofs < V.dofmap.index_map.size_local * 2]
+
+    @property
+    def friction_c_T(self):
+        """c_T as used by the friction term: μ c_n, or c_n μ(|v|) for a velocity law."""
+        law = self.scene.friction_coefficient
+        if law is None:
+            return self.mu * self.c_n
+        return lambda speed: self.c_n * law(speed)
+
+    # --- quantities on Γ_C -----------------------------------------------------------------------
+    def penetration(self):
+        """UFL penetration d = (u_n - g)_+ on Γ_C."""
+        return laws.penetration(normal_part(self.residual.u, self.normal), self.gap)
+
+    def pressure(self):
+        """UFL normal contact pressure c_n d^{m_n} (elastic part)."""
+        return laws.normal_pressure(self.penetration(), self.c_n, self.m_n)
+
+    def friction_traction(self):
+        """UFL friction traction on the body at rest (u̇ = 0), a vector tangent to Γ_C."""
+        if not self.with_friction:
+            return ufl.zero(2)
+        w = tangential_part(self.residual.u_dot, self.normal) - self.belt_velocity
+        c_T = self.friction_c_T
+        if is_speed_law(c_T):
+            c_T = c_T(ufl.sqrt(ufl.inner(w, w)))
+        direction = laws.REGULARISATIONS[self.scene.regularisation][1](w, self.eps)
+        traction = -laws.friction_bound(self.penetration(), c_T, self.m_T) * direction
+        return ufl.replace(traction, {self.residual.u_dot: ufl.zero(2)})
+
+    def _integral(self, key: str, integrand) -> float:
+        if key not in self._functionals:
+            self._functionals[key] = _compat.form(self.thickness * integrand * self.ds_contact)
+        value = fem.assemble_scalar(self._functionals[key])
+        return self.msh.comm.allreduce(value, op=MPI.SUM)
+
+    @property
+    def force_scale(self) -> float:
+        """Total load pressing the block down [force]: the scale of the residual's entries."""
+        return self.scene.contact_pressure * self.scene.L * self.scene.B0
+
+    def solver_options(self) -> dict:
+        """SNES tolerances scaled to this scene (residual entries are nodal forces).
+
+        The round-off floor of the residual is about 1e-16 |K| |u|: the spring stretch (tens of
+        cm) times stiffness entries of order E B0 gives ~1e-7, so 1e-8 of the load (4.5e-6 for
+        the paper's block) is the tightest absolute tolerance Newton can always reach.
+        """
+        return {"snes_atol": 1e-8 * self.force_scale}
+
+    def initial_guess(self) -> None:
+        """Uniform penetration under the mean pressure and the spring balancing μ W."""
+        s = self.scene
+        d0 = s.law.uniform_penetration(s.contact_pressure)
+        ux = s.belt_direction * float(self.mu.value) * s.contact_pressure * s.L * s.B0 / s.K_x
+        self.residual.u.interpolate(
+            lambda x: np.vstack([np.full(x.shape[1], ux), np.full(x.shape[1], -(d0 + s.g))]))
+
+    def quantities(self) -> dict:
+        """Resultants and penetration extremes of the current state (same on every rank).
+
+        ``normal_force`` [force]: total normal contact force on the body (upwards > 0);
+        ``friction_force`` and ``spring_force`` [force]: x-components of the forces on the
+        body; ``centre_of_pressure`` [cm]: x of the normal resultant minus L/2;
+        ``min_penetration``/``max_penetration`` [cm] over the contact nodes.
+        """
+        x = ufl.SpatialCoordinate(self.msh)
+        p = self.pressure()
+        normal = self._integral("normal", p)
+        moment = self._integral("moment", (x[0] - self.scene.L / 2) * p)
+        friction_force = self._integral("friction", self.friction_traction()[0]) \
+            if self.with_friction else 0.0
+        uy = self.residual.u.x.array[self._contact_y]
+        d = np.maximum(-uy - self.scene.g, 0.0)
+        comm = self.msh.comm
+        return {"mu": float(self.mu.value),
+                "normal_force": normal,
+                "friction_force": friction_force,
+                "spring_force": self.spring.force(self.residual.u),
+                "centre_of_pressure": moment / normal if normal > 0 else float("nan"),
+                "min_penetration": comm.allreduce(d.min() if d.size else np.inf, op=MPI.MIN),
+                "max_penetration": comm.allreduce(d.max() if d.size else -np.inf, op=MPI.MAX)}
