@@ -84,6 +84,6 @@ def assemble_matrix_into(A: PETSc.Mat, a: fem.FormMetaClass, bcs: list) -> None:
     dolfinx.fem.petsc.assemble_matrix(A, a, bcs)
 
 
-def form(expr: ufl.Form) -> fem.FormMetaClass:
-    """Compile a UFL form with the package's JIT options."""
-    return fem.form(expr, **jit_options())
+def form(expr: ufl.Form, cache_dir: typing.Optional[str] = None) -> fem.FormMetaClass:
+    """Compile a UFL form with the package's JIT options (``cache_dir``: where FFCx caches)."""
+    return fem.form(expr, **jit_options(cache_dir))

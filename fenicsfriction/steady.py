@@ -87,6 +87,8 @@ class SteadySolver:
         prefix: PETSc options prefix of the SNES (and its KSP/PC).
         options: defaults for this solver, merged over :data:`DEFAULT_OPTIONS`; options already
             in the PETSc database (set by the user) take precedence.
+        jit_cache_dir: FFCx cache directory (default: dolfinx's); ``jit_time_s`` records the
+            time spent compiling (or loading) the two forms.
 
     Attributes:
         snes: the PETSc SNES, exposed for monitoring or further configuration.
@@ -94,12 +96,12 @@ class SteadySolver:
     """
 
     def __init__(self, residual: Residual, prefix: str = "steady_",
-                 options: typing.Optional[dict] = None):
+                 options: typing.Optional[dict] = None, jit_cache_dir: typing.Optional[str] = None):
         self.residual = residual
         self.u = residual.u
         t0 = time.perf_counter()
-        self.L = _compat.form(residual.steady())
-        self.a = _compat.form(residual.steady_jacobian())
+        self.L = _compat.form(residual.steady(), jit_cache_dir)
+        self.a = _compat.form(residual.steady_jacobian(), jit_cache_dir)
         self.jit_time_s = time.perf_counter() - t0
         self.b = dolfinx.fem.petsc.create_vector(self.L)
         self.A = dolfinx.fem.petsc.create_matrix(self.a)
