@@ -19,8 +19,13 @@ Choices the paper leaves open, made here and changeable through the fields:
 * **Belt** along ``belt_direction`` × e_x at ``belt_speed``; friction drags the block that
   way and the spring holds it back.
 * **Contact** on the bottom face y = 0 (outward normal -e_y), initial gap g (default 0).
-  The contact integrals use a fixed quadrature degree so that the reported resultants are
+  The contact integrals use a fixed quadrature rule so that the reported resultants are
   computed exactly as the residual integrates them.
+* **Discrete tipping limit.** The normal resultant cannot lie further out than the outermost
+  contact quadrature point, so steady sliding exists only up to
+  μ_h = (L/2 - s_1)/h_s (s_1: that point's distance from the corner). Gauss points
+  (default, ``contact_quadrature="gauss"``) give μ_h → L/(2 h_s) as the mesh is refined;
+  Gauss-Lobatto points (``"gll"``) include the corners, so μ_h = L/(2 h_s) on any mesh.
 """
 
 from __future__ import annotations
@@ -43,6 +48,22 @@ from fenicsfriction.laws import check
 __all__ = ["BlockModel", "BlockOnBelt"]
 
 CONTACT, TOP, LEFT, RIGHT = 1, 2, 3, 4
+
+
+def _gauss(degree: int) -> tuple[np.ndarray, dict]:
+    """Gauss points on [0, 1] of the contact rule and its UFL metadata."""
+    q = 2 * degree + 4
+    x = (np.polynomial.legendre.leggauss(q // 2 + 1)[0] + 1) / 2
+    return x, {"quadrature_degree": q}
+
+
+def _gll(degree: int) -> tuple[np.ndarray, dict]:
+    """Gauss-Lobatto points (corners included) and metadata; FFCx uses (q+3)/2 points."""
+    q = 2 * degree + 5
+    return np.array([0.0, 1.0]), {"quadrature_degree": q, "quadrature_rule": "GLL"}
+
+
+QUADRATURE = {"gauss": _gauss, "gll": _gll}
 
 
 @dataclasses.dataclass
@@ -72,6 +93,7 @@ class BlockOnBelt:
         spring_height: height of the spring's line of action [cm] (None: H/2).
         refine: mesh refinement factor; the mesh has 4·refine × 3·refine cells.
         degree: polynomial degree of the Lagrange quadrilaterals (2: nine-node Q2).
+        contact_quadrature: "gauss" or "gll" (Gauss-Lobatto, includes the corners) on Γ_C.
     """
 
     L: float = 48.8
@@ -98,6 +120,7 @@ class BlockOnBelt:
     spring_height: typing.Optional[float] = None
     refine: int = 1
     degree: int = 2
+    contact_quadrature: str = "gauss"
 
     def __post_init__(self):
         if self.spring_height is None:
@@ -121,6 +144,8 @@ class BlockOnBelt:
         check("refine", self.refine, isinstance(self.refine, int) and self.refine >= 1,
               "must be an integer >= 1")
         check("degree", self.degree, self.degree in (1, 2, 3), "must be 1, 2 or 3")
+        check("contact_quadrature", self.contact_quadrature,
+              self.contact_quadrature in QUADRATURE, f"must be one of {sorted(QUADRATURE)}")
         self.law  # validates the interface parameters
 
     @property
@@ -139,6 +164,15 @@ class BlockOnBelt:
     def tipping_limit(self) -> float:
         """μ at which the normal resultant reaches the front corner: L / (2 h_s)."""
         return self.L / (2 * self.spring_height) if self.spring_height > 0 else np.inf
+
+    @property
+    def discrete_tipping_limit(self) -> float:
+        """μ at which the resultant reaches the outermost contact quadrature point."""
+        if self.spring_height == 0:
+            return np.inf
+        points = QUADRATURE[self.contact_quadrature](self.degree)[0]
+        s_1 = points.min() * self.L / (4 * self.refine)
+        return (self.L / 2 - s_1) / self.spring_height
 
     def build(self, comm: MPI.Comm = MPI.COMM_WORLD,
               with_friction: typing.Optional[bool] = None) -> "BlockModel":
@@ -184,6 +218,8 @@ class BlockModel:
         spring: the driver's :class:`~fenicsfriction.forms.NodalSpring`.
     """
 
+    CONTACT = CONTACT
+
     def __init__(self, scene: BlockOnBelt, comm: MPI.Comm, with_friction: typing.Optional[bool]):
         self.scene = s = scene
         law = s.law
@@ -211,8 +247,7 @@ class BlockModel:
         order = np.argsort(facets)
         self.facet_tags = mesh.meshtags(msh, fdim, facets[order], values[order])
         ds = ufl.Measure("ds", domain=msh, subdomain_data=self.facet_tags)
-        quad = 2 * s.degree + 4
-        self.ds_contact = ds(CONTACT, metadata={"quadrature_degree": quad})
+        self.ds_contact = ds(CONTACT, metadata=QUADRATURE[s.contact_quadrature](s.degree)[1])
         self.dx = ufl.Measure("dx", domain=msh)
 
         def constant(value):
@@ -261,25 +296,36 @@ class BlockModel:
         return lambda speed: self.c_n * law(speed)
 
     # --- quantities on Γ_C -----------------------------------------------------------------------
-    def penetration(self):
-        """UFL penetration d = (u_n - g)_+ on Γ_C."""
-        return laws.penetration(normal_part(self.residual.u, self.normal), self.gap)
+    def penetration(self, n=None):
+        """UFL penetration d = (u_n - g)_+ (``n``: normal to use, default the facet normal)."""
+        n = self.normal if n is None else n
+        return laws.penetration(normal_part(self.residual.u, n), self.gap)
 
-    def pressure(self):
+    def pressure(self, n=None):
         """UFL normal contact pressure c_n d^{m_n} (elastic part)."""
-        return laws.normal_pressure(self.penetration(), self.c_n, self.m_n)
+        return laws.normal_pressure(self.penetration(n), self.c_n, self.m_n)
 
-    def friction_traction(self):
+    def friction_traction(self, n=None):
         """UFL friction traction on the body at rest (u̇ = 0), a vector tangent to Γ_C."""
         if not self.with_friction:
             return ufl.zero(2)
-        w = tangential_part(self.residual.u_dot, self.normal) - self.belt_velocity
+        n = self.normal if n is None else n
+        w = tangential_part(self.residual.u_dot, n) - self.belt_velocity
         c_T = self.friction_c_T
         if is_speed_law(c_T):
             c_T = c_T(ufl.sqrt(ufl.inner(w, w)))
         direction = laws.REGULARISATIONS[self.scene.regularisation][1](w, self.eps)
-        traction = -laws.friction_bound(self.penetration(), c_T, self.m_T) * direction
+        traction = -laws.friction_bound(self.penetration(n), c_T, self.m_T) * direction
         return ufl.replace(traction, {self.residual.u_dot: ufl.zero(2)})
+
+    def contact_traction(self):
+        """UFL traction of the foundation on the body, valid in cells (for output fields).
+
+        Uses the contact face's constant normal -e_y instead of the facet normal so it can be
+        interpolated; it is meaningful only on Γ_C (see :meth:`contact_dofs`).
+        """
+        n = ufl.as_vector([0.0, -1.0])
+        return -self.pressure(n) * n + self.friction_traction(n)
 
     def _integral(self, key: str, integrand) -> float:
         if key not in self._functionals:
@@ -293,13 +339,9 @@ class BlockModel:
         return self.scene.contact_pressure * self.scene.L * self.scene.B0
 
     def solver_options(self) -> dict:
-        """SNES tolerances scaled to this scene (residual entries are nodal forces).
-
-        The round-off floor of the residual is about 1e-16 |K| |u|: the spring stretch (tens of
-        cm) times stiffness entries of order E B0 gives ~1e-7, so 1e-8 of the load (4.5e-6 for
-        the paper's block) is the tightest absolute tolerance Newton can always reach.
-        """
-        return {"snes_atol": 1e-8 * self.force_scale}
+        """SNES tolerances scaled to this scene: residual entries are nodal forces, 1e-10 of the
+        load. The solver raises it to the round-off floor where needed (see SteadySolver)."""
+        return {"snes_atol": 1e-10 * self.force_scale}
 
     def initial_guess(self) -> None:
         """Uniform penetration under the mean pressure and the spring balancing μ W."""

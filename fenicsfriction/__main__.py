@@ -1,0 +1,5 @@
+import sys
+
+from fenicsfriction.cli import main
+
+sys.exit(main())

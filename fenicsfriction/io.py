@@ -1,0 +1,93 @@
+"""Results on disk: JSON for numbers, XDMF for fields (ParaView). Rank 0 writes files."""
+
+from __future__ import annotations
+
+import json
+import logging
+import pathlib
+import typing
+
+import numpy as np
+from dolfinx import fem, io
+
+from mpi4py import MPI
+
+from fenicsfriction import _compat
+
+__all__ = ["FieldWriter", "get_logger", "write_json"]
+
+
+def get_logger(comm: MPI.Comm = MPI.COMM_WORLD) -> logging.Logger:
+    """The package logger: INFO on rank 0, warnings only elsewhere."""
+    logger = logging.getLogger("fenicsfriction")
+    if not logger.handlers:
+        handler = logging.StreamHandler()
+        handler.setFormatter(logging.Formatter("%(message)s"))
+        logger.addHandler(handler)
+        logger.propagate = False
+    logger.setLevel(logging.INFO if comm.rank == 0 else logging.WARNING)
+    return logger
+
+
+def _plain(value):
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, float) and not np.isfinite(value):
+        return None
+    return value
+
+
+def write_json(path: typing.Union[str, pathlib.Path], data, comm: MPI.Comm = MPI.COMM_WORLD):
+    """Write ``data`` as JSON on rank 0 (NumPy scalars converted, non-finite floats -> null)."""
+    if comm.rank == 0:
+        path = pathlib.Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(_plain(data), indent=1) + "\n")
+    comm.Barrier()
+
+
+class FieldWriter:
+    """XDMF time series of the displacement and the contact traction.
+
+    dolfinx 0.5 writes fields of the mesh's coordinate degree only, so both are interpolated
+    into a degree-1 vector space. The traction field is kept on the contact nodes only (zero
+    elsewhere). The "time" of each record is the continuation parameter (μ) or the time.
+    """
+
+    def __init__(self, path: typing.Union[str, pathlib.Path], model):
+        self.model = model
+        msh = model.msh
+        self.V1 = _compat.vector_function_space(msh, 1)
+        self.displacement = fem.Function(self.V1, name="displacement")
+        self.traction = fem.Function(self.V1, name="contact_traction")
+        self._traction_expr = fem.Expression(model.contact_traction(),
+                                             _compat.interpolation_points(self.V1))
+        fdim = msh.topology.dim - 1
+        facets = model.facet_tags.find(model.CONTACT)
+        self._off_contact = np.setdiff1d(
+            np.arange(self.V1.dofmap.index_map.size_local + self.V1.dofmap.index_map.num_ghosts),
+            fem.locate_dofs_topological(self.V1, fdim, facets))
+        pathlib.Path(path).parent.mkdir(parents=True, exist_ok=True)
+        self.file = io.XDMFFile(msh.comm, str(path), "w")
+        self.file.write_mesh(msh)
+
+    def write(self, t: float) -> None:
+        self.displacement.interpolate(self.model.residual.u)
+        self.traction.interpolate(self._traction_expr)
+        values = self.traction.x.array.reshape(-1, 2)
+        values[self._off_contact] = 0.0
+        self.file.write_function(self.displacement, t)
+        self.file.write_function(self.traction, t)
+
+    def close(self) -> None:
+        self.file.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()

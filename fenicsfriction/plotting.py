@@ -1,0 +1,109 @@
+"""Figures people would rather look at than read (matplotlib, drawn on rank 0)."""
+
+from __future__ import annotations
+
+import pathlib
+import typing
+
+import numpy as np
+from dolfinx import fem
+
+from mpi4py import MPI
+
+from fenicsfriction import _compat
+
+__all__ = ["cell_outlines", "plot_deformed", "plot_steady_forces"]
+
+
+def _pyplot():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def cell_outlines(u: fem.Function) -> typing.Optional[tuple[np.ndarray, np.ndarray]]:
+    """Reference coordinates and displacements of every quadrilateral's corners, on rank 0.
+
+    Returns ``(X, U)`` of shape (num_cells, 4, 2) on rank 0 and ``None`` elsewhere.
+    """
+    msh = u.function_space.mesh
+    V1 = _compat.vector_function_space(msh, 1)
+    u1 = fem.Function(V1)
+    u1.interpolate(u)
+    num_cells = msh.topology.index_map(msh.topology.dim).size_local
+    dofs = np.array([V1.dofmap.cell_dofs(c) for c in range(num_cells)]).reshape(num_cells, -1)
+    dofs = dofs[:, [0, 1, 3, 2]]  # tensor-product order -> counter-clockwise polygon
+    X = V1.tabulate_dof_coordinates()[:, :2][dofs]
+    U = u1.x.array.reshape(-1, 2)[dofs]
+    gathered = msh.comm.gather((X, U), root=0)
+    if msh.comm.rank != 0:
+        return None
+    return (np.concatenate([g[0] for g in gathered]), np.concatenate([g[1] for g in gathered]))
+
+
+def plot_deformed(snapshots: list[tuple[float, np.ndarray, np.ndarray]], path, length: float,
+                  height: float, comm: MPI.Comm = MPI.COMM_WORLD) -> None:
+    """Deformed configurations at several μ (seed 000 Fig. 7), magnified.
+
+    The mean displacement (the spring's rigid stretch, tens of cm) is removed and the rest,
+    rotation and deformation of order 1e-4 cm, is magnified by one factor shared by all panels.
+    """
+    if comm.rank != 0 or not snapshots:
+        return
+    plt = _pyplot()
+    amplitude = max(np.abs(U - U.reshape(-1, 2).mean(axis=0)).max() for _, _, U in snapshots)
+    scale = 0.08 * height / amplitude if amplitude > 0 else 1.0
+    fig, axes = plt.subplots(1, len(snapshots), figsize=(3.2 * len(snapshots), 3.2),
+                             squeeze=False)
+    for ax, (mu, X, U) in zip(axes[0], snapshots):
+        W = U - U.reshape(-1, 2).mean(axis=0)
+        for x, w in zip(X, W):
+            ax.fill(*x.T, fc="none", ec="0.8", lw=0.6)
+            ax.fill(*(x + scale * w).T, fc="tab:blue", alpha=0.15, ec="tab:blue", lw=0.8)
+        ax.axhline(0.0, color="k", lw=1.5)
+        ax.set_title(f"μ = {mu:.3g}")
+        ax.set_aspect("equal")
+        ax.set_xlim(-0.1 * length, 1.1 * length)
+        ax.set_ylim(-0.25 * height, 1.15 * height)
+        ax.set_xlabel("x [cm]")
+    axes[0][0].set_ylabel("y [cm]")
+    fig.suptitle(f"Steady sliding: deformed block (rigid stretch removed, ×{scale:.3g})")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def plot_steady_forces(records: list[dict], path, spring_height: float, belt_direction: int,
+                       tipping_limit: float, comm: MPI.Comm = MPI.COMM_WORLD) -> None:
+    """Resultant forces, centre of pressure and penetration against μ."""
+    if comm.rank != 0 or not records:
+        return
+    plt = _pyplot()
+    mu = np.array([r["mu"] for r in records])
+    get = lambda key: np.array([r[key] for r in records])  # noqa: E731
+    fig, axes = plt.subplots(1, 3, figsize=(14, 4))
+    ax = axes[0]
+    ax.plot(mu, get("normal_force"), "o-", ms=3, label="normal force N")
+    ax.plot(mu, np.abs(get("friction_force")), "s-", ms=3, label="|friction force|")
+    ax.plot(mu, np.abs(get("spring_force")), "x", label="|spring force|")
+    ax.plot(mu, mu * get("normal_force"), "k:", label="μ N")
+    ax.set_xlabel("μ")
+    ax.set_ylabel("force [10³ kg cm s⁻²]")
+    ax.legend()
+    ax = axes[1]
+    ax.plot(mu, get("centre_of_pressure"), "o-", ms=3, label="computed")
+    ax.plot(mu, -belt_direction * mu * spring_height, "k:", label="statics: −μ h_s")
+    ax.axvline(tipping_limit, color="r", lw=0.8, ls="--", label=f"tipping μ = {tipping_limit:.3g}")
+    ax.set_xlabel("μ")
+    ax.set_ylabel("centre of pressure − L/2 [cm]")
+    ax.legend()
+    ax = axes[2]
+    ax.plot(mu, get("max_penetration"), "o-", ms=3, label="max")
+    ax.plot(mu, get("min_penetration"), "s-", ms=3, label="min")
+    ax.set_xlabel("μ")
+    ax.set_ylabel("penetration [cm]")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
