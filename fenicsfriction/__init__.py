@@ -2,7 +2,7 @@
 
 from importlib import metadata as _metadata
 
-from fenicsfriction import forms, laws
+from fenicsfriction import forms, io, laws
 from fenicsfriction.forms import Residual
 from fenicsfriction.laws import InterfaceLaw
 from fenicsfriction.scenes import BlockOnBelt
@@ -15,4 +15,4 @@ except _metadata.PackageNotFoundError:  # running from a source tree
     __version__ = "0.0.0+unknown"
 
 __all__ = ["BlockOnBelt", "ContinuationError", "InterfaceLaw", "Residual", "SolveError",
-           "SteadySolver", "__version__", "continuation", "epsilon_sequence", "forms", "laws"]
+           "SteadySolver", "__version__", "continuation", "epsilon_sequence", "forms", "io", "laws"]

@@ -139,6 +139,7 @@ def _run_steady(args: argparse.Namespace, log: logging.Logger) -> int:
     plotting.plot_deformed(snapshots, out / "deformed.png", scene.L, scene.H, comm)
     plotting.plot_steady_forces(records, out / "forces.png", scene.spring_height,
                                 scene.belt_direction, scene.tipping_limit, comm)
+    comm.Barrier()  # every file exists on return, whichever rank asks
     log.info(f"results in {out}/: steady.json, summary.json, steady.xdmf, deformed.png, forces.png"
              + (", epsilon.json" if eps_records else ""))
     if failure is not None:

@@ -1,0 +1,89 @@
+"""The command line: results written as documented, user errors as one line and exit 2."""
+
+import json
+import os
+import pathlib
+import shutil
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+import pytest
+
+from mpi4py import MPI
+
+from fenicsfriction.cli import main
+
+REQUIRED = {"mu", "normal_force", "friction_force", "spring_force", "centre_of_pressure",
+            "min_penetration", "max_penetration", "newton_iterations", "residual_norm",
+            "wall_time_s"}
+
+
+@pytest.fixture
+def out_dir() -> pathlib.Path:
+    """One folder for all ranks, made by rank 0 (pytest's tmp_path rotation is per process)."""
+    comm = MPI.COMM_WORLD
+    path = pathlib.Path(comm.bcast(tempfile.mkdtemp(prefix="ff-cli-") if comm.rank == 0 else None))
+    yield path / "out"
+    comm.Barrier()
+    if comm.rank == 0:
+        shutil.rmtree(path, ignore_errors=True)
+
+
+def test_steady_cli_writes_one_balanced_record_per_step(out_dir):
+    code = main(["steady", "block", "--mu-max", "0.9", "--steps", "6", "--out", str(out_dir),
+                 "--snapshots", "2"])
+    assert code == 0
+    records = json.loads((out_dir / "steady.json").read_text())
+    assert isinstance(records, list) and len(records) == 7
+    for r in records:
+        assert REQUIRED <= set(r)
+        # statics of the block (Newton tolerance ~1e-7 of the load, see SteadySolver)
+        assert r["friction_force"] == pytest.approx(r["mu"] * r["normal_force"], rel=1e-8, abs=1e-8)
+        assert r["spring_force"] == pytest.approx(-r["friction_force"], rel=1e-6, abs=1e-6)
+        assert r["centre_of_pressure"] == pytest.approx(-r["mu"] * 30.5 / 2, rel=1e-5, abs=1e-6)
+    assert np.allclose([r["mu"] for r in records], np.linspace(0, 0.9, 7))
+    summary = json.loads((out_dir / "summary.json").read_text())
+    assert summary["failure"] is None and summary["tipping_limit"] == pytest.approx(1.6)
+    for name in ("steady.xdmf", "steady.h5", "deformed.png", "forces.png"):
+        assert (out_dir / name).stat().st_size > 0, name
+
+
+def test_steady_cli_stops_at_discrete_tipping_limit_and_reports_it(out_dir):
+    """Beyond μ = L/H no steady state exists: exit 1, converged steps kept, no hang."""
+    code = main(["steady", "block", "--mu-max", "1.7", "--steps", "2", "--out", str(out_dir),
+                 "--max-halvings", "3", "--snapshots", "0"])
+    assert code == 1
+    summary = json.loads((out_dir / "summary.json").read_text())
+    assert "continuation failed" in summary["failure"]
+    assert 0.85 <= summary["mu_last_converged"] < 1.6
+    assert len(json.loads((out_dir / "steady.json").read_text())) == 2  # μ = 0 and 0.85
+
+
+@pytest.mark.parametrize("flag,value,name", [("--mu-max", "-1", "--mu-max"),
+                                             ("--refine", "0", "refine"),
+                                             ("--belt-direction", "2", "belt_direction"),
+                                             ("--eps", "0", "eps")])
+def test_bad_parameter_value_is_reported_by_name(out_dir, capsys, flag, value, name):
+    args = ["steady", "block", "--mu-max", "0.5", "--steps", "2", "--out", str(out_dir)]
+    args += [flag, value]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    if MPI.COMM_WORLD.rank == 0:
+        assert name in err and value in err
+
+
+@pytest.mark.skipif(MPI.COMM_WORLD.size > 1,
+                    reason="starts its own interpreter; runs in the serial pass")
+@pytest.mark.parametrize("args", [["--mu-max", "-1"], ["--mu-max", "abc"], ["--steps", "0"],
+                                  ["--regularisation", "tanh"]])
+def test_user_error_prints_one_line_without_traceback(tmp_path, args):
+    cmd = [sys.executable, "-m", "fenicsfriction", "steady", "block", "--mu-max", "0.5",
+           "--out", str(tmp_path)] + args
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_"))}
+    result = subprocess.run(cmd, capture_output=True, text=True, timeout=120, env=env)
+    assert result.returncode == 2
+    lines = [line for line in result.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1, result.stderr
+    assert "Traceback" not in result.stderr and args[1] in lines[0]

@@ -1,0 +1,13 @@
+"""Every demo runs, in-process, on however many ranks pytest runs on (1 and 2 in `make test`)."""
+
+import pathlib
+import runpy
+
+import pytest
+
+DEMOS = sorted((pathlib.Path(__file__).parents[1] / "demos").glob("demo_*.py"))
+
+
+@pytest.mark.parametrize("path", DEMOS, ids=[p.stem for p in DEMOS])
+def test_demo_runs(path):
+    runpy.run_path(str(path), run_name="__main__")  # demos assert their own checks
