@@ -10,8 +10,9 @@ Each term is a small pure function returning a UFL form; a scene adds up the one
 *derived* from the one residual with :func:`ufl.derivative` and :func:`ufl.replace`:
 
 * steady sliding (Problem 2): :math:`R(u_0, 0, 0; v)` and its Jacobian;
-* stability (Problem 3): :math:`M = \partial R/\partial\ddot u`, :math:`C = \partial R/\partial\dot u`,
-  :math:`\bar K = \partial R/\partial u` at :math:`(u_0, 0, 0)`.
+* stability (Problem 3): :math:`M = \partial R/\partial\ddot u`,
+  :math:`C = \partial R/\partial\dot u`, :math:`\bar K = \partial R/\partial u` at
+  :math:`(u_0, 0, 0)`.
 
 A researcher can read or extend ``Residual.form`` before anything is compiled; see
 ``demos/demo_block_steady.py`` for a term added to the block and the problem re-solved.

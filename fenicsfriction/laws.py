@@ -170,7 +170,10 @@ class PiecewiseLinearFriction:
 
 @dataclasses.dataclass(frozen=True)
 class StribeckFriction:
-    """Exponential Stribeck-type law :math:`\\mu = \\mu_k + (\\mu_s-\\mu_k) e^{-(|v|/v_s)^\\delta}`."""
+    """Exponential Stribeck-type law.
+
+    :math:`\\mu = \\mu_k + (\\mu_s-\\mu_k) e^{-(|v|/v_s)^\\delta}`.
+    """
 
     mu_s: float
     mu_k: float

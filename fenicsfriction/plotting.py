@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import pathlib
 import typing
 
 import numpy as np
@@ -56,9 +55,9 @@ def plot_deformed(snapshots: list[tuple[float, np.ndarray, np.ndarray]], path, l
     scale = 0.08 * height / amplitude if amplitude > 0 else 1.0
     fig, axes = plt.subplots(1, len(snapshots), figsize=(3.2 * len(snapshots), 3.2),
                              squeeze=False)
-    for ax, (mu, X, U) in zip(axes[0], snapshots):
+    for ax, (mu, X, U) in zip(axes[0], snapshots, strict=True):
         W = U - U.reshape(-1, 2).mean(axis=0)
-        for x, w in zip(X, W):
+        for x, w in zip(X, W, strict=True):
             ax.fill(*x.T, fc="none", ec="0.8", lw=0.6)
             ax.fill(*(x + scale * w).T, fc="tab:blue", alpha=0.15, ec="tab:blue", lw=0.8)
         ax.axhline(0.0, color="k", lw=1.5)

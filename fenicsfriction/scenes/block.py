@@ -146,14 +146,17 @@ class BlockOnBelt:
         check("degree", self.degree, self.degree in (1, 2, 3), "must be 1, 2 or 3")
         check("contact_quadrature", self.contact_quadrature,
               self.contact_quadrature in QUADRATURE, f"must be one of {sorted(QUADRATURE)}")
-        self.law  # validates the interface parameters
+        laws.InterfaceLaw(**self._law_parameters())  # validates the interface parameters
+
+    def _law_parameters(self) -> dict:
+        names = ("c_n", "m_n", "mu", "m_T", "b_n", "l_n", "g", "eps", "regularisation",
+                 "friction_coefficient")
+        return {name: getattr(self, name) for name in names}
 
     @property
     def law(self) -> laws.InterfaceLaw:
-        return laws.InterfaceLaw(c_n=self.c_n, m_n=self.m_n, mu=self.mu, m_T=self.m_T,
-                                 b_n=self.b_n, l_n=self.l_n, g=self.g, eps=self.eps,
-                                 regularisation=self.regularisation,
-                                 friction_coefficient=self.friction_coefficient)
+        """The interface law of the scene (validated)."""
+        return laws.InterfaceLaw(**self._law_parameters())
 
     @property
     def contact_pressure(self) -> float:
@@ -186,24 +189,24 @@ class BlockOnBelt:
         return BlockModel(self, comm, with_friction)
 
 
-def _node_rows_to(n_rows: int, H: float, target: float) -> np.ndarray:
-    """Heights of the n_rows+1 vertex rows, uniform except that a Q2 node lies at ``target``."""
+def _vertex_rows(n_rows: int, degree: int, H: float, target: float) -> np.ndarray:
+    """Heights of the n_rows+1 vertex rows: uniform, except shifted so that a row of nodes of
+    the degree-``degree`` Lagrange space lies at height ``target`` (the spring's node)."""
     rows = np.linspace(0.0, H, n_rows + 1)
-    nodes = np.linspace(0.0, H, 2 * n_rows + 1)
+    nodes = np.linspace(0.0, H, degree * n_rows + 1)
     k = int(np.argmin(np.abs(nodes - target)))
     if np.isclose(nodes[k], target, rtol=0, atol=1e-12 * H):
         return rows
-    if k % 2 == 1:  # a mid-edge row: centre its cell row on the target if it fits
-        half = H / (2 * n_rows)
-        j = (k - 1) // 2
-        if 0 < target - half and target + half < H and 0 < j < n_rows - 1:
-            below = np.linspace(0.0, target - half, j + 1)
-            above = np.linspace(target + half, H, n_rows - j)
-            return np.concatenate([below, above])
-        k = k + 1 if k + 1 < 2 * n_rows else k - 1
-    j = k // 2
-    j = min(max(j, 1), n_rows - 1) if 0 < target < H else (0 if target == 0 else n_rows)
-    return np.concatenate([np.linspace(0.0, target, j + 1)[:-1], np.linspace(target, H, n_rows - j + 1)])
+    spacing = H / n_rows
+    j, fraction = divmod(k, degree)
+    if fraction:  # a row inside cell row j: slide that cell row so the node row hits target
+        low = target - fraction / degree * spacing
+        if 0 < j < n_rows - 1 and 0 < low and low + spacing < H:
+            return np.concatenate([np.linspace(0.0, low, j + 1),
+                                   np.linspace(low + spacing, H, n_rows - j)])
+    j = min(max(int(round(target / spacing)), 1), n_rows - 1)  # move the nearest vertex row
+    return np.concatenate([np.linspace(0.0, target, j + 1)[:-1],
+                           np.linspace(target, H, n_rows - j + 1)])
 
 
 class BlockModel:
@@ -228,7 +231,7 @@ class BlockModel:
         self.with_friction = with_friction
         nx, ny = 4 * s.refine, 3 * s.refine
         self.msh = msh = _compat.create_rectangle(comm, (0.0, 0.0), (s.L, s.H), (nx, ny))
-        rows = _node_rows_to(ny, s.H, s.spring_height)
+        rows = _vertex_rows(ny, s.degree, s.H, s.spring_height)
         msh.geometry.x[:, 1] = np.interp(msh.geometry.x[:, 1], np.linspace(0, s.H, ny + 1), rows)
         self.V = V = _compat.vector_function_space(msh, s.degree)
 
