@@ -75,13 +75,14 @@ def jit_options(cache_dir: typing.Optional[str] = None) -> dict:
     return {"jit_params": options}
 
 
-def assemble_matrix_into(A: PETSc.Mat, a: fem.FormMetaClass, bcs: list) -> None:
-    """Assemble ``a`` into ``A`` (Dirichlet rows: identity), leaving A *unfinalised*.
-
-    The caller adds its own entries (e.g. nodal springs) and then calls ``A.assemble()``.
+def assemble_matrix_into(A: PETSc.Mat, a: fem.FormMetaClass, bcs: list,
+                         diagonal: float = 1.0) -> None:
+    """Assemble ``a`` into ``A`` (Dirichlet rows: ``diagonal`` on the diagonal), leaving A
+    *unfinalised*: the caller adds its own entries (nodal springs), then ``A.assemble()``.
+    ``diagonal`` became ``diag`` in 0.8, so it is passed positionally.
     """
     A.zeroEntries()
-    dolfinx.fem.petsc.assemble_matrix(A, a, bcs)
+    dolfinx.fem.petsc.assemble_matrix(A, a, bcs, diagonal)
 
 
 def form(expr: ufl.Form, cache_dir: typing.Optional[str] = None) -> fem.FormMetaClass:

@@ -41,9 +41,13 @@ def assemble_residual(b: PETSc.Vec, L: fem.FormMetaClass, a: fem.FormMetaClass, 
 
 
 def assemble_jacobian(A: PETSc.Mat, a: fem.FormMetaClass, bcs: list,
-                      springs: typing.Sequence = ()) -> None:
-    """A = dR/du (bilinear form ``a``) plus nodal spring stiffnesses; Dirichlet rows identity."""
-    _compat.assemble_matrix_into(A, a, bcs)
+                      springs: typing.Sequence = (), diagonal: float = 1.0) -> None:
+    """A = dR/du (bilinear form ``a``) plus nodal spring stiffnesses.
+
+    Dirichlet rows and columns are zeroed with ``diagonal`` on the diagonal (1 for a
+    stiffness, 0 for damping and mass so that constrained dofs give infinite eigenvalues).
+    """
+    _compat.assemble_matrix_into(A, a, bcs, diagonal)
     for spring in springs:
         spring.add_to_matrix(A)
     A.assemble()

@@ -1,0 +1,217 @@
+r"""Problem 3, stability of steady sliding: :math:`(\lambda^2 M + \lambda C + \bar K) w = 0`.
+
+The operators are the Gateaux derivatives of the one residual at the steady state
+:math:`(u_0, 0, 0)` (:meth:`Residual.linearisation`); :math:`\bar K` is not symmetric: friction
+couples normal displacement into tangential force (seed 000, eq. 31). Re λ > 0 means the
+steady sliding is dynamically unstable.
+
+SLEPc PEP (TOAR) with shift-and-invert about 0 (MUMPS LU) computes the eigenvalues of
+smallest modulus; the number requested grows until every eigenvalue with
+:math:`|\lambda| \le \omega_{max}` has been found, so all modes whose frequency and growth rate
+lie in that disc — those that can go unstable in the band of interest — are caught. In the real
+PETSc build, complex eigenvalues come in conjugate pairs; only Im λ >= 0 is kept. Each
+eigenpair carries its relative residual
+
+.. math:: \frac{\|(\lambda^2 M + \lambda C + \bar K) w\|}
+               {(|\lambda|^2\|M\|_\infty + |\lambda|\|C\|_\infty + \|\bar K\|_\infty)\|w\|}
+
+and is flagged when that exceeds ``residual_tol``. Dirichlet dofs have 1 on the diagonal of
+:math:`\bar K` and 0 in M and C, so their eigenvalues are infinite and never near the shift.
+PETSc/SLEPc options live under the prefix (default ``stability_``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import typing
+
+import numpy as np
+import scipy.optimize
+
+import dolfinx.fem.petsc  # noqa: F401
+
+from mpi4py import MPI
+from petsc4py import PETSc
+from slepc4py import SLEPc
+
+from fenicsfriction import _compat
+from fenicsfriction.assembly import assemble_jacobian, options_with_defaults
+from fenicsfriction.forms import Residual
+from fenicsfriction.laws import check
+
+__all__ = ["Mode", "StabilitySolver", "mac", "track"]
+
+DEFAULT_OPTIONS = {
+    "pep_type": "toar",
+    "pep_tol": 1e-10,
+    "pep_max_it": 1000,
+    "pep_scale": "scalar",
+    "st_type": "sinvert",
+    "st_ksp_type": "preonly",
+    "st_pc_type": "lu",
+    "st_pc_factor_mat_solver_type": "mumps",
+}
+
+
+@dataclasses.dataclass
+class Mode:
+    """One eigenpair with Im λ >= 0.
+
+    Attributes:
+        value: the eigenvalue λ [1/s]; Re λ > 0 is a growing mode, Im λ its angular frequency.
+        residual: relative residual of the pair (see module docstring).
+        accurate: ``residual <= residual_tol`` of the solver.
+        vector: this rank's owned entries of the complex eigenvector.
+        ident: identifier of the physical mode along a continuation (set by :func:`track`).
+    """
+
+    value: complex
+    residual: float
+    accurate: bool
+    vector: np.ndarray = dataclasses.field(repr=False)
+    ident: int = -1
+
+
+def mac(a: np.ndarray, b: np.ndarray, comm: MPI.Comm) -> float:
+    """Modal assurance criterion |a^H b|² / ((a^H a)(b^H b)) of distributed complex vectors."""
+    ab, aa, bb = comm.allreduce(np.array([np.vdot(a, b), np.vdot(a, a), np.vdot(b, b)]))
+    return float(abs(ab) ** 2 / (aa.real * bb.real))
+
+
+class StabilitySolver:
+    """Quadratic eigenproblem of the linearisation of a :class:`Residual` at its current state.
+
+    Args:
+        residual: the residual; its ``u`` must hold a converged steady state.
+        prefix: PETSc options prefix of the PEP (and its ST/KSP/PC).
+        options: defaults over :data:`DEFAULT_OPTIONS` (user options in the database win).
+        residual_tol: eigenpairs with a larger relative residual are flagged inaccurate.
+
+    Attributes:
+        pep: the SLEPc PEP, exposed for inspection or further configuration.
+        K, C, M: the assembled PETSc matrices (after :meth:`assemble`).
+    """
+
+    def __init__(self, residual: Residual, prefix: str = "stability_",
+                 options: typing.Optional[dict] = None, residual_tol: float = 1e-8):
+        check("residual_tol", residual_tol, residual_tol > 0, "must be > 0")
+        self.residual = residual
+        self.residual_tol = residual_tol
+        self.comm = residual.V.mesh.comm
+        M, C, K = residual.linearisation()
+        self._forms = {name: None if form.empty() else _compat.form(form)
+                       for name, form in (("K", K), ("C", C), ("M", M))}
+        if self._forms["K"] is None or self._forms["M"] is None:
+            raise ValueError("the residual has no stiffness or no inertia: nothing to oscillate")
+        self.K = dolfinx.fem.petsc.create_matrix(self._forms["K"])
+        self.M = dolfinx.fem.petsc.create_matrix(self._forms["M"])
+        self.C = (dolfinx.fem.petsc.create_matrix(self._forms["C"]) if self._forms["C"]
+                  else self.M.duplicate())
+        self.pep = SLEPc.PEP().create(self.comm)
+        self.pep.setOptionsPrefix(prefix)
+        options_with_defaults(prefix, {**DEFAULT_OPTIONS, **(options or {})})
+        self._norms = (1.0, 1.0, 1.0)
+
+    def assemble(self) -> None:
+        """Assemble K̄ (nodal springs included), C and M at the residual's current state."""
+        bcs = self.residual.bcs
+        assemble_jacobian(self.K, self._forms["K"], bcs, self.residual.springs, 1.0)
+        assemble_jacobian(self.M, self._forms["M"], bcs, (), 0.0)
+        if self._forms["C"] is not None:
+            assemble_jacobian(self.C, self._forms["C"], bcs, (), 0.0)
+        else:
+            self.C.zeroEntries()
+            self.C.assemble()
+        self._norms = tuple(A.norm(PETSc.NormType.INFINITY) for A in (self.K, self.C, self.M))
+
+    def _relative_residual(self, lam: complex, xr: PETSc.Vec, xi: PETSc.Vec) -> float:
+        a, b = lam.real, lam.imag
+        r_re, r_im, tmp = xr.duplicate(), xr.duplicate(), xr.duplicate()
+        # (λ² M + λ C + K)(xr + i xi) with λ = a + ib, split into real and imaginary parts
+        self.K.mult(xr, r_re)
+        self.K.mult(xi, r_im)
+        self.C.mult(xr, tmp)
+        r_re.axpy(a, tmp)
+        r_im.axpy(b, tmp)
+        self.C.mult(xi, tmp)
+        r_re.axpy(-b, tmp)
+        r_im.axpy(a, tmp)
+        self.M.mult(xr, tmp)
+        r_re.axpy(a * a - b * b, tmp)
+        r_im.axpy(2 * a * b, tmp)
+        self.M.mult(xi, tmp)
+        r_re.axpy(-2 * a * b, tmp)
+        r_im.axpy(a * a - b * b, tmp)
+        nK, nC, nM = self._norms
+        modulus = abs(lam)
+        scale = (modulus**2 * nM + modulus * nC + nK) * np.hypot(xr.norm(), xi.norm())
+        value = np.hypot(r_re.norm(), r_im.norm()) / scale
+        for v in (r_re, r_im, tmp):
+            v.destroy()
+        return float(value)
+
+    def solve(self, max_modulus: float, nev: int = 8, max_nev: int = 400) -> list[Mode]:
+        """Every eigenvalue with |λ| <= ``max_modulus`` (Im λ >= 0), sorted by |λ|.
+
+        Args:
+            max_modulus: radius of the disc searched [1/s]: the highest angular frequency (or
+                growth rate) of interest.
+            nev: eigenvalues requested at first; doubled until the disc is covered.
+            max_nev: upper bound on the request; reaching it raises ``RuntimeError``.
+        """
+        check("max_modulus", max_modulus, max_modulus > 0, "must be > 0")
+        self.assemble()
+        self.pep.setOperators([self.K, self.C, self.M])
+        self.pep.setProblemType(SLEPc.PEP.ProblemType.GENERAL)
+        self.pep.setTarget(0.0)
+        self.pep.setWhichEigenpairs(SLEPc.PEP.Which.TARGET_MAGNITUDE)
+        self.pep.setFromOptions()
+        n = self.K.getSize()[0]
+        while True:
+            self.pep.setDimensions(nev=min(nev, n))
+            self.pep.solve()
+            count = self.pep.getConverged()
+            values = [self.pep.getEigenpair(i) for i in range(count)]
+            covered = count > 0 and max(abs(v) for v in values) > max_modulus
+            if covered or count >= n or nev >= min(n, max_nev):
+                break
+            nev *= 2
+        if not covered and count < n:
+            raise RuntimeError(
+                f"PEP found {count} eigenvalues, none beyond |λ| = {max_modulus:g}, with "
+                f"{nev} requested (max_nev={max_nev}); reason {self.pep.getConvergedReason()}")
+        xr, xi = self.K.createVecs()
+        modes = []
+        for i in range(count):
+            lam = complex(self.pep.getEigenpair(i, xr, xi))
+            if lam.imag < 0 or abs(lam) > max_modulus:
+                continue
+            res = self._relative_residual(lam, xr, xi)
+            modes.append(Mode(value=lam, residual=res, accurate=res <= self.residual_tol,
+                              vector=xr.getArray() + 1j * xi.getArray()))
+        xr.destroy()
+        xi.destroy()
+        return sorted(modes, key=lambda m: abs(m.value))
+
+
+def track(previous: list[Mode], current: list[Mode], comm: MPI.Comm,
+          next_ident: int) -> int:
+    """Give each mode of ``current`` the ``ident`` of the ``previous`` mode it continues.
+
+    Pairs are matched by the Hungarian algorithm on 1 - MAC (eigenvectors), ties broken by
+    eigenvalue distance; a mode matched with MAC < 0.5 or with no partner is new and gets a
+    fresh ident. Returns the next unused ident.
+    """
+    if previous:
+        scale = max(abs(m.value) for m in previous + current)
+        cost = np.array([[1.0 - mac(p.vector, c.vector, comm) + abs(p.value - c.value) / scale
+                          for c in current] for p in previous])
+        rows, cols = scipy.optimize.linear_sum_assignment(cost)
+        for r, c in zip(rows, cols, strict=True):
+            if mac(previous[r].vector, current[c].vector, comm) >= 0.5:
+                current[c].ident = previous[r].ident
+    for mode in current:
+        if mode.ident < 0:
+            mode.ident = next_ident
+            next_ident += 1
+    return next_ident
