@@ -5,8 +5,8 @@ The operators are the Gateaux derivatives of the one residual at the steady stat
 couples normal displacement into tangential force (seed 000, eq. 31). Re λ > 0 means the
 steady sliding is dynamically unstable.
 
-SLEPc PEP (TOAR) with shift-and-invert about 0 (MUMPS LU) computes the eigenvalues of
-smallest modulus; the number requested grows until every eigenvalue with
+SLEPc PEP (TOAR) with shift-and-invert about a real shift σ > 0 (MUMPS LU) computes the
+eigenvalues nearest σ; the number requested grows until every eigenvalue with
 :math:`|\lambda| \le \omega_{max}` has been found, so all modes whose frequency and growth rate
 lie in that disc — those that can go unstable in the band of interest — are caught. In the real
 PETSc build, complex eigenvalues come in conjugate pairs; only Im λ >= 0 is kept. Each
@@ -150,7 +150,8 @@ class StabilitySolver:
             v.destroy()
         return float(value)
 
-    def solve(self, max_modulus: float, nev: int = 8, max_nev: int = 400) -> list[Mode]:
+    def solve(self, max_modulus: float, nev: int = 8, max_nev: int = 400,
+              shift: typing.Optional[float] = None) -> list[Mode]:
         """Every eigenvalue with |λ| <= ``max_modulus`` (Im λ >= 0), sorted by |λ|.
 
         Args:
@@ -158,12 +159,19 @@ class StabilitySolver:
                 growth rate) of interest.
             nev: eigenvalues requested at first; doubled until the disc is covered.
             max_nev: upper bound on the request; reaching it raises ``RuntimeError``.
+            shift: real shift σ of shift-and-invert (default ``max_modulus / 4``). The
+                eigenvalues nearest σ are computed until the disc |λ - σ| <= max_modulus + σ,
+                which contains |λ| <= max_modulus, is covered. σ > 0 favours growing modes and
+                adds σ²M to the factorised matrix, which keeps it well conditioned when soft
+                springs carry rigid-body motions (σ = 0 would factorise K̄ itself).
         """
         check("max_modulus", max_modulus, max_modulus > 0, "must be > 0")
+        shift = max_modulus / 4 if shift is None else shift
+        radius = max_modulus + abs(shift)
         self.assemble()
         self.pep.setOperators([self.K, self.C, self.M])
         self.pep.setProblemType(SLEPc.PEP.ProblemType.GENERAL)
-        self.pep.setTarget(0.0)
+        self.pep.setTarget(shift)
         self.pep.setWhichEigenpairs(SLEPc.PEP.Which.TARGET_MAGNITUDE)
         self.pep.setFromOptions()
         n = self.K.getSize()[0]
@@ -172,13 +180,13 @@ class StabilitySolver:
             self.pep.solve()
             count = self.pep.getConverged()
             values = [self.pep.getEigenpair(i) for i in range(count)]
-            covered = count > 0 and max(abs(v) for v in values) > max_modulus
+            covered = count > 0 and max(abs(v - shift) for v in values) > radius
             if covered or count >= n or nev >= min(n, max_nev):
                 break
             nev *= 2
         if not covered and count < n:
             raise RuntimeError(
-                f"PEP found {count} eigenvalues, none beyond |λ| = {max_modulus:g}, with "
+                f"PEP found {count} eigenvalues, none beyond |λ - {shift:g}| = {radius:g}, with "
                 f"{nev} requested (max_nev={max_nev}); reason {self.pep.getConvergedReason()}")
         xr, xi = self.K.createVecs()
         modes = []
