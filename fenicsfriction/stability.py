@@ -26,6 +26,7 @@ import dataclasses
 import typing
 
 import numpy as np
+import scipy.linalg
 import scipy.optimize
 
 import dolfinx.fem.petsc  # noqa: F401
@@ -39,7 +40,7 @@ from fenicsfriction.assembly import assemble_jacobian, options_with_defaults
 from fenicsfriction.forms import Residual
 from fenicsfriction.laws import check
 
-__all__ = ["Mode", "StabilitySolver", "mac", "track"]
+__all__ = ["Mode", "StabilitySolver", "dense_eigenvalues", "mac", "track"]
 
 DEFAULT_OPTIONS = {
     "pep_type": "toar",
@@ -70,6 +71,17 @@ class Mode:
     accurate: bool
     vector: np.ndarray = dataclasses.field(repr=False)
     ident: int = -1
+
+
+def dense_eigenvalues(K: np.ndarray, C: np.ndarray, M: np.ndarray) -> np.ndarray:
+    """Finite eigenvalues of (λ²M + λC + K) w = 0 from the companion linearisation
+    [[0, I], [-K, -C]] z = λ [[I, 0], [0, M]] z (dense, scipy), sorted by |λ|."""
+    n = K.shape[0]
+    zero, eye = np.zeros((n, n)), np.eye(n)
+    lam = scipy.linalg.eig(np.block([[zero, eye], [-K, -C]]),
+                           np.block([[eye, zero], [zero, M]]), right=False)
+    lam = lam[np.isfinite(lam)]
+    return lam[np.argsort(np.abs(lam))]
 
 
 def mac(a: np.ndarray, b: np.ndarray, comm: MPI.Comm) -> float:

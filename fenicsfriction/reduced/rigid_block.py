@@ -29,10 +29,10 @@ import dataclasses
 import typing
 
 import numpy as np
-import scipy.linalg
 
 from fenicsfriction import laws
 from fenicsfriction.laws import check
+from fenicsfriction.stability import dense_eigenvalues
 
 __all__ = ["RigidBlock"]
 
@@ -239,7 +239,4 @@ class RigidBlock:
     def eigenvalues(self, q: np.ndarray) -> np.ndarray:
         """Eigenvalues of (λ² M + λ C + K̄) at q (companion form), sorted by |λ|."""
         M, C, K = self.linearisation(q)
-        Z, I = np.zeros((3, 3)), np.eye(3)
-        lam = scipy.linalg.eig(np.block([[Z, I], [-K, -C]]), np.block([[I, Z], [Z, M]]),
-                               right=False)
-        return lam[np.argsort(np.abs(lam))]
+        return dense_eigenvalues(K, C, M)
