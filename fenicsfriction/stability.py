@@ -235,3 +235,114 @@ def track(previous: list[Mode], current: list[Mode], comm: MPI.Comm,
             mode.ident = next_ident
             next_ident += 1
     return next_ident
+
+
+def is_unstable(mode: Mode, growth_tol: float) -> bool:
+    """Re λ > growth_tol |λ|: a growing mode (undamped stable modes have Re λ ~ round-off)."""
+    return mode.value.real > growth_tol * abs(mode.value)
+
+
+def _records(value: float, modes: list[Mode]) -> dict:
+    return {"mu": float(value),
+            "modes": [{"mode": m.ident, "re": m.value.real, "im": m.value.imag,
+                       "residual": m.residual, "accurate": m.accurate} for m in modes],
+            "max_re": max((m.value.real for m in modes), default=float("nan"))}
+
+
+class Loci:
+    """Eigenvalue loci along a continuation in a parameter (μ), one curve per physical mode.
+
+    Args:
+        steady: steady solver of the problem (its ``u`` is moved along the continuation).
+        stability: quadratic eigensolver of the same residual.
+        parameter: the ``fem.Constant`` continued.
+        max_modulus: every eigenvalue with |λ| <= max_modulus is computed at each step.
+        growth_tol: a mode is unstable when Re λ > growth_tol |λ|.
+    """
+
+    def __init__(self, steady, stability: StabilitySolver, parameter, max_modulus: float,
+                 growth_tol: float = 1e-6):
+        check("growth_tol", growth_tol, growth_tol > 0, "must be > 0")
+        self.steady, self.stability, self.parameter = steady, stability, parameter
+        self.max_modulus, self.growth_tol = max_modulus, growth_tol
+        self.comm = stability.comm
+        self._next = 0
+
+    def _solve_at(self, value: float) -> list[Mode]:
+        from fenicsfriction.steady import continuation
+        continuation(self.steady, self.parameter, [value])
+        return self.stability.solve(self.max_modulus)
+
+    def follow(self, values: typing.Iterable[float],
+               on_step: typing.Optional[typing.Callable[[dict, list[Mode]], None]] = None
+               ) -> list[dict]:
+        """Steady state and eigenvalues at each value; modes tracked by MAC from step to step.
+
+        Returns one record per value: ``mu``, ``modes`` (``mode`` id, ``re``, ``im``,
+        ``residual``, ``accurate``) and ``max_re``. ``on_step(record, modes)`` sees each step.
+        """
+        records, previous = [], []
+        for value in values:
+            modes = self._solve_at(value)
+            self._next = track(previous, modes, self.comm, self._next)
+            record = _records(value, modes)
+            records.append(record)
+            if on_step is not None:
+                on_step(record, modes)
+            previous = modes
+        return records
+
+    def unstable(self, modes: list[Mode]) -> list[Mode]:
+        return [m for m in modes if is_unstable(m, self.growth_tol)]
+
+    def onset(self, stable: float, unstable: float, tol: float = 1e-4,
+              reference: typing.Optional[list[Mode]] = None) -> dict:
+        """Bisect [stable, unstable] for the parameter where a mode starts to grow.
+
+        Args:
+            stable, unstable: parameter values with no growing mode / with one.
+            tol: width of the final interval.
+            reference: the tracked modes at ``stable`` (from :meth:`follow`), used to name the
+                colliding modes; at the onset itself their eigenvectors coalesce (an
+                exceptional point), so they are named where they are still apart.
+
+        Returns:
+            ``mu_crit`` (midpoint of the final interval), ``interval``, the growing eigenvalue
+            ``value`` just past the onset, and ``colliding``: the two modes of ``reference``
+            whose frequencies are nearest to it (``mode`` id and eigenvalue ``re``, ``im``).
+            The steady state is left at the stable end.
+        """
+        if reference is None:
+            reference = self._solve_at(stable)
+        if self.unstable(reference) or not self.unstable(self._solve_at(unstable)):
+            raise ValueError(f"onset: need no growing mode at {stable} and one at {unstable}")
+        while unstable - stable > tol:
+            mid = 0.5 * (stable + unstable)
+            if self.unstable(self._solve_at(mid)):
+                unstable = mid
+            else:
+                stable = mid
+        grow = max(self.unstable(self._solve_at(unstable)), key=lambda m: m.value.real)
+        self._solve_at(stable)
+        nearest = sorted(reference, key=lambda m: abs(m.value.imag - grow.value.imag))[:2]
+        return {"mu_crit": 0.5 * (stable + unstable), "interval": [stable, unstable],
+                "value": [grow.value.real, grow.value.imag],
+                "colliding": [{"mode": m.ident, "re": m.value.real, "im": m.value.imag}
+                              for m in nearest]}
+
+
+def unstable_intervals(records: list[dict], growth_tol: float = 1e-6) -> dict[int, list]:
+    """Grid μ-intervals [first, last] in which each tracked mode is unstable."""
+    spans: dict[int, list] = {}
+    for record in records:
+        for m in record["modes"]:
+            growing = m["re"] > growth_tol * abs(complex(m["re"], m["im"]))
+            runs = spans.setdefault(m["mode"], [])
+            if growing:
+                if runs and runs[-1][2]:
+                    runs[-1][1] = record["mu"]
+                else:
+                    runs.append([record["mu"], record["mu"], True])
+            elif runs:
+                runs[-1][2] = False
+    return {k: [r[:2] for r in v] for k, v in spans.items() if v}
