@@ -34,57 +34,82 @@ def _floats(text: str) -> list[float]:
             f"expected comma-separated numbers, got {text!r}") from None
 
 
+def _scene_flags() -> argparse.ArgumentParser:
+    """Flags shared by the commands that build a scene (None: the scene's default)."""
+    flags = _Parser(add_help=False)
+    flags.add_argument("scene", choices=["block"], help="scene to run")
+    flags.add_argument("--mu-max", type=float, required=True, help="last friction coefficient")
+    flags.add_argument("--steps", type=int, default=30, help="continuation increments (NINCT)")
+    flags.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    flags.add_argument("--refine", type=int, default=1, help="mesh refinement (4r × 3r cells)")
+    flags.add_argument("--degree", type=int, default=2, help="Lagrange degree (2: Q2)")
+    flags.add_argument("--E", type=float, help="Young's modulus [10³ kg cm⁻¹ s⁻²] (1.4e6)")
+    flags.add_argument("--B0", type=float, help="breadth out of the plane [cm] (30.5)")
+    flags.add_argument("--K-x", type=float, dest="K_x", help="driver spring [10³ kg s⁻²] (11.1)")
+    flags.add_argument("--spring-height", type=float, help="spring height [cm] (H/2)")
+    flags.add_argument("--belt-speed", type=float, help="belt speed [cm/s] (0.287)")
+    flags.add_argument("--belt-direction", type=int, help="+1 or -1 (+1)")
+    flags.add_argument("--eps", type=float, help="regularisation ε [cm/s] (1e-3)")
+    flags.add_argument("--regularisation", help="c1 or smooth (c1)")
+    flags.add_argument("--contact-quadrature", help="gauss or gll (gauss)")
+    flags.add_argument("--max-halvings", type=int, default=8,
+                       help="step halvings allowed when a continuation step fails")
+    return flags
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="fenicsfriction", description=__doc__.splitlines()[0])
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    scene = _scene_flags()
     steady = commands.add_parser(
-        "steady", help="steady sliding with continuation in μ (Problem 2)",
+        "steady", parents=[scene], help="steady sliding with continuation in μ (Problem 2)",
         description="Steady sliding solved by Newton (PETSc SNES) at each μ from 0 to --mu-max; "
                     "PETSc options can be given as -steady_<option> after the flags.")
-    steady.add_argument("scene", choices=["block"], help="scene to run")
-    steady.add_argument("--mu-max", type=float, required=True, help="last friction coefficient")
-    steady.add_argument("--steps", type=int, default=30, help="continuation increments (NINCT)")
-    steady.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
-    steady.add_argument("--refine", type=int, default=1, help="mesh refinement (4r × 3r cells)")
-    steady.add_argument("--degree", type=int, default=2, help="Lagrange degree (2: Q2)")
-    steady.add_argument("--B0", type=float, help="breadth out of the plane [cm] (30.5)")
-    steady.add_argument("--K-x", type=float, dest="K_x", help="driver spring [10³ kg s⁻²] (11.1)")
-    steady.add_argument("--spring-height", type=float, help="spring height [cm] (H/2)")
-    steady.add_argument("--belt-speed", type=float, help="belt speed [cm/s] (0.287)")
-    steady.add_argument("--belt-direction", type=int, help="+1 or -1 (+1)")
-    steady.add_argument("--eps", type=float, help="regularisation ε [cm/s] (1e-3)")
-    steady.add_argument("--regularisation", help="c1 or smooth (c1)")
-    steady.add_argument("--contact-quadrature", help="gauss or gll (gauss)")
     steady.add_argument("--eps-sequence", type=_floats, metavar="E1,E2,...",
                         help="after the continuation, Kalker's sequential ε process at μ-max")
-    steady.add_argument("--max-halvings", type=int, default=8,
-                        help="step halvings allowed when a continuation step fails")
     steady.add_argument("--snapshots", type=int, default=4, help="deformed shapes to draw")
+    stability = commands.add_parser(
+        "stability", parents=[scene], help="eigenvalue loci and flutter onset (Problem 3)",
+        description="Quadratic eigenvalues of the linearised steady sliding (SLEPc PEP) at each "
+                    "μ from 0 to --mu-max, FE and rigid model side by side; PETSc/SLEPc options "
+                    "as -stability_<option> after the flags.")
+    stability.add_argument("--max-frequency", type=float, default=3e4,
+                           help="every eigenvalue with |λ| below this [rad/s] is computed")
+    stability.add_argument("--onset-tol", type=float, default=1e-4,
+                           help="width of the μ interval the onset is bisected to")
+    stability.add_argument("--growth-tol", type=float, default=1e-6,
+                           help="a mode grows when Re λ > growth-tol |λ|")
     return parser
+
+
+def _build(args: argparse.Namespace):
+    """Validate the shared flags and return (scene, model, steady solver, μ targets)."""
+    from fenicsfriction.laws import check
+    from fenicsfriction.scenes import SCENES
+    from fenicsfriction.steady import SteadySolver
+
+    check("--mu-max", args.mu_max, np.isfinite(args.mu_max) and args.mu_max >= 0, "must be >= 0")
+    check("--steps", args.steps, args.steps >= 1, "must be >= 1")
+    check("--max-halvings", args.max_halvings, args.max_halvings >= 0, "must be >= 0")
+    scene_cls = SCENES[args.scene]
+    names = {f.name for f in dataclasses.fields(scene_cls)}
+    scene = scene_cls(**{k: v for k, v in vars(args).items() if k in names and v is not None})
+    model = scene.build(MPI.COMM_WORLD, with_friction=args.mu_max > 0)
+    model.initial_guess()
+    solver = SteadySolver(model.residual, prefix="steady_", options=model.solver_options())
+    return scene, model, solver, np.linspace(0.0, args.mu_max, args.steps + 1)
 
 
 def _run_steady(args: argparse.Namespace, log: logging.Logger) -> int:
     from fenicsfriction import io, plotting
     from fenicsfriction.laws import check
-    from fenicsfriction.scenes import SCENES
-    from fenicsfriction.steady import ContinuationError, SteadySolver, continuation, \
-        epsilon_sequence
+    from fenicsfriction.steady import ContinuationError, continuation, epsilon_sequence
 
     comm = MPI.COMM_WORLD
-    check("--mu-max", args.mu_max, np.isfinite(args.mu_max) and args.mu_max >= 0, "must be >= 0")
-    check("--steps", args.steps, args.steps >= 1, "must be >= 1")
-    check("--max-halvings", args.max_halvings, args.max_halvings >= 0, "must be >= 0")
     check("--snapshots", args.snapshots, args.snapshots >= 0, "must be >= 0")
-    scene_cls = SCENES[args.scene]
-    names = {f.name for f in dataclasses.fields(scene_cls)}
-    given = {k: v for k, v in vars(args).items() if k in names and v is not None}
-    scene = scene_cls(**given)
-    out: pathlib.Path = args.out
     t_start = time.perf_counter()
-    model = scene.build(comm, with_friction=args.mu_max > 0)
-    model.initial_guess()
-    solver = SteadySolver(model.residual, prefix="steady_", options=model.solver_options())
-    targets = np.linspace(0.0, args.mu_max, args.steps + 1)
+    scene, model, solver, targets = _build(args)
+    out: pathlib.Path = args.out
     wanted = set(np.unique(np.linspace(0, args.steps, args.snapshots).round().astype(int))) \
         if args.snapshots else set()
     snapshots, count = [], [0]
@@ -149,6 +174,102 @@ def _run_steady(args: argparse.Namespace, log: logging.Logger) -> int:
     return 0
 
 
+def _rigid_loci(scene, targets: np.ndarray, max_frequency: float, growth_tol: float,
+                onset_tol: float) -> dict:
+    """Eigenvalues of the rigid block along the same μ grid, and its onsets by bisection."""
+    from fenicsfriction.reduced import RigidBlock
+
+    q, steps = None, []
+
+    def values(mu: float) -> np.ndarray:
+        nonlocal q
+        block = RigidBlock.from_scene(scene, mu=mu)
+        q = block.steady_state(q)
+        lam = block.eigenvalues(q)
+        return lam[(lam.imag >= 0) & (np.abs(lam) <= max_frequency)]
+
+    def grows(lam: np.ndarray) -> bool:
+        return bool(np.any(lam.real > growth_tol * np.abs(lam)))
+
+    for mu in targets:
+        lam = values(mu)
+        steps.append({"mu": float(mu), "eigenvalues": [[v.real, v.imag] for v in lam],
+                      "max_re": float(lam.real.max())})
+    flags = [grows(np.array([complex(*v) for v in st["eigenvalues"]])) for st in steps]
+    onsets, intervals = [], []
+    for k in range(1, len(steps)):
+        if flags[k] and not flags[k - 1]:
+            lo, hi = targets[k - 1], targets[k]
+            values(lo)
+            while hi - lo > onset_tol:
+                mid = 0.5 * (lo + hi)
+                lo, hi = (lo, mid) if grows(values(mid)) else (mid, hi)
+            onsets.append(0.5 * (lo + hi))
+            intervals.append([float(targets[k]), float(targets[k])])
+        if flags[k] and intervals:
+            intervals[-1][1] = float(targets[k])
+    return {"steps": steps, "onsets": onsets, "mu_crit": onsets[0] if onsets else None,
+            "unstable_intervals": intervals}
+
+
+def _run_stability(args: argparse.Namespace, log: logging.Logger) -> int:
+    from fenicsfriction import io, plotting
+    from fenicsfriction.laws import check
+    from fenicsfriction.stability import Loci, StabilitySolver, unstable_intervals
+    from fenicsfriction.steady import ContinuationError
+
+    comm = MPI.COMM_WORLD
+    check("--max-frequency", args.max_frequency, args.max_frequency > 0, "must be > 0")
+    check("--onset-tol", args.onset_tol, args.onset_tol > 0, "must be > 0")
+    check("--growth-tol", args.growth_tol, args.growth_tol > 0, "must be > 0")
+    t_start = time.perf_counter()
+    scene, model, solver, targets = _build(args)
+    out: pathlib.Path = args.out
+    loci = Loci(solver, StabilitySolver(model.residual, prefix="stability_"), model.mu,
+                args.max_frequency, args.growth_tol)
+    transitions, previous = [], {}
+    with io.ModeWriter(out / "unstable_modes.xdmf", model) as shapes:
+        def on_step(record: dict, modes: list) -> None:
+            growing = loci.unstable(modes)
+            if previous and growing and not loci.unstable(previous["modes"]):
+                transitions.append((previous["mu"], record["mu"], previous["modes"]))
+            if growing:
+                shapes.write(max(growing, key=lambda m: m.value.real), record["mu"])
+            previous.update(mu=record["mu"], modes=modes)
+            flagged = sum(not m["accurate"] for m in record["modes"])
+            log.info(f"μ={record['mu']:.4f}  {len(modes)} modes  max Re λ={record['max_re']:.4g}"
+                     f"  growing: {[m.ident for m in growing]}"
+                     + (f"  ({flagged} inaccurate)" if flagged else ""))
+
+        failure = None
+        try:
+            records = loci.follow(targets, on_step=on_step)
+        except ContinuationError as err:
+            failure, records = str(err), []
+    onsets = [loci.onset(a, b, args.onset_tol, reference=ref) for a, b, ref in transitions]
+    rigid = _rigid_loci(scene, targets, args.max_frequency, args.growth_tol, args.onset_tol)
+    fe = {"steps": records, "onsets": onsets,
+          "mu_crit": onsets[0]["mu_crit"] if onsets else None,
+          "unstable_intervals": {str(k): v for k, v in
+                                 unstable_intervals(records, args.growth_tol).items()}}
+    io.write_json(out / "stability.json", {
+        "scene": args.scene, "parameters": dataclasses.asdict(scene), "ranks": comm.size,
+        "mu_crit": {"fe": fe["mu_crit"], "rigid": rigid["mu_crit"]},
+        "fe": fe, "rigid": rigid, "max_frequency": args.max_frequency,
+        "growth_tol": args.growth_tol, "wall_time_s": time.perf_counter() - t_start,
+        "failure": failure}, comm)
+    plotting.plot_loci(records, rigid["steps"], out / "loci.png", comm)
+    plotting.plot_growth(records, rigid["steps"], out / "growth.png", comm)
+    comm.Barrier()
+    log.info(f"μ_crit: FE {fe['mu_crit']}, rigid {rigid['mu_crit']}; FE unstable intervals by "
+             f"mode {fe['unstable_intervals']}; rigid {rigid['unstable_intervals']}")
+    log.info(f"results in {out}/: stability.json, loci.png, growth.png, unstable_modes.xdmf")
+    if failure is not None:
+        log.error(f"fenicsfriction: {failure}")
+        return 1
+    return 0
+
+
 def main(argv: typing.Optional[list[str]] = None) -> int:
     """Entry point of the ``fenicsfriction`` console script and ``python -m fenicsfriction``."""
     argv = sys.argv[1:] if argv is None else list(argv)
@@ -165,7 +286,7 @@ def main(argv: typing.Optional[list[str]] = None) -> int:
     from fenicsfriction.io import get_logger
     log = get_logger(MPI.COMM_WORLD)
     try:
-        return _run_steady(args, log)
+        return {"steady": _run_steady, "stability": _run_stability}[args.command](args, log)
     except ValueError as err:
         if MPI.COMM_WORLD.rank == 0:
             print(f"fenicsfriction: error: {err}", file=sys.stderr)

@@ -14,7 +14,7 @@ from mpi4py import MPI
 
 from fenicsfriction import _compat
 
-__all__ = ["FieldWriter", "get_logger", "write_json"]
+__all__ = ["FieldWriter", "ModeWriter", "get_logger", "write_json"]
 
 
 def get_logger(comm: MPI.Comm = MPI.COMM_WORLD) -> logging.Logger:
@@ -82,6 +82,38 @@ class FieldWriter:
         values[self._off_contact] = 0.0
         self.file.write_function(self.displacement, t)
         self.file.write_function(self.traction, t)
+
+    def close(self) -> None:
+        self.file.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+class ModeWriter:
+    """XDMF series of complex mode shapes: real and imaginary parts as two degree-1 fields."""
+
+    def __init__(self, path: typing.Union[str, pathlib.Path], model):
+        msh = model.msh
+        self.mode = fem.Function(model.V)
+        self.V1 = _compat.vector_function_space(msh, 1)
+        self.parts = (fem.Function(self.V1, name="mode_real"),
+                      fem.Function(self.V1, name="mode_imag"))
+        pathlib.Path(path).parent.mkdir(parents=True, exist_ok=True)
+        self.file = io.XDMFFile(msh.comm, str(path), "w")
+        self.file.write_mesh(msh)
+
+    def write(self, mode, t: float) -> None:
+        """Write ``mode`` (a :class:`~fenicsfriction.stability.Mode`) at "time" ``t``."""
+        owned = len(mode.vector)
+        for part, values in zip(self.parts, (mode.vector.real, mode.vector.imag), strict=True):
+            self.mode.x.array[:owned] = values
+            self.mode.x.scatter_forward()
+            part.interpolate(self.mode)
+            self.file.write_function(part, t)
 
     def close(self) -> None:
         self.file.close()

@@ -11,7 +11,7 @@ from mpi4py import MPI
 
 from fenicsfriction import _compat
 
-__all__ = ["cell_outlines", "plot_deformed", "plot_steady_forces"]
+__all__ = ["cell_outlines", "plot_deformed", "plot_growth", "plot_loci", "plot_steady_forces"]
 
 
 def _pyplot():
@@ -103,6 +103,61 @@ def plot_steady_forces(records: list[dict], path, spring_height: float, belt_dir
     ax.set_xlabel("μ")
     ax.set_ylabel("penetration [cm]")
     ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def _fe_points(records: list[dict]) -> tuple[np.ndarray, np.ndarray]:
+    """(μ, λ) of every FE eigenvalue in the loci records."""
+    mu = np.array([r["mu"] for r in records for _ in r["modes"]])
+    lam = np.array([complex(m["re"], m["im"]) for r in records for m in r["modes"]])
+    return mu, lam
+
+
+def _rigid_points(steps: list[dict]) -> tuple[np.ndarray, np.ndarray]:
+    mu = np.array([s["mu"] for s in steps for _ in s["eigenvalues"]])
+    lam = np.array([complex(*v) for s in steps for v in s["eigenvalues"]])
+    return mu, lam
+
+
+def plot_loci(records: list[dict], rigid_steps: list[dict], path,
+              comm: MPI.Comm = MPI.COMM_WORLD) -> None:
+    """Eigenvalues in the complex plane coloured by μ, FE and rigid (seed 000 Fig. 9)."""
+    if comm.rank != 0:
+        return
+    plt = _pyplot()
+    fig, axes = plt.subplots(1, 2, figsize=(12, 5), sharex=True, sharey=True)
+    for ax, (mu, lam), title in ((axes[0], _fe_points(records), "finite elements"),
+                                 (axes[1], _rigid_points(rigid_steps), "rigid block (3 dof)")):
+        both = np.concatenate([lam, lam.conj()])
+        sc = ax.scatter(both.real, both.imag, c=np.concatenate([mu, mu]), s=10, cmap="viridis")
+        ax.axvline(0.0, color="k", lw=0.6)
+        ax.set_title(title)
+        ax.set_xlabel("Re λ [1/s]")
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("Im λ [rad/s]")
+    fig.colorbar(sc, ax=axes, label="μ")
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def plot_growth(records: list[dict], rigid_steps: list[dict], path,
+                comm: MPI.Comm = MPI.COMM_WORLD) -> None:
+    """Largest Re λ against μ, FE and rigid (seed 000 Fig. 8)."""
+    if comm.rank != 0:
+        return
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.plot([r["mu"] for r in records], [r["max_re"] for r in records], "o-", ms=3,
+            label="finite elements")
+    ax.plot([s["mu"] for s in rigid_steps], [s["max_re"] for s in rigid_steps], "s--", ms=3,
+            label="rigid block")
+    ax.axhline(0.0, color="k", lw=0.6)
+    ax.set_xlabel("μ")
+    ax.set_ylabel("max Re λ [1/s]")
+    ax.legend()
+    ax.grid(alpha=0.3)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
