@@ -21,6 +21,7 @@ from petsc4py import PETSc
 
 __all__ = [
     "assemble_matrix_into",
+    "create_box",
     "create_rectangle",
     "interpolation_points",
     "jit_options",
@@ -56,6 +57,14 @@ def create_rectangle(comm: MPI.Comm, corner0: typing.Sequence[float],
     points = [np.asarray(corner0, dtype=float), np.asarray(corner1, dtype=float)]
     return mesh.create_rectangle(comm=comm, points=points, n=list(n),
                                  cell_type=mesh.CellType.quadrilateral)
+
+
+def create_box(comm: MPI.Comm, corner0: typing.Sequence[float], corner1: typing.Sequence[float],
+               n: typing.Sequence[int]) -> mesh.Mesh:
+    """Hexahedral mesh of a box (keywords: ``dtype`` was inserted before ``cell_type`` in 0.8)."""
+    points = [np.asarray(corner0, dtype=float), np.asarray(corner1, dtype=float)]
+    return mesh.create_box(comm=comm, points=points, n=list(n),
+                           cell_type=mesh.CellType.hexahedron)
 
 
 def interpolation_points(V: fem.FunctionSpace) -> np.ndarray:

@@ -48,6 +48,9 @@ def assemble_jacobian(A: PETSc.Mat, a: fem.FormMetaClass, bcs: list,
     stiffness, 0 for damping and mass so that constrained dofs give infinite eigenvalues).
     """
     _compat.assemble_matrix_into(A, a, bcs, diagonal)
+    if springs:  # the Dirichlet diagonal was INSERTed; PETSc needs a flush before ADD
+        A.assemblyBegin(PETSc.Mat.AssemblyType.FLUSH)
+        A.assemblyEnd(PETSc.Mat.AssemblyType.FLUSH)
     for spring in springs:
         spring.add_to_matrix(A)
     A.assemble()

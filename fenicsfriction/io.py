@@ -78,7 +78,7 @@ class FieldWriter:
     def write(self, t: float) -> None:
         self.displacement.interpolate(self.model.residual.u)
         self.traction.interpolate(self._traction_expr)
-        values = self.traction.x.array.reshape(-1, 2)
+        values = self.traction.x.array.reshape(-1, self.model.msh.geometry.dim)
         values[self._off_contact] = 0.0
         self.file.write_function(self.displacement, t)
         self.file.write_function(self.traction, t)

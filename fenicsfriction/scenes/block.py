@@ -9,6 +9,11 @@ Choices the paper leaves open, made here and changeable through the fields:
 * **Plane strain with breadth B0.** B0 is the block's breadth out of the plane (the
   plane-strain thickness): every 2D integral is multiplied by B0, so forces are totals, the
   contact pressure is force / (L B0), and ``mass``/``weight`` are totals over that breadth.
+  With ``dim=3`` the block is a box L × H × B0 (breadth along z, hexahedra) with free faces
+  at z = 0 and z = B0, and the spring node is at mid-breadth. Nothing restrains translation
+  along z or rotation about y (only the transverse friction damping c_T d^m_T / |U_T| acts on
+  them), so the symmetry plane z = B0/2 is held in z: exact for the symmetric steady state,
+  and it removes those two rigid modes from the eigenproblem.
 * **Weight as a body force** ρ g = W / (L H B0), mass density ρ = M / (L H B0).
 * **Driver spring through the centre of mass.** A horizontal nodal spring of total stiffness
   K_x on the node of the left face at height ``spring_height`` (default H/2, the height of
@@ -94,6 +99,8 @@ class BlockOnBelt:
         refine: mesh refinement factor; the mesh has 4·refine × 3·refine cells.
         degree: polynomial degree of the Lagrange quadrilaterals (2: nine-node Q2).
         contact_quadrature: "gauss" or "gll" (Gauss-Lobatto, includes the corners) on Γ_C.
+        dim: 2 (plane strain, the paper's model) or 3 (a box, 4r × 3r × nz·r hexahedra).
+        nz: cells across the breadth per refinement in 3D (even, so a node row is at B0/2).
     """
 
     L: float = 48.8
@@ -121,6 +128,8 @@ class BlockOnBelt:
     refine: int = 1
     degree: int = 2
     contact_quadrature: str = "gauss"
+    dim: int = 2
+    nz: int = 2
 
     def __post_init__(self):
         if self.spring_height is None:
@@ -144,6 +153,9 @@ class BlockOnBelt:
         check("refine", self.refine, isinstance(self.refine, int) and self.refine >= 1,
               "must be an integer >= 1")
         check("degree", self.degree, self.degree in (1, 2, 3), "must be 1, 2 or 3")
+        check("dim", self.dim, self.dim in (2, 3), "must be 2 or 3")
+        check("nz", self.nz, isinstance(self.nz, int) and self.nz >= 2 and self.nz % 2 == 0,
+              "must be an even integer >= 2")
         check("contact_quadrature", self.contact_quadrature,
               self.contact_quadrature in QUADRATURE, f"must be one of {sorted(QUADRATURE)}")
         laws.InterfaceLaw(**self._law_parameters())  # validates the interface parameters
@@ -230,7 +242,12 @@ class BlockModel:
             with_friction = s.mu > 0 or s.friction_coefficient is not None
         self.with_friction = with_friction
         nx, ny = 4 * s.refine, 3 * s.refine
-        self.msh = msh = _compat.create_rectangle(comm, (0.0, 0.0), (s.L, s.H), (nx, ny))
+        if s.dim == 2:
+            msh = _compat.create_rectangle(comm, (0.0, 0.0), (s.L, s.H), (nx, ny))
+        else:
+            msh = _compat.create_box(comm, (0.0, 0.0, 0.0), (s.L, s.H, s.B0),
+                                     (nx, ny, s.nz * s.refine))
+        self.msh = msh
         rows = _vertex_rows(ny, s.degree, s.H, s.spring_height)
         msh.geometry.x[:, 1] = np.interp(msh.geometry.x[:, 1], np.linspace(0, s.H, ny + 1), rows)
         self.V = V = _compat.vector_function_space(msh, s.degree)
@@ -256,16 +273,19 @@ class BlockModel:
         def constant(value):
             return fem.Constant(msh, np.float64(value))
 
-        self.mu, self.eps, self.thickness = constant(s.mu), constant(s.eps), constant(s.B0)
+        # 2D integrals are per unit breadth: times B0 makes every force a total
+        thickness = s.B0 if s.dim == 2 else 1.0
+        self.mu, self.eps, self.thickness = constant(s.mu), constant(s.eps), constant(thickness)
+        e_x, e_y = np.eye(s.dim)[0], np.eye(s.dim)[1]
         self.c_n = constant(law.c_n)
         # exponents stay Python floats: UFL differentiates d**Constant very slowly
         self.m_n, self.m_T = float(law.m_n), float(law.m_T)
         self.gap = constant(law.g)
-        self.belt_velocity = fem.Constant(msh, np.array([s.belt_direction * s.belt_speed, 0.0]))
+        self.belt_velocity = fem.Constant(msh, s.belt_direction * s.belt_speed * e_x)
         volume = s.L * s.H * s.B0
         self.rho = constant(s.mass / volume)
-        self.gravity = fem.Constant(msh, np.array([0.0, -s.weight / volume]))
-        self.top_traction = fem.Constant(msh, np.array([0.0, -s.top_pressure]))
+        self.gravity = fem.Constant(msh, -s.weight / volume * e_y)
+        self.top_traction = fem.Constant(msh, -s.top_pressure * e_y)
         self.normal = ufl.FacetNormal(msh)
 
         u, u_dot, u_ddot = fem.Function(V, name="displacement"), fem.Function(V), fem.Function(V)
@@ -282,13 +302,20 @@ class BlockModel:
         if with_friction:
             terms += friction(u, u_dot, v, n, self.friction_c_T, self.m_T, self.gap,
                               self.belt_velocity, self.eps, ds_c, law.regularisation)
-        self.spring = NodalSpring.at_point(V, (0.0, s.spring_height), 0, s.K_x)
+        self.spring = NodalSpring.at_point(V, (0.0, s.spring_height, s.B0 / 2)[:s.dim], 0, s.K_x)
+        bcs = []
+        if s.dim == 3:
+            Vz, _ = V.sub(2).collapse()
+            mid = fem.locate_dofs_geometrical(
+                (V.sub(2), Vz), lambda x: np.isclose(x[2], s.B0 / 2, atol=tol))
+            zero = fem.Function(Vz)
+            bcs.append(fem.dirichletbc(zero, mid, V.sub(2)))
         self.residual = Residual(form=self.thickness * terms, u=u, u_dot=u_dot, u_ddot=u_ddot,
-                                 v=v, bcs=[], springs=[self.spring])
+                                 v=v, bcs=bcs, springs=[self.spring])
         self._functionals: dict = {}
         contact_dofs = fem.locate_dofs_topological(
             V.sub(1), fdim, self.facet_tags.find(CONTACT))
-        self._contact_y = contact_dofs[contact_dofs < V.dofmap.index_map.size_local * 2]
+        self._contact_y = contact_dofs[contact_dofs < V.dofmap.index_map.size_local * s.dim]
 
     @property
     def friction_c_T(self):
@@ -311,7 +338,7 @@ class BlockModel:
     def friction_traction(self, n=None):
         """UFL friction traction on the body at rest (u̇ = 0), a vector tangent to Γ_C."""
         if not self.with_friction:
-            return ufl.zero(2)
+            return ufl.zero(self.scene.dim)
         n = self.normal if n is None else n
         w = tangential_part(self.residual.u_dot, n) - self.belt_velocity
         c_T = self.friction_c_T
@@ -319,7 +346,7 @@ class BlockModel:
             c_T = c_T(ufl.sqrt(ufl.inner(w, w)))
         direction = laws.REGULARISATIONS[self.scene.regularisation][1](w, self.eps)
         traction = -laws.friction_bound(self.penetration(n), c_T, self.m_T) * direction
-        return ufl.replace(traction, {self.residual.u_dot: ufl.zero(2)})
+        return ufl.replace(traction, {self.residual.u_dot: ufl.zero(self.scene.dim)})
 
     def contact_traction(self):
         """UFL traction of the foundation on the body, valid in cells (for output fields).
@@ -327,7 +354,7 @@ class BlockModel:
         Uses the contact face's constant normal -e_y instead of the facet normal so it can be
         interpolated; it is meaningful only on Γ_C (see :meth:`contact_dofs`).
         """
-        n = ufl.as_vector([0.0, -1.0])
+        n = ufl.as_vector(-np.eye(self.scene.dim)[1])
         return -self.pressure(n) * n + self.friction_traction(n)
 
     def _integral(self, key: str, integrand) -> float:
@@ -351,8 +378,8 @@ class BlockModel:
         s = self.scene
         d0 = s.law.uniform_penetration(s.contact_pressure)
         ux = s.belt_direction * float(self.mu.value) * s.contact_pressure * s.L * s.B0 / s.K_x
-        self.residual.u.interpolate(
-            lambda x: np.vstack([np.full(x.shape[1], ux), np.full(x.shape[1], -(d0 + s.g))]))
+        value = np.array([ux, -(d0 + s.g), 0.0][:s.dim])
+        self.residual.u.interpolate(lambda x: np.tile(value[:, None], (1, x.shape[1])))
 
     def quantities(self) -> dict:
         """Resultants and penetration extremes of the current state (same on every rank).
