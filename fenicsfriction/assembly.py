@@ -7,6 +7,7 @@ springs are always assembled together and Dirichlet rows are treated one way
 
 from __future__ import annotations
 
+import contextlib
 import typing
 
 from dolfinx import fem
@@ -56,13 +57,21 @@ def assemble_jacobian(A: PETSc.Mat, a: fem.FormMetaClass, bcs: list,
     A.assemble()
 
 
-def options_with_defaults(prefix: str, defaults: dict) -> PETSc.Options:
-    """Put ``defaults`` into the PETSc options database under ``prefix`` unless already set.
+@contextlib.contextmanager
+def options_with_defaults(prefix: str, defaults: dict):
+    """Put ``defaults`` into the PETSc options database under ``prefix`` for the duration of
+    the block (call ``setFromOptions`` inside it), then take them out again.
 
-    Options the user set (command line, ``PETSC_OPTIONS`` or code) always win.
+    Options already in the database (set by the user: command line, ``PETSC_OPTIONS`` or code)
+    win and are left alone; the defaults never outlive the block, so a later solver with the
+    same prefix gets its own defaults rather than these.
     """
     opts = PETSc.Options(prefix)
-    for key, value in defaults.items():
-        if not opts.hasName(key):
-            opts[key] = value
-    return opts
+    added = [key for key in defaults if not opts.hasName(key)]
+    for key in added:
+        opts[key] = defaults[key]
+    try:
+        yield opts
+    finally:
+        for key in added:
+            opts.delValue(key)

@@ -143,7 +143,7 @@ class ConstantFriction:
         check("mu", self.mu, self.mu >= 0, "the friction coefficient must be >= 0")
 
     def __call__(self, speed: Scalar) -> Scalar:
-        return self.mu + 0 * speed
+        return self.mu + 0 * abs(speed)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -165,7 +165,8 @@ class PiecewiseLinearFriction:
               f"mu_s - slope*v_c must be >= 0 (got {mu_k:g}): mu may not turn negative")
 
     def __call__(self, speed: Scalar) -> Scalar:
-        return self.mu_s - self.slope * _min(speed, self.v_c)
+        """μ at relative velocity ``speed`` (its magnitude is used: signed input is fine)."""
+        return self.mu_s - self.slope * _min(abs(speed), self.v_c)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -187,7 +188,9 @@ class StribeckFriction:
         check("exponent", self.exponent, self.exponent > 0, "the exponent must be > 0")
 
     def __call__(self, speed: Scalar) -> Scalar:
-        return self.mu_k + (self.mu_s - self.mu_k) * _exp(-((speed / self.v_s) ** self.exponent))
+        """μ at relative velocity ``speed`` (its magnitude is used: signed input is fine)."""
+        ratio = abs(speed) / self.v_s
+        return self.mu_k + (self.mu_s - self.mu_k) * _exp(-(ratio**self.exponent))
 
 
 FrictionCoefficient = typing.Union[ConstantFriction, PiecewiseLinearFriction, StribeckFriction]

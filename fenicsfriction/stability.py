@@ -121,7 +121,11 @@ class StabilitySolver:
                   else self.M.duplicate())
         self.pep = SLEPc.PEP().create(self.comm)
         self.pep.setOptionsPrefix(prefix)
-        options_with_defaults(prefix, {**DEFAULT_OPTIONS, **(options or {})})
+        self.pep.setOperators([self.K, self.C, self.M])
+        self.pep.setProblemType(SLEPc.PEP.ProblemType.GENERAL)
+        self.pep.setWhichEigenpairs(SLEPc.PEP.Which.TARGET_MAGNITUDE)
+        with options_with_defaults(prefix, {**DEFAULT_OPTIONS, **(options or {})}):
+            self.pep.setFromOptions()
         self._norms = (1.0, 1.0, 1.0)
 
     def assemble(self) -> None:
@@ -181,11 +185,8 @@ class StabilitySolver:
         shift = max_modulus / 4 if shift is None else shift
         radius = max_modulus + abs(shift)
         self.assemble()
-        self.pep.setOperators([self.K, self.C, self.M])
-        self.pep.setProblemType(SLEPc.PEP.ProblemType.GENERAL)
+        self.pep.setOperators([self.K, self.C, self.M])  # values changed: set up again
         self.pep.setTarget(shift)
-        self.pep.setWhichEigenpairs(SLEPc.PEP.Which.TARGET_MAGNITUDE)
-        self.pep.setFromOptions()
         n = self.K.getSize()[0]
         while True:
             self.pep.setDimensions(nev=min(nev, n))

@@ -117,12 +117,12 @@ class SteadySolver:
         comm = self.u.function_space.mesh.comm
         self.snes = PETSc.SNES().create(comm)
         self.snes.setOptionsPrefix(prefix)
-        options_with_defaults(prefix, {**DEFAULT_OPTIONS, **(options or {})})
         self.snes.setFunction(self._F, self.b)
         self.snes.setJacobian(self._J, self.A)
-        self.snes.setFromOptions()
-        self.snes.getKSP().setFromOptions()
-        self.snes.getKSP().getPC().setFromOptions()
+        with options_with_defaults(prefix, {**DEFAULT_OPTIONS, **(options or {})}):
+            self.snes.setFromOptions()
+            self.snes.getKSP().setFromOptions()
+            self.snes.getKSP().getPC().setFromOptions()
         self.rtol, self.atol = self.snes.getTolerances()[:2]
         self._jacobian_norm = 0.0
         self._f0 = np.inf
@@ -255,23 +255,30 @@ def epsilon_sequence(solver: SteadySolver, eps: fem.Constant, values: typing.Ite
     """Kalker's sequential ε process: solve for each ε in ``values``, warm-starting each solve.
 
     Each record has ``eps``, ``newton_iterations``, ``change`` (the max-norm of the solution
-    change from the previous ε; ``None`` for the first) and what ``observe`` adds. A failing
-    solve raises :class:`SolveError` with ``u`` at the last converged ε.
+    change from the previous ε; ``None`` for the first), ``residual_norm``, ``atol`` and what
+    ``observe`` adds. A failing solve raises :class:`SolveError` with ``u`` and ``eps`` at the
+    last converged ε.
     """
     records: list[dict] = []
     u_vec = _compat.petsc_vec(solver.u)
     previous = None
     for value in values:
         check("eps", value, value > 0, "the regularisation parameter must be > 0")
+        last = float(eps.value)
         eps.value = value
-        report = solver.solve()
+        try:
+            report = solver.solve()
+        except SolveError:
+            eps.value = last  # u was restored to the state converged at ``last``
+            raise
         change = None
         if previous is not None:
             previous.axpy(-1.0, u_vec)
             change = previous.norm(PETSc.NormType.INFINITY)
             previous.destroy()
         previous = u_vec.copy()
-        record = {"eps": float(value), "newton_iterations": report.iterations, "change": change}
+        record = {"eps": float(value), "newton_iterations": report.iterations, "change": change,
+                  "residual_norm": report.residual_norm, "atol": report.atol}
         if observe is not None:
             record.update(observe())
         records.append(record)

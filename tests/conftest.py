@@ -1,0 +1,31 @@
+"""Fixtures shared by the test suite; every test must pass serially and under `mpirun -n 2`."""
+
+import gc
+import pathlib
+
+import pytest
+
+from mpi4py import MPI
+
+
+@pytest.fixture(autouse=True)
+def collective_cleanup():
+    """Destroy the PETSc objects a test leaves behind on all ranks together.
+
+    PETSc destructors are collective: if ranks garbage-collect at different times, the next
+    collective call can deadlock (the dolfinx test suite does the same).
+    """
+    yield
+    gc.collect()
+    MPI.COMM_WORLD.Barrier()
+
+
+@pytest.fixture
+def shared_tmp_path(request) -> pathlib.Path:
+    """One temporary folder seen by every rank: rank 0's ``tmp_path``, broadcast.
+
+    pytest's ``tmp_path`` is made per process, so under MPI each rank would get its own.
+    """
+    comm = MPI.COMM_WORLD
+    path = request.getfixturevalue("tmp_path") if comm.rank == 0 else None
+    return pathlib.Path(comm.bcast(path, root=0))
