@@ -50,7 +50,25 @@ def write_json(path: typing.Union[str, pathlib.Path], data, comm: MPI.Comm = MPI
     comm.Barrier()
 
 
-class FieldWriter:
+class _XDMFSeries:
+    """An XDMF file holding a mesh and a time series of fields (a context manager)."""
+
+    def __init__(self, path: typing.Union[str, pathlib.Path], msh):
+        pathlib.Path(path).parent.mkdir(parents=True, exist_ok=True)
+        self.file = io.XDMFFile(msh.comm, str(path), "w")
+        self.file.write_mesh(msh)
+
+    def close(self) -> None:
+        self.file.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+class FieldWriter(_XDMFSeries):
     """XDMF time series of the displacement and the contact traction.
 
     dolfinx 0.5 writes fields of the mesh's coordinate degree only, so both are interpolated
@@ -71,9 +89,7 @@ class FieldWriter:
         self._off_contact = np.setdiff1d(
             np.arange(self.V1.dofmap.index_map.size_local + self.V1.dofmap.index_map.num_ghosts),
             fem.locate_dofs_topological(self.V1, fdim, facets))
-        pathlib.Path(path).parent.mkdir(parents=True, exist_ok=True)
-        self.file = io.XDMFFile(msh.comm, str(path), "w")
-        self.file.write_mesh(msh)
+        super().__init__(path, msh)
 
     def write(self, t: float) -> None:
         self.displacement.interpolate(self.model.residual.u)
@@ -83,17 +99,8 @@ class FieldWriter:
         self.file.write_function(self.displacement, t)
         self.file.write_function(self.traction, t)
 
-    def close(self) -> None:
-        self.file.close()
 
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-
-
-class ModeWriter:
+class ModeWriter(_XDMFSeries):
     """XDMF series of complex mode shapes: real and imaginary parts as two degree-1 fields."""
 
     def __init__(self, path: typing.Union[str, pathlib.Path], model):
@@ -102,9 +109,7 @@ class ModeWriter:
         self.V1 = _compat.vector_function_space(msh, 1)
         self.parts = (fem.Function(self.V1, name="mode_real"),
                       fem.Function(self.V1, name="mode_imag"))
-        pathlib.Path(path).parent.mkdir(parents=True, exist_ok=True)
-        self.file = io.XDMFFile(msh.comm, str(path), "w")
-        self.file.write_mesh(msh)
+        super().__init__(path, msh)
 
     def write(self, mode, t: float) -> None:
         """Write ``mode`` (a :class:`~fenicsfriction.stability.Mode`) at "time" ``t``."""
@@ -114,12 +119,3 @@ class ModeWriter:
             self.mode.x.scatter_forward()
             part.interpolate(self.mode)
             self.file.write_function(part, t)
-
-    def close(self) -> None:
-        self.file.close()
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()

@@ -30,8 +30,8 @@ import typing
 
 import numpy as np
 
-from fenicsfriction import laws
 from fenicsfriction.laws import check
+from fenicsfriction.scenes.block import BlockData
 from fenicsfriction.stability import dense_eigenvalues
 
 __all__ = ["RigidBlock"]
@@ -48,61 +48,37 @@ def _dphi(regularisation: str, w: float, eps: float) -> tuple[float, float]:
 
 
 @dataclasses.dataclass
-class RigidBlock:
-    """Rigid block on a belt; parameters as :class:`~fenicsfriction.scenes.BlockOnBelt`.
+class RigidBlock(BlockData):
+    """Rigid block on a belt: :class:`~fenicsfriction.scenes.block.BlockData` plus inertia.
 
     Args:
         inertia: moment of inertia about G [10^3 kg cm^2]; None: M (L² + H²)/12 (uniform).
         viscous: linear viscous damping (c_x, c_y, c_θ) on q [10^3 kg s^-1, ..., 10^3 kg cm² s^-1].
-        Other fields as in :class:`~fenicsfriction.scenes.BlockOnBelt` (same units and meaning).
+        Other parameters: see :class:`~fenicsfriction.scenes.block.BlockData`.
     """
 
-    L: float = 48.8
-    H: float = 30.5
-    B0: float = 30.5
-    mass: float = 0.45
     inertia: typing.Optional[float] = None
-    weight: float = 450.0
-    c_n: float = 1e10
-    m_n: float = 2.5
-    mu: float = 0.0
-    m_T: typing.Optional[float] = None
-    b_n: float = 0.0
-    l_n: typing.Optional[float] = None
-    g: float = 0.0
-    eps: float = 1e-3
-    regularisation: str = "c1"
-    belt_speed: float = 0.287
-    belt_direction: int = 1
-    K_x: float = 11.1
-    spring_height: typing.Optional[float] = None
     viscous: tuple = (0.0, 0.0, 0.0)
 
     def __post_init__(self):
-        if self.spring_height is None:
-            self.spring_height = self.H / 2
         if self.inertia is None:
             self.inertia = self.mass * (self.L**2 + self.H**2) / 12
-        law = laws.InterfaceLaw(c_n=self.c_n, m_n=self.m_n, mu=self.mu, m_T=self.m_T,
-                                b_n=self.b_n, l_n=self.l_n, g=self.g, eps=self.eps,
-                                regularisation=self.regularisation)
-        self.m_T, self.l_n = law.m_T, law.l_n
-        for name in ("L", "H", "B0", "mass", "inertia", "K_x", "belt_speed"):
-            value = getattr(self, name)
-            check(name, value, np.isfinite(value) and value > 0, "must be a finite number > 0")
+        super().__post_init__()
+        self.m_T, self.l_n = self.law.m_T, self.law.l_n
+
+    def validate(self) -> None:
+        super().validate()
+        check("inertia", self.inertia, np.isfinite(self.inertia) and self.inertia > 0,
+              "must be a finite number > 0")
         check("weight", self.weight, self.weight > 0, "must be > 0")
-        check("belt_direction", self.belt_direction, self.belt_direction in (1, -1),
-              "must be +1 or -1")
         check("viscous", self.viscous, len(self.viscous) == 3 and min(self.viscous) >= 0,
               "must be three coefficients >= 0")
 
     @classmethod
-    def from_scene(cls, scene, **changes) -> "RigidBlock":
-        """The rigid counterpart of a :class:`~fenicsfriction.scenes.BlockOnBelt`."""
-        names = {f.name for f in dataclasses.fields(cls)}
-        data = {k: v for k, v in dataclasses.asdict(scene).items() if k in names}
-        data.pop("inertia", None)
-        return cls(**{**data, **changes})
+    def from_scene(cls, scene: BlockData, **changes) -> "RigidBlock":
+        """The rigid counterpart of a scene (its :class:`BlockData` fields), with ``changes``."""
+        shared = {f.name: getattr(scene, f.name) for f in dataclasses.fields(BlockData)}
+        return cls(**{**shared, **changes})
 
     @property
     def mass_matrix(self) -> np.ndarray:

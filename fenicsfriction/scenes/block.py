@@ -50,7 +50,7 @@ from fenicsfriction.forms import (NodalSpring, Residual, body_force, elasticity,
                                   surface_traction, tangential_part)
 from fenicsfriction.laws import check
 
-__all__ = ["BlockModel", "BlockOnBelt"]
+__all__ = ["BlockData", "BlockModel", "BlockOnBelt"]
 
 CONTACT, TOP, LEFT, RIGHT = 1, 2, 3, 4
 
@@ -72,18 +72,15 @@ QUADRATURE = {"gauss": _gauss, "gll": _gll}
 
 
 @dataclasses.dataclass
-class BlockOnBelt:
-    """Parameters of the block-on-belt scene (names as in seed 000; units in brackets).
+class BlockData:
+    """The block, its interface and its driver: what the FE and the rigid models share.
 
     Args:
         L: length of the block along the belt [cm].
         H: height of the block [cm].
         B0: breadth out of the plane, the plane-strain thickness [cm].
-        E: Young's modulus [10^3 kg cm^-1 s^-2].
-        nu: Poisson's ratio [-].
         mass: total mass M [10^3 kg].
         weight: total weight W, applied as a body force [10^3 kg cm s^-2].
-        top_pressure: uniform pressure on the top face [10^3 kg cm^-1 s^-2] (0 in the paper).
         c_n, m_n: normal compliance c_n [10^3 kg cm^(-1-m_n) s^-2] and exponent [-].
         mu: friction coefficient μ = c_T / c_n [-].
         m_T: friction exponent [-] (None: m_n, Coulomb).
@@ -91,26 +88,17 @@ class BlockOnBelt:
         g: initial gap [cm].
         eps: regularisation of |u̇_T - U_T| [cm/s].
         regularisation: "c1" or "smooth".
-        friction_coefficient: velocity-dependent μ(|v|) replacing ``mu`` (see laws).
         belt_speed: |U_T| [cm/s], > 0.
         belt_direction: +1 (belt moves along +x) or -1.
         K_x: total stiffness of the driver spring [10^3 kg s^-2].
         spring_height: height of the spring's line of action [cm] (None: H/2).
-        refine: mesh refinement factor; the mesh has 4·refine × 3·refine cells.
-        degree: polynomial degree of the Lagrange quadrilaterals (2: nine-node Q2).
-        contact_quadrature: "gauss" or "gll" (Gauss-Lobatto, includes the corners) on Γ_C.
-        dim: 2 (plane strain, the paper's model) or 3 (a box, 4r × 3r × nz·r hexahedra).
-        nz: cells across the breadth per refinement in 3D (even, so a node row is at B0/2).
     """
 
     L: float = 48.8
     H: float = 30.5
     B0: float = 30.5
-    E: float = 1.4e6
-    nu: float = 0.25
     mass: float = 0.45
     weight: float = 450.0
-    top_pressure: float = 0.0
     c_n: float = 1e10
     m_n: float = 2.5
     mu: float = 0.0
@@ -120,16 +108,10 @@ class BlockOnBelt:
     g: float = 0.0
     eps: float = 1e-3
     regularisation: str = "c1"
-    friction_coefficient: typing.Optional[laws.FrictionCoefficient] = None
     belt_speed: float = 0.287
     belt_direction: int = 1
     K_x: float = 11.1
     spring_height: typing.Optional[float] = None
-    refine: int = 1
-    degree: int = 2
-    contact_quadrature: str = "gauss"
-    dim: int = 2
-    nz: int = 2
 
     def __post_init__(self):
         if self.spring_height is None:
@@ -138,31 +120,18 @@ class BlockOnBelt:
 
     def validate(self) -> None:
         """Raise ``ValueError`` naming the first parameter out of its range."""
-        for name in ("L", "H", "B0", "E", "mass", "K_x", "belt_speed"):
+        for name in ("L", "H", "B0", "mass", "K_x", "belt_speed"):
             value = getattr(self, name)
             check(name, value, np.isfinite(value) and value > 0, "must be a finite number > 0")
-        check("nu", self.nu, -1 < self.nu < 0.5, "Poisson's ratio must lie in (-1, 0.5)")
         check("weight", self.weight, self.weight >= 0, "must be >= 0")
-        check("top_pressure", self.top_pressure, self.top_pressure >= 0, "must be >= 0")
-        check("weight", self.weight, self.weight + self.top_pressure > 0,
-              "weight and top_pressure cannot both be 0: nothing presses the block on the belt")
         check("belt_direction", self.belt_direction, self.belt_direction in (1, -1),
               "must be +1 or -1")
         check("spring_height", self.spring_height, 0 <= self.spring_height <= self.H,
               f"must lie in [0, H] = [0, {self.H}]")
-        check("refine", self.refine, isinstance(self.refine, int) and self.refine >= 1,
-              "must be an integer >= 1")
-        check("degree", self.degree, self.degree in (1, 2, 3), "must be 1, 2 or 3")
-        check("dim", self.dim, self.dim in (2, 3), "must be 2 or 3")
-        check("nz", self.nz, isinstance(self.nz, int) and self.nz >= 2 and self.nz % 2 == 0,
-              "must be an even integer >= 2")
-        check("contact_quadrature", self.contact_quadrature,
-              self.contact_quadrature in QUADRATURE, f"must be one of {sorted(QUADRATURE)}")
         laws.InterfaceLaw(**self._law_parameters())  # validates the interface parameters
 
     def _law_parameters(self) -> dict:
-        names = ("c_n", "m_n", "mu", "m_T", "b_n", "l_n", "g", "eps", "regularisation",
-                 "friction_coefficient")
+        names = ("c_n", "m_n", "mu", "m_T", "b_n", "l_n", "g", "eps", "regularisation")
         return {name: getattr(self, name) for name in names}
 
     @property
@@ -171,14 +140,61 @@ class BlockOnBelt:
         return laws.InterfaceLaw(**self._law_parameters())
 
     @property
-    def contact_pressure(self) -> float:
-        """Mean contact pressure (W + p_top L B0) / (L B0) at equilibrium."""
-        return self.weight / (self.L * self.B0) + self.top_pressure
-
-    @property
     def tipping_limit(self) -> float:
         """μ at which the normal resultant reaches the front corner: L / (2 h_s)."""
         return self.L / (2 * self.spring_height) if self.spring_height > 0 else np.inf
+
+
+@dataclasses.dataclass
+class BlockOnBelt(BlockData):
+    """The block-on-belt scene: :class:`BlockData` and the finite element model's own data.
+
+    Args:
+        E: Young's modulus [10^3 kg cm^-1 s^-2].
+        nu: Poisson's ratio [-].
+        top_pressure: uniform pressure on the top face [10^3 kg cm^-1 s^-2] (0 in the paper).
+        friction_coefficient: velocity-dependent μ(|v|) replacing ``mu`` (see laws).
+        refine: mesh refinement factor; the mesh has 4·refine × 3·refine cells.
+        degree: polynomial degree of the Lagrange quadrilaterals (2: nine-node Q2).
+        contact_quadrature: "gauss" or "gll" (Gauss-Lobatto, includes the corners) on Γ_C.
+        dim: 2 (plane strain, the paper's model) or 3 (a box, 4r × 3r × nz·r hexahedra).
+        nz: cells across the breadth per refinement in 3D (even, so a node row is at B0/2).
+        Other parameters: see :class:`BlockData`.
+    """
+
+    E: float = 1.4e6
+    nu: float = 0.25
+    top_pressure: float = 0.0
+    friction_coefficient: typing.Optional[laws.FrictionCoefficient] = None
+    refine: int = 1
+    degree: int = 2
+    contact_quadrature: str = "gauss"
+    dim: int = 2
+    nz: int = 2
+
+    def validate(self) -> None:
+        super().validate()
+        check("E", self.E, np.isfinite(self.E) and self.E > 0, "must be a finite number > 0")
+        check("nu", self.nu, -1 < self.nu < 0.5, "Poisson's ratio must lie in (-1, 0.5)")
+        check("top_pressure", self.top_pressure, self.top_pressure >= 0, "must be >= 0")
+        check("weight", self.weight, self.weight + self.top_pressure > 0,
+              "weight and top_pressure cannot both be 0: nothing presses the block on the belt")
+        check("refine", self.refine, isinstance(self.refine, int) and self.refine >= 1,
+              "must be an integer >= 1")
+        check("degree", self.degree, self.degree in (1, 2, 3), "must be 1, 2 or 3")
+        check("dim", self.dim, self.dim in (2, 3), "must be 2 or 3")
+        check("nz", self.nz, isinstance(self.nz, int) and self.nz >= 2 and self.nz % 2 == 0,
+              "must be an even integer >= 2")
+        check("contact_quadrature", self.contact_quadrature,
+              self.contact_quadrature in QUADRATURE, f"must be one of {sorted(QUADRATURE)}")
+
+    def _law_parameters(self) -> dict:
+        return {**super()._law_parameters(), "friction_coefficient": self.friction_coefficient}
+
+    @property
+    def contact_pressure(self) -> float:
+        """Mean contact pressure (W + p_top L B0) / (L B0) at equilibrium."""
+        return self.weight / (self.L * self.B0) + self.top_pressure
 
     @property
     def discrete_tipping_limit(self) -> float:
