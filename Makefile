@@ -30,6 +30,7 @@ setup: .venv/.installed
 
 demo: setup
 	$(PY) -m fenicsfriction steady block --mu-max 1.55 --steps 31 --out $(OUT)/steady-block
+	$(PY) -m fenicsfriction stability block --mu-max 1.55 --steps 62 --out $(OUT)/stability-block
 
 test-serial: setup
 	$(PY) -m pytest -q tests

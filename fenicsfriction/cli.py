@@ -215,7 +215,8 @@ def _rigid_loci(scene, targets: np.ndarray, max_frequency: float, growth_tol: fl
 def _run_stability(args: argparse.Namespace, log: logging.Logger) -> int:
     from fenicsfriction import io, plotting
     from fenicsfriction.laws import check
-    from fenicsfriction.stability import Loci, StabilitySolver, unstable_intervals
+    from fenicsfriction.stability import EigenSolveError, Loci, StabilitySolver, \
+        unstable_intervals
     from fenicsfriction.steady import ContinuationError
 
     comm = MPI.COMM_WORLD
@@ -241,12 +242,13 @@ def _run_stability(args: argparse.Namespace, log: logging.Logger) -> int:
                      f"  growing: {[m.ident for m in growing]}"
                      + (f"  ({flagged} inaccurate)" if flagged else ""))
 
-        failure = None
+        failure, records = None, []
         try:
-            records = loci.follow(targets, on_step=on_step)
-        except ContinuationError as err:
-            failure, records = str(err), []
-    onsets = [loci.onset(a, b, args.onset_tol, reference=ref) for a, b, ref in transitions]
+            loci.follow(targets, on_step=lambda r, m: (records.append(r), on_step(r, m)))
+        except (ContinuationError, EigenSolveError) as err:
+            failure = f"at μ = {float(model.mu.value):.6g}: {err}"
+    onsets = [] if failure else [loci.onset(a, b, args.onset_tol, reference=ref)
+                                 for a, b, ref in transitions]
     rigid = _rigid_loci(scene, targets, args.max_frequency, args.growth_tol, args.onset_tol)
     fe = {"steps": records, "onsets": onsets,
           "mu_crit": onsets[0]["mu_crit"] if onsets else None,

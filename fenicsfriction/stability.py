@@ -40,7 +40,7 @@ from fenicsfriction.assembly import assemble_jacobian, options_with_defaults
 from fenicsfriction.forms import Residual
 from fenicsfriction.laws import check
 
-__all__ = ["Mode", "StabilitySolver", "dense_eigenvalues", "mac", "track"]
+__all__ = ["EigenSolveError", "Mode", "StabilitySolver", "dense_eigenvalues", "mac", "track"]
 
 DEFAULT_OPTIONS = {
     "pep_type": "toar",
@@ -52,6 +52,10 @@ DEFAULT_OPTIONS = {
     "st_pc_type": "lu",
     "st_pc_factor_mat_solver_type": "mumps",
 }
+
+
+class EigenSolveError(RuntimeError):
+    """The PEP could not cover the requested disc (not enough eigenpairs converged)."""
 
 
 @dataclasses.dataclass
@@ -174,7 +178,7 @@ class StabilitySolver:
             max_modulus: radius of the disc searched [1/s]: the highest angular frequency (or
                 growth rate) of interest.
             nev: eigenvalues requested at first; doubled until the disc is covered.
-            max_nev: upper bound on the request; reaching it raises ``RuntimeError``.
+            max_nev: upper bound on the request; reaching it raises :class:`EigenSolveError`.
             shift: real shift σ of shift-and-invert (default ``max_modulus / 4``). The
                 eigenvalues nearest σ are computed until the disc |λ - σ| <= max_modulus + σ,
                 which contains |λ| <= max_modulus, is covered. σ > 0 favours growing modes and
@@ -198,7 +202,7 @@ class StabilitySolver:
                 break
             nev *= 2
         if not covered and count < n:
-            raise RuntimeError(
+            raise EigenSolveError(
                 f"PEP found {count} eigenvalues, none beyond |λ - {shift:g}| = {radius:g}, with "
                 f"{nev} requested (max_nev={max_nev}); reason {self.pep.getConvergedReason()}")
         xr, xi = self.K.createVecs()
