@@ -272,6 +272,7 @@ class Loci:
         self.max_modulus, self.growth_tol = max_modulus, growth_tol
         self.comm = stability.comm
         self._next = 0
+        self._previous: list[Mode] = []
 
     def _solve_at(self, value: float) -> list[Mode]:
         from fenicsfriction.steady import continuation
@@ -285,16 +286,17 @@ class Loci:
 
         Returns one record per value: ``mu``, ``modes`` (``mode`` id, ``re``, ``im``,
         ``residual``, ``accurate``) and ``max_re``. ``on_step(record, modes)`` sees each step.
+        A further call goes on from the last step of the previous one (same mode ids).
         """
-        records, previous = [], []
+        records = []
         for value in values:
             modes = self._solve_at(value)
-            self._next = track(previous, modes, self.comm, self._next)
+            self._next = track(self._previous, modes, self.comm, self._next)
             record = _records(value, modes)
             records.append(record)
             if on_step is not None:
                 on_step(record, modes)
-            previous = modes
+            self._previous = modes
         return records
 
     def unstable(self, modes: list[Mode]) -> list[Mode]:

@@ -76,8 +76,17 @@ class RigidBlock(BlockData):
 
     @classmethod
     def from_scene(cls, scene: BlockData, **changes) -> "RigidBlock":
-        """The rigid counterpart of a scene (its :class:`BlockData` fields), with ``changes``."""
+        """The rigid counterpart of a scene (its :class:`BlockData` fields), with ``changes``.
+
+        A uniform top pressure p of the FE scene is a vertical resultant p L B0 through G, so
+        it joins the weight; a velocity-dependent friction law has no rigid counterpart here
+        and is refused rather than silently replaced by ``mu``.
+        """
         shared = {f.name: getattr(scene, f.name) for f in dataclasses.fields(BlockData)}
+        if getattr(scene, "friction_coefficient", None) is not None:
+            raise ValueError(f"friction_coefficient={scene.friction_coefficient!r} is invalid: "
+                             "the rigid block supports a constant mu only")
+        shared["weight"] += getattr(scene, "top_pressure", 0.0) * scene.L * scene.B0
         return cls(**{**shared, **changes})
 
     @property
