@@ -50,6 +50,26 @@ def test_steady_cli_writes_one_balanced_record_per_step(out_dir):
         assert (out_dir / name).stat().st_size > 0, name
 
 
+def test_stability_cli_writes_tracked_loci_and_both_onsets(out_dir):
+    code = main(["stability", "block", "--mu-max", "0.6", "--steps", "6", "--out", str(out_dir),
+                 "--onset-tol", "1e-3"])
+    assert code == 0
+    data = json.loads((out_dir / "stability.json").read_text())
+    assert [s["mu"] for s in data["fe"]["steps"]] == pytest.approx(np.linspace(0, 0.6, 7))
+    for step in data["fe"]["steps"]:
+        assert step["modes"] and all({"mode", "re", "im", "residual", "accurate"} <= set(m)
+                                     for m in step["modes"])
+        assert all(m["accurate"] for m in step["modes"])
+    # flutter of the normal/rotational pair: FE and rigid onsets lie between the grid
+    # points that bracket them (0.3 stable, 0.4 unstable for FE; 0.4 and 0.5 for rigid)
+    assert 0.3 < data["mu_crit"]["fe"] < 0.4 and 0.4 < data["mu_crit"]["rigid"] < 0.5
+    onset = data["fe"]["onsets"][0]
+    assert onset["interval"][1] - onset["interval"][0] <= 1e-3
+    assert len({c["mode"] for c in onset["colliding"]}) == 2
+    for name in ("loci.png", "growth.png", "unstable_modes.xdmf", "unstable_modes.h5"):
+        assert (out_dir / name).stat().st_size > 0, name
+
+
 def test_steady_cli_stops_at_discrete_tipping_limit_and_reports_it(out_dir):
     """Beyond μ = L/H no steady state exists: exit 1, converged steps kept, no hang."""
     code = main(["steady", "block", "--mu-max", "1.7", "--steps", "2", "--out", str(out_dir),
