@@ -379,6 +379,33 @@ class BlockModel:
         value = fem.assemble_scalar(self._functionals[key])
         return self.msh.comm.allreduce(value, op=MPI.SUM)
 
+    def energies(self) -> dict:
+        """Kinetic, strain, interface, spring and load-potential energies of the current state.
+
+        The load potential is -∫ b·u (weight) - ∫ t·u (top pressure); without friction and
+        damping their sum ``total`` is conserved by the dynamics.
+        """
+        s, R = self.scene, self.residual
+        u, u_dot = R.u, R.u_dot
+        if "energy" not in self._functionals:
+            d = self.penetration()
+            ds = ufl.Measure("ds", domain=self.msh, subdomain_data=self.facet_tags)
+            forms = {"kinetic": 0.5 * self.rho * ufl.inner(u_dot, u_dot) * self.dx,
+                     "strain": 0.5 * elasticity(u, u, s.E, s.nu, self.dx),
+                     "interface": self.c_n * d ** (self.m_n + 1) / (self.m_n + 1)
+                     * self.ds_contact,
+                     "load": -ufl.inner(self.gravity, u) * self.dx
+                     - ufl.inner(self.top_traction, u) * ds(TOP)}
+            self._functionals["energy"] = {k: _compat.form(self.thickness * f)
+                                           for k, f in forms.items()}
+        comm = self.msh.comm
+        values = {k: comm.allreduce(fem.assemble_scalar(f), op=MPI.SUM)
+                  for k, f in self._functionals["energy"].items()}
+        force = self.spring.force(u)
+        values["spring"] = 0.5 * force**2 / self.spring.stiffness
+        values["total"] = sum(values.values())
+        return values
+
     @property
     def force_scale(self) -> float:
         """Total load pressing the block down [force]: the scale of the residual's entries."""

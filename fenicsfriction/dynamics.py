@@ -1,0 +1,172 @@
+r"""Problem 1ε, dynamics: :math:`R(u, \dot u, \ddot u; v) = 0` integrated by PETSc TS.
+
+The default scheme is PETSc's generalized-α method for second-order systems (``TSALPHA2``;
+Newmark's average acceleration is ``-dynamics_ts_alpha_radius 1``), with Newton (SNES, MUMPS)
+at each step. TS asks for
+
+* the residual :math:`F(t, u, \dot u, \ddot u) = R(u, \dot u, \ddot u)` — the one residual of
+  :mod:`fenicsfriction.forms`, nothing rewritten;
+* its Jacobian :math:`\partial R/\partial u + s_v\,\partial R/\partial \dot u
+  + s_a\,\partial R/\partial \ddot u`, compiled once with the shifts :math:`s_v, s_a` as
+  ``fem.Constant``.
+
+Steps: fixed (``-dynamics_ts_adapt_type none``, the default) or adaptive
+(``-dynamics_ts_adapt_type basic``); a step whose Newton solve fails is retried with a smaller
+step (``ts_max_snes_failures = -1``, the cut-back of seed 001 at slide-to-stick transitions).
+Options live under the prefix (default ``dynamics_``).
+"""
+
+from __future__ import annotations
+
+import time
+import typing
+
+from dolfinx import fem
+
+import dolfinx.fem.petsc  # noqa: F401
+
+from petsc4py import PETSc
+
+from fenicsfriction import _compat
+from fenicsfriction.assembly import assemble_jacobian, assemble_residual, options_with_defaults
+from fenicsfriction.forms import Residual
+from fenicsfriction.laws import check
+
+__all__ = ["DEFAULT_OPTIONS", "DynamicsError", "DynamicsSolver"]
+
+DEFAULT_OPTIONS = {
+    "ts_type": "alpha2",
+    "ts_alpha_radius": 1.0,
+    "ts_adapt_type": "none",
+    "ts_max_snes_failures": -1,
+    "ts_max_reject": 20,
+    "ts_exact_final_time": "matchstep",
+    "snes_type": "newtonls",
+    "snes_linesearch_type": "basic",
+    "snes_rtol": 1e-10,
+    "snes_max_it": 25,
+    "ksp_type": "preonly",
+    "pc_type": "lu",
+    "pc_factor_mat_solver_type": "mumps",
+}
+
+
+class DynamicsError(RuntimeError):
+    """The time integration stopped before the final time; ``records`` holds the steps done."""
+
+    def __init__(self, message: str, records: list):
+        super().__init__(message)
+        self.records = records
+
+
+class DynamicsSolver:
+    """Generalized-α (TSALPHA2) integration of the one residual.
+
+    Args:
+        residual: the residual; ``u`` and ``u_dot`` hold the initial state (e.g. a steady
+            sliding state plus a velocity perturbation) and receive the final one.
+        prefix: PETSc options prefix of the TS (and its SNES/KSP/PC).
+        options: defaults over :data:`DEFAULT_OPTIONS`; options in the database win.
+        atol: absolute Newton tolerance on the residual (force units).
+
+    Attributes:
+        ts: the PETSc TS, exposed for monitoring or further configuration.
+    """
+
+    def __init__(self, residual: Residual, prefix: str = "dynamics_",
+                 options: typing.Optional[dict] = None, atol: float = 1e-8):
+        self.residual = residual
+        msh = residual.V.mesh
+        self.shift_v = fem.Constant(msh, 0.0)
+        self.shift_a = fem.Constant(msh, 0.0)
+        R = residual.form
+        jacobian = residual.derivative(R, residual.u)
+        for field, shift in ((residual.u_dot, self.shift_v), (residual.u_ddot, self.shift_a)):
+            part = residual.derivative(R, field)
+            if not part.empty():
+                jacobian = jacobian + shift * part
+        self.L = _compat.form(R)
+        self.a = _compat.form(jacobian)
+        self.b = dolfinx.fem.petsc.create_vector(self.L)
+        self.A = dolfinx.fem.petsc.create_matrix(self.a)
+        self.ts = PETSc.TS().create(msh.comm)
+        self.ts.setOptionsPrefix(prefix)
+        self.ts.setI2Function(self._F, self.b)
+        self.ts.setI2Jacobian(self._J, self.A)
+        with options_with_defaults(prefix, {**DEFAULT_OPTIONS, "snes_atol": atol,
+                                            **(options or {})}):
+            self.ts.setFromOptions()
+
+    def _load(self, x, xdot, xddot) -> None:
+        """Copy a state into the fields (``xddot=None`` leaves the acceleration alone)."""
+        for vec, field in ((x, self.residual.u), (xdot, self.residual.u_dot),
+                           (xddot, self.residual.u_ddot)):
+            if vec is not None:
+                vec.copy(_compat.petsc_vec(field))
+                field.x.scatter_forward()
+
+    def _F(self, ts, t, x, xdot, xddot, F):
+        self._load(x, xdot, xddot)
+        assemble_residual(F, self.L, self.a, self.residual.bcs, x, self.residual.springs)
+
+    def _J(self, ts, t, x, xdot, xddot, shift_v, shift_a, J, P):
+        self.shift_v.value = shift_v
+        self.shift_a.value = shift_a
+        assemble_jacobian(J, self.a, self.residual.bcs, self.residual.springs)
+
+    def run(self, t_end: float, dt: float,
+            observe: typing.Optional[typing.Callable[[float], dict]] = None,
+            on_step: typing.Optional[typing.Callable[[dict], None]] = None) -> list[dict]:
+        """Integrate from t = 0 to ``t_end`` with (initial) step ``dt``.
+
+        Args:
+            observe: called after every accepted step (fields hold the state), its dict is
+                merged into the step's record.
+            on_step: called with each record (progress output, field output).
+
+        Returns:
+            One record per accepted step (and one for t = 0): ``time``, ``dt``,
+            ``newton_iterations``, ``wall_time_s`` and what ``observe`` adds.
+
+        Raises:
+            DynamicsError: TS stopped early (e.g. too many step rejections); the fields hold
+                the last accepted state and ``error.records`` the steps done.
+        """
+        check("t_end", t_end, t_end > 0, "must be > 0")
+        check("dt", dt, 0 < dt <= t_end, f"must lie in (0, t_end = {t_end}]")
+        u = _compat.petsc_vec(self.residual.u).copy()
+        v = _compat.petsc_vec(self.residual.u_dot).copy()
+        self.ts.setSolution2(u, v)
+        self.ts.setTime(0.0)
+        self.ts.setStepNumber(0)
+        self.ts.setTimeStep(dt)
+        self.ts.setMaxTime(t_end)
+        self.ts.setMaxSteps(10**9)
+        records: list[dict] = []
+        clock = [time.perf_counter(), 0]
+
+        def monitor(ts, step, t, x):
+            snes_its = ts.getSNESIterations()
+            record = {"time": float(t), "dt": 0.0,
+                      "newton_iterations": snes_its - clock[1],
+                      "wall_time_s": time.perf_counter() - clock[0]}
+            clock[0], clock[1] = time.perf_counter(), snes_its
+            if step:  # the fields hold the last residual evaluation: load the accepted state
+                self._load(x, ts.getSolution2()[1], None)
+                record["dt"] = float(t - records[-1]["time"])
+            if observe is not None:
+                record.update(observe(float(t)))
+            records.append(record)
+            if on_step is not None:
+                on_step(record)
+
+        self.ts.setMonitor(monitor)
+        self.ts.solve(u)
+        self.ts.cancelMonitor()
+        reason = self.ts.getConvergedReason()
+        u.destroy()
+        v.destroy()
+        if reason < 0:
+            raise DynamicsError(f"TS stopped at t = {self.ts.getTime():.6g} with reason "
+                                f"{reason} after {self.ts.getStepNumber()} steps", records)
+        return records
