@@ -79,7 +79,105 @@ def _parser() -> argparse.ArgumentParser:
                            help="width of the μ interval the onset is bisected to")
     stability.add_argument("--growth-tol", type=float, default=1e-6,
                            help="a mode grows when Re λ > growth-tol |λ|")
+    dynamics = commands.add_parser(
+        "dynamics", help="dynamics from a perturbed steady state (Problem 1ε, PETSc TS)",
+        description="Generalized-α (TSALPHA2) integration from the steady sliding state at --mu "
+                    "plus a normal velocity perturbation; TS/SNES options as -dynamics_<option> "
+                    "after the flags (e.g. -dynamics_ts_adapt_type basic).")
+    dynamics.add_argument("scene", choices=["block"], help="scene to run")
+    dynamics.add_argument("--mu", type=float, required=True, help="friction coefficient")
+    dynamics.add_argument("--t-end", type=float, required=True, help="final time [s]")
+    dynamics.add_argument("--dt", type=float, default=1e-5, help="(initial) time step [s]")
+    dynamics.add_argument("--perturbation", type=float, default=-0.01,
+                          help="initial normal velocity added to the steady state [cm/s]")
+    dynamics.add_argument("--stride", type=int, default=20, help="steps between field outputs")
+    dynamics.add_argument("--scheme", choices=["alpha2"], default="alpha2",
+                          help="time scheme (explicit central differences: not yet)")
+    dynamics.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    for flag, dest, kind, text in (
+            ("--refine", "refine", int, "mesh refinement (1)"),
+            ("--belt-speed", "belt_speed", float, "belt speed [cm/s] (0.287)"),
+            ("--b-n", "b_n", float, "normal damping [10³ kg cm^(-2-l_n) s⁻¹] (0)"),
+            ("--K-x", "K_x", float, "driver spring [10³ kg s⁻²] (11.1)"),
+            ("--B0", "B0", float, "breadth [cm] (30.5)"),
+            ("--eps", "eps", float, "regularisation ε [cm/s] (1e-3)"),
+            ("--regularisation", "regularisation", str, "c1 or smooth (c1)")):
+        dynamics.add_argument(flag, dest=dest, type=kind, help=text)
     return parser
+
+
+def _run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
+    import csv
+
+    from fenicsfriction import io
+    from fenicsfriction.dynamics import DynamicsError, DynamicsSolver
+    from fenicsfriction.laws import check
+    from fenicsfriction.scenes import SCENES
+    from fenicsfriction.steady import SteadySolver, continuation
+
+    comm = MPI.COMM_WORLD
+    check("--mu", args.mu, np.isfinite(args.mu) and args.mu >= 0, "must be >= 0")
+    check("--t-end", args.t_end, args.t_end > 0, "must be > 0")
+    check("--dt", args.dt, 0 < args.dt <= args.t_end, "must lie in (0, t-end]")
+    check("--stride", args.stride, args.stride >= 1, "must be >= 1")
+    scene_cls = SCENES[args.scene]
+    names = {f.name for f in dataclasses.fields(scene_cls)}
+    scene = scene_cls(mu=args.mu, **{k: v for k, v in vars(args).items()
+                                     if k in names and k != "mu" and v is not None})
+    model = scene.build(comm)
+    model.initial_guess()
+    steady = SteadySolver(model.residual, prefix="steady_", options=model.solver_options())
+    continuation(steady, model.mu, np.linspace(0.0, args.mu, 1 + int(np.ceil(args.mu / 0.05))))
+    model.residual.u_dot.x.array[1::model.V.dofmap.index_map_bs] += args.perturbation
+    dynamics = DynamicsSolver(model.residual, prefix="dynamics_",
+                              atol=1e-10 * model.force_scale)
+    out: pathlib.Path = args.out
+    energy0, work, last = model.energies()["total"], [0.0], {}
+
+    def observe(t: float) -> dict:
+        q, powers, energies = model.quantities(), model.powers(), model.energies()
+        power = powers["friction"] + powers["damping"]
+        if last:  # trapezoidal rule for the work of the interface forces
+            work[0] += 0.5 * (power + last["power"]) * (t - last["time"])
+        last.update(time=t, power=power)
+        return {key: q[key] for key in ("normal_force", "friction_force", "spring_force",
+                                        "centre_of_pressure", "min_penetration",
+                                        "max_penetration")} | model.contact_states() | {
+            "kinetic_energy": energies["kinetic"], "friction_power": powers["friction"],
+            "damping_power": powers["damping"],
+            "energy_error": energies["total"] - energy0 - work[0]}
+
+    records = []
+    with io.FieldWriter(out / "dynamics.xdmf", model) as fields:
+        def on_step(record: dict) -> None:
+            k = len(records)
+            records.append(record)
+            if k % args.stride == 0:
+                fields.write(record["time"])
+                log.info(f"step {k:6d}  t={record['time']:.4e} s  dt={record['dt']:.2e}  "
+                         f"Newton {record['newton_iterations']}  N={record['normal_force']:.4g}"
+                         f"  F_T={record['friction_force']:.4g}  stick/slip/open "
+                         f"{record['n_stick']}/{record['n_slip']}/{record['n_open']}")
+
+        failure = None
+        try:
+            dynamics.run(args.t_end, args.dt, observe=observe, on_step=on_step)
+        except DynamicsError as err:
+            failure = str(err)
+    if comm.rank == 0:
+        out.mkdir(parents=True, exist_ok=True)
+        with open(out / "timeseries.csv", "w", newline="") as handle:
+            writer = csv.DictWriter(handle, fieldnames=list(records[0]))
+            writer.writeheader()
+            writer.writerows(records)
+    io.write_json(out / "summary.json", {"scene": args.scene,
+                                         "parameters": dataclasses.asdict(scene),
+                                         "steps": len(records) - 1, "failure": failure}, comm)
+    log.info(f"results in {out}/: timeseries.csv, summary.json, dynamics.xdmf")
+    if failure is not None:
+        log.error(f"fenicsfriction: {failure}")
+        return 1
+    return 0
 
 
 def _build(args: argparse.Namespace):
@@ -288,7 +386,8 @@ def main(argv: typing.Optional[list[str]] = None) -> int:
     from fenicsfriction.io import get_logger
     log = get_logger(MPI.COMM_WORLD)
     try:
-        return {"steady": _run_steady, "stability": _run_stability}[args.command](args, log)
+        commands = {"steady": _run_steady, "stability": _run_stability, "dynamics": _run_dynamics}
+        return commands[args.command](args, log)
     except ValueError as err:
         if MPI.COMM_WORLD.rank == 0:
             print(f"fenicsfriction: error: {err}", file=sys.stderr)

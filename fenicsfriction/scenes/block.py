@@ -406,6 +406,42 @@ class BlockModel:
         values["total"] = sum(values.values())
         return values
 
+    def powers(self) -> dict:
+        """Power of the interface forces on the body at the current state [force × cm/s].
+
+        ``friction``: ∫ t_T · u̇ of the regularised friction traction (the moving belt can put
+        energy in); ``damping``: -∫ b_n d^{l_n} u̇_n² (normal damping, <= 0).
+        """
+        if "power" not in self._functionals:
+            R, n, law = self.residual, self.normal, self.scene.law
+            forms = {"friction": -friction(R.u, R.u_dot, R.u_dot, n, self.friction_c_T,
+                                           self.m_T, self.gap, self.belt_velocity, self.eps,
+                                           self.ds_contact, law.regularisation)
+                     if self.with_friction else None,
+                     "damping": -normal_damping(R.u, R.u_dot, R.u_dot, n, law.b_n, law.l_n,
+                                                self.gap, self.ds_contact)
+                     if law.b_n > 0 else None}
+            self._functionals["power"] = {k: _compat.form(self.thickness * f)
+                                          for k, f in forms.items() if f is not None}
+        comm = self.msh.comm
+        values = {"friction": 0.0, "damping": 0.0}
+        values.update({k: comm.allreduce(fem.assemble_scalar(f), op=MPI.SUM)
+                       for k, f in self._functionals["power"].items()})
+        return values
+
+    def contact_states(self) -> dict:
+        """Counts of contact nodes that are open (d = 0), sticking (|u̇_T - U_T| < ε, the
+        regularisation band) or slipping, over the whole mesh."""
+        y = self._contact_y
+        d = np.maximum(-self.residual.u.x.array[y] - self.scene.g, 0.0)
+        slip = np.abs(self.residual.u_dot.x.array[y - 1] - self.scene.belt_direction
+                      * self.scene.belt_speed)
+        closed = d > 0
+        stick = closed & (slip < float(self.eps.value))
+        counts = np.array([np.sum(~closed), np.sum(stick), np.sum(closed & ~stick)])
+        n_open, n_stick, n_slip = self.msh.comm.allreduce(counts, op=MPI.SUM)
+        return {"n_open": int(n_open), "n_stick": int(n_stick), "n_slip": int(n_slip)}
+
     @property
     def force_scale(self) -> float:
         """Total load pressing the block down [force]: the scale of the residual's entries."""
