@@ -91,8 +91,9 @@ def _parser() -> argparse.ArgumentParser:
     dynamics.add_argument("--perturbation", type=float, default=-0.01,
                           help="initial normal velocity added to the steady state [cm/s]")
     dynamics.add_argument("--stride", type=int, default=20, help="steps between field outputs")
-    dynamics.add_argument("--scheme", choices=["alpha2"], default="alpha2",
-                          help="time scheme (explicit central differences: not yet)")
+    dynamics.add_argument("--scheme", choices=["alpha2", "central"], default="alpha2",
+                          help="implicit generalized-α, or explicit central differences with "
+                               "a lumped mass (dt capped at 0.9 of the stable step)")
     dynamics.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
     for flag, dest, kind, text in (
             ("--refine", "refine", int, "mesh refinement (1)"),
@@ -110,7 +111,7 @@ def _run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
     import csv
 
     from fenicsfriction import io
-    from fenicsfriction.dynamics import DynamicsError, DynamicsSolver
+    from fenicsfriction.dynamics import CentralDifference, DynamicsError, DynamicsSolver
     from fenicsfriction.laws import check
     from fenicsfriction.scenes import SCENES
     from fenicsfriction.steady import SteadySolver, continuation
@@ -129,8 +130,13 @@ def _run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
     steady = SteadySolver(model.residual, prefix="steady_", options=model.solver_options())
     continuation(steady, model.mu, np.linspace(0.0, args.mu, 1 + int(np.ceil(args.mu / 0.05))))
     model.residual.u_dot.x.array[1::model.V.dofmap.index_map_bs] += args.perturbation
-    dynamics = DynamicsSolver(model.residual, prefix="dynamics_",
-                              atol=1e-10 * model.force_scale)
+    if args.scheme == "central":
+        dynamics = CentralDifference(model.residual)
+        log.info(f"central differences: stable step {dynamics.stable_dt:.3e} s, using "
+                 f"{min(args.dt, dynamics.safety * dynamics.stable_dt):.3e} s")
+    else:
+        dynamics = DynamicsSolver(model.residual, prefix="dynamics_",
+                                  atol=1e-10 * model.force_scale)
     out: pathlib.Path = args.out
     energy0, work, last = model.energies()["total"], [0.0], {}
 

@@ -21,6 +21,8 @@ from __future__ import annotations
 import time
 import typing
 
+import numpy as np
+import ufl
 from dolfinx import fem
 
 import dolfinx.fem.petsc  # noqa: F401
@@ -169,4 +171,111 @@ class DynamicsSolver:
         if reason < 0:
             raise DynamicsError(f"TS stopped at t = {self.ts.getTime():.6g} with reason "
                                 f"{reason} after {self.ts.getStepNumber()} steps", records)
+        return records
+
+
+class CentralDifference:
+    """Explicit central differences with a row-sum lumped mass (seed 000's FE dynamics).
+
+    .. math::
+        a_n = M_L^{-1}\\,(-R(u_n, \\tilde v_n, 0)),\\quad
+        v_{n+1/2} = v_{n-1/2} + \\Delta t\\, a_n,\\quad u_{n+1} = u_n + \\Delta t\\, v_{n+1/2},
+
+    with the velocity-dependent forces (friction, damping) evaluated at the predicted
+    :math:`\\tilde v_n = v_{n-1/2} + \\tfrac{\\Delta t}{2} a_{n-1}`. The scheme is stable for
+    :math:`\\Delta t < 2/\\omega_{max}`, :math:`\\omega_{max}^2` the largest eigenvalue of
+    :math:`\\bar K w = \\omega^2 M_L w` (SLEPc EPS, at the initial state); steps are capped at
+    ``safety`` times that bound. Tensor-product Lagrange elements have positive row sums.
+    """
+
+    def __init__(self, residual: Residual, safety: float = 0.9):
+        check("safety", safety, 0 < safety < 1, "must lie in (0, 1)")
+        self.residual, self.safety = residual, safety
+        zero = ufl.zero(*residual.u.ufl_shape)
+        self.L = _compat.form(ufl.replace(residual.form, {residual.u_ddot: zero}))
+        mass = residual.derivative(residual.form, residual.u_ddot)
+        self.b = dolfinx.fem.petsc.create_vector(self.L)
+        M = dolfinx.fem.petsc.assemble_matrix(_compat.form(mass))
+        M.assemble()
+        self.lumped = self.b.duplicate()
+        M.getRowSum(self.lumped)
+        bc_dofs = [i for bc in residual.bcs for i in bc.dof_indices()[0]]
+        with self.lumped.localForm() as m:
+            m.array[bc_dofs] = np.inf  # constrained dofs never accelerate
+        self.stable_dt = self._stable_step(residual)
+        M.destroy()
+
+    def _stable_step(self, residual: Residual) -> float:
+        """2 / ω_max with ω_max² the largest eigenvalue of K̄ w = ω² M_L w."""
+        from slepc4py import SLEPc
+        a = _compat.form(residual.derivative(residual.at_rest(residual.form), residual.u))
+        K = dolfinx.fem.petsc.create_matrix(a)
+        assemble_jacobian(K, a, residual.bcs, residual.springs)
+        inverse_mass = self.lumped.copy()
+        inverse_mass.reciprocal()
+        K.diagonalScale(inverse_mass, None)  # M_L^{-1} K̄: same eigenvalues ω²
+        eps = SLEPc.EPS().create(K.getComm())
+        eps.setOperators(K)
+        eps.setProblemType(SLEPc.EPS.ProblemType.NHEP)
+        eps.setWhichEigenpairs(SLEPc.EPS.Which.LARGEST_MAGNITUDE)
+        eps.setTolerances(1e-6, 500)
+        eps.solve()
+        omega2 = max(abs(eps.getEigenvalue(i)) for i in range(eps.getConverged()))
+        for obj in (eps, K, inverse_mass):
+            obj.destroy()
+        return 2.0 / np.sqrt(omega2)
+
+    def run(self, t_end: float, dt: float,
+            observe: typing.Optional[typing.Callable[[float], dict]] = None,
+            on_step: typing.Optional[typing.Callable[[dict], None]] = None) -> list[dict]:
+        """Integrate to ``t_end``; ``dt`` above ``safety × stable_dt`` is reduced to it.
+
+        Records as :meth:`DynamicsSolver.run` (``newton_iterations`` is 0: nothing to solve).
+        """
+        check("t_end", t_end, t_end > 0, "must be > 0")
+        check("dt", dt, 0 < dt <= t_end, f"must lie in (0, t_end = {t_end}]")
+        dt = min(dt, self.safety * self.stable_dt)
+        R = self.residual
+        u, v = _compat.petsc_vec(R.u), _compat.petsc_vec(R.u_dot)
+        a = v.duplicate()
+
+        def acceleration() -> None:
+            R.u.x.scatter_forward()
+            R.u_dot.x.scatter_forward()
+            assemble_residual(self.b, self.L, self.L, [], u, R.springs)
+            a.pointwiseDivide(self.b, self.lumped)
+            a.scale(-1.0)
+
+        records, t, clock = [], 0.0, time.perf_counter()
+
+        def record(step_dt: float) -> None:
+            nonlocal clock
+            entry = {"time": t, "dt": step_dt, "newton_iterations": 0,
+                     "wall_time_s": time.perf_counter() - clock}
+            clock = time.perf_counter()
+            if observe is not None:
+                entry.update(observe(t))
+            records.append(entry)
+            if on_step is not None:
+                on_step(entry)
+
+        record(0.0)
+        acceleration()
+        v_half = v.copy()
+        v_half.axpy(0.5 * dt, a)
+        n_steps = int(np.ceil(t_end / dt - 1e-9))
+        for k in range(n_steps):
+            h = min(dt, t_end - t)
+            u.axpy(h, v_half)  # u_{n+1} = u_n + h v_{n+1/2}
+            t = t_end if k == n_steps - 1 else t + h
+            v_half.copy(v)
+            v.axpy(0.5 * h, a)  # predicted v_{n+1} for friction and damping
+            acceleration()  # a_{n+1}
+            v_half.copy(v)
+            v.axpy(0.5 * h, a)  # v_{n+1} = v_{n+1/2} + h/2 a_{n+1}, recorded
+            R.u_dot.x.scatter_forward()
+            record(h)
+            v_half.axpy(h, a)  # v_{n+3/2}
+        for obj in (a, v_half):
+            obj.destroy()
         return records

@@ -76,3 +76,27 @@ def test_time_integration_is_the_same_on_one_and_two_ranks():
     # Newton stops at 1e-12 of the load; the difference may only be round-off amplified by
     # the growing mode over 1 ms (e^{0.5} < 2)
     assert np.allclose(series[0], series[1], rtol=0, atol=1e-8 * series[0].max())
+
+
+def test_central_differences_agree_with_generalized_alpha_and_respect_the_stable_step():
+    """The explicit scheme (lumped mass) and the implicit one integrate the same residual:
+    their normal forces agree to the schemes' O(dt²) error, and the explicit step is capped
+    below the stable step 2/ω_max whatever step is asked for."""
+    from fenicsfriction.dynamics import CentralDifference
+    forces = []
+    for scheme in ("central", "alpha2"):
+        model = steady_block(0.6, prefix=f"cd_{scheme}")
+        model.residual.u_dot.x.array[1::2] = -1e-4
+        observe = lambda t, m=model: {"normal_force": m.quantities()["normal_force"]}  # noqa: E731
+        if scheme == "central":
+            explicit = CentralDifference(model.residual)
+            records = explicit.run(2e-3, 2e-3, observe=observe)
+            assert max(r["dt"] for r in records) <= 0.9 * explicit.stable_dt * (1 + 1e-12)
+        else:
+            records = DynamicsSolver(model.residual, prefix="cd_ts_",
+                                     atol=1e-12 * model.force_scale).run(2e-3, 1e-6, observe)
+        t = np.array([r["time"] for r in records])
+        forces.append(np.interp(np.linspace(0, 2e-3, 41), t,
+                                [r["normal_force"] for r in records]))
+    signal = np.abs(forces[1] - forces[1][0]).max()
+    assert np.abs(forces[0] - forces[1]).max() < 1e-2 * signal
