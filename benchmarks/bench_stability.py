@@ -239,7 +239,7 @@ def run_mesh(dim: int, refine: int, comm: MPI.Comm, dense_max_dofs: int) -> dict
         solver = StabilitySolver(model.residual, prefix=f"{tag}v{i}_", options=options)
         if "pep_ncv" in options:
             solver.pep = _KeepNcv(solver.pep, options["pep_ncv"])
-        variants[name] = best_of(lambda: pep_solve(solver, comm, solve_args), comm)
+        variants[name] = best_of(lambda s=solver, a=solve_args: pep_solve(s, comm, a), comm)
         if name == "default":
             stab = solver  # kept for the baselines and the dense check
         else:
@@ -383,13 +383,13 @@ def plot(runs: list[dict], rigid: dict, path: pathlib.Path) -> None:
                               lw=2.5 if name == "default" else 1, ms=4,
                               label=f"{dim}D: {name}")
         acc = [(run["dofs"], run["errors"]["flutter"]) for run in same if run["errors"]["flutter"]]
-        ax_acc.loglog(*zip(*acc), "o-", color=c, label=f"{dim}D: flutter λ₊ vs finest mesh")
+        ax_acc.loglog(*zip(*acc, strict=True), "o-", color=c, label=f"{dim}D: flutter λ₊ vs finest mesh")
         acc = [(run["dofs"], run["errors"]["spring"]) for run in same if run["errors"]["spring"]]
-        ax_acc.loglog(*zip(*acc), "v:", color=c, label=f"{dim}D: spring mode vs finest mesh")
+        ax_acc.loglog(*zip(*acc, strict=True), "v:", color=c, label=f"{dim}D: spring mode vs finest mesh")
         dense = [(run["dofs"], run["dense"]["max_relative_error"]) for run in same
                  if run["dense"]]
         if dense:
-            ax_acc.loglog(*zip(*dense), "D", color=c, ms=8, mfc="none",
+            ax_acc.loglog(*zip(*dense, strict=True), "D", color=c, ms=8, mfc="none",
                           label=f"{dim}D: PEP vs dense QZ, max over modes")
         ax_acc.loglog(dofs, [run["pep"]["max_residual"] for run in same], "x--", color=c,
                       alpha=0.6, label=f"{dim}D: max relative residual")
