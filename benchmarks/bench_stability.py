@@ -383,9 +383,11 @@ def plot(runs: list[dict], rigid: dict, path: pathlib.Path) -> None:
                               lw=2.5 if name == "default" else 1, ms=4,
                               label=f"{dim}D: {name}")
         acc = [(run["dofs"], run["errors"]["flutter"]) for run in same if run["errors"]["flutter"]]
-        ax_acc.loglog(*zip(*acc, strict=True), "o-", color=c, label=f"{dim}D: flutter λ₊ vs finest mesh")
+        ax_acc.loglog(*zip(*acc, strict=True), "o-", color=c,
+                      label=f"{dim}D: flutter λ₊ vs finest mesh")
         acc = [(run["dofs"], run["errors"]["spring"]) for run in same if run["errors"]["spring"]]
-        ax_acc.loglog(*zip(*acc, strict=True), "v:", color=c, label=f"{dim}D: spring mode vs finest mesh")
+        ax_acc.loglog(*zip(*acc, strict=True), "v:", color=c,
+                      label=f"{dim}D: spring mode vs finest mesh")
         dense = [(run["dofs"], run["dense"]["max_relative_error"]) for run in same
                  if run["dense"]]
         if dense:
