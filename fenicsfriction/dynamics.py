@@ -11,8 +11,13 @@ at each step. TS asks for
   ``fem.Constant``.
 
 Steps: fixed (``-dynamics_ts_adapt_type none``, the default) or adaptive
-(``-dynamics_ts_adapt_type basic``); a step whose Newton solve fails is retried with a smaller
-step (``ts_max_snes_failures = -1``, the cut-back of seed 001 at slide-to-stick transitions).
+(``-dynamics_ts_adapt_type basic``, error-controlled). A step whose Newton solve fails is
+retried with a quarter of the step (``ts_max_snes_failures = -1``): the cut-back of seed 001,
+whose Newton iterations cycle across the steep part of φ_ε at slide-to-stick transitions when ε
+is small and the step large. With fixed steps the step then grows back (doubling after each
+accepted step) to the one asked for, so a transition costs a few small steps, not the rest of
+the run. Newton stops on the residual (atol raised to its round-off floor, see
+:class:`~fenicsfriction.assembly.RoundoffConvergence`), never on the step length.
 Options live under the prefix (default ``dynamics_``).
 """
 
@@ -30,11 +35,13 @@ import dolfinx.fem.petsc  # noqa: F401
 from petsc4py import PETSc
 
 from fenicsfriction import _compat
-from fenicsfriction.assembly import assemble_jacobian, assemble_residual, options_with_defaults
+from fenicsfriction.assembly import (RoundoffConvergence, assemble_jacobian, assemble_residual,
+                                     options_with_defaults)
 from fenicsfriction.forms import Residual
 from fenicsfriction.laws import check
 
-__all__ = ["DEFAULT_OPTIONS", "DynamicsError", "DynamicsSolver"]
+__all__ = ["DEFAULT_OPTIONS", "Alpha2Integrator", "CentralDifference", "DynamicsError",
+           "DynamicsSolver"]
 
 DEFAULT_OPTIONS = {
     "ts_type": "alpha2",
@@ -44,9 +51,9 @@ DEFAULT_OPTIONS = {
     "ts_max_reject": 20,
     "ts_exact_final_time": "matchstep",
     "snes_type": "newtonls",
-    "snes_linesearch_type": "basic",
+    "snes_linesearch_type": "bt",
     "snes_rtol": 1e-10,
-    "snes_max_it": 25,
+    "snes_max_it": 10,  # converged steps take 2-4; a cycling Newton is cut back sooner
     "ksp_type": "preonly",
     "pc_type": "lu",
     "pc_factor_mat_solver_type": "mumps",
@@ -61,8 +68,122 @@ class DynamicsError(RuntimeError):
         self.records = records
 
 
-class DynamicsSolver:
-    """Generalized-α (TSALPHA2) integration of the one residual.
+class Alpha2Integrator:
+    """PETSc TS (TSALPHA2 by default) on a second-order system R(t, x, ẋ, ẍ) = 0: the set-up,
+    the Newton stopping test, the cut-back and regrowth of the step, and the run loop with its
+    records, shared by the FE solver and the few-d.o.f. models of :mod:`fenicsfriction.reduced`.
+
+    A subclass provides the residual ``_F(ts, t, x, xdot, xddot, F)``, the Jacobian
+    ``_J(ts, t, x, xdot, xddot, shift_v, shift_a, J, P)`` (which must call
+    ``self.convergence.jacobian_assembled(J)``), ``_load(x, xdot, xddot)`` (put an accepted state
+    where ``observe`` reads it) and ``_state()`` (the initial displacement and velocity vectors,
+    which receive the final state).
+
+    Attributes:
+        ts: the PETSc TS, exposed for monitoring or further configuration.
+        fixed_steps: no error control (``ts_adapt_type none``): a cut step grows back.
+        convergence: the Newton stopping test (its ``atol_used``: the last tolerance).
+    """
+
+    def __init__(self, comm, prefix: str, F: PETSc.Vec, J: PETSc.Mat,
+                 options: typing.Optional[dict], atol: float):
+        check("atol", atol, np.isfinite(atol) and atol > 0, "must be a finite number > 0")
+        self.ts = PETSc.TS().create(comm)
+        self.ts.setOptionsPrefix(prefix)
+        self.ts.setI2Function(self._F, F)
+        self.ts.setI2Jacobian(self._J, J)
+        with options_with_defaults(prefix, {**DEFAULT_OPTIONS, "snes_atol": atol,
+                                            **(options or {})}) as opts:
+            self.ts.setFromOptions()
+            # petsc4py 3.18 does not wrap TSAdapt: read the choice from the options
+            self.fixed_steps = opts.getString("ts_adapt_type") == "none"
+        self.convergence = RoundoffConvergence(self.ts.getSNES())
+        self.ts.getSNES().setConvergenceTest(self.convergence)
+
+    def _F(self, ts, t, x, xdot, xddot, F):
+        raise NotImplementedError
+
+    def _J(self, ts, t, x, xdot, xddot, shift_v, shift_a, J, P):
+        raise NotImplementedError
+
+    def _load(self, x, xdot, xddot) -> None:
+        raise NotImplementedError
+
+    def _state(self) -> tuple[PETSc.Vec, PETSc.Vec]:
+        raise NotImplementedError
+
+    def run(self, t_end: float, dt: float,
+            observe: typing.Optional[typing.Callable[[float], dict]] = None,
+            on_step: typing.Optional[typing.Callable[[dict], None]] = None) -> list[dict]:
+        """Integrate from t = 0 to ``t_end`` with (initial) step ``dt``.
+
+        Args:
+            observe: called after every accepted step (fields hold the state), its dict is
+                merged into the step's record.
+            on_step: called with each record (progress output, field output).
+
+        Returns:
+            One record per accepted step (and one for t = 0): ``time``, ``dt``,
+            ``newton_iterations`` (rejected attempts included), ``rejected_steps`` (cut-backs
+            and error-control rejections before this step), ``wall_time_s`` and what
+            ``observe`` adds.
+
+        Raises:
+            DynamicsError: TS stopped early (e.g. too many step rejections); the fields hold
+                the last accepted state and ``error.records`` the steps done.
+        """
+        check("t_end", t_end, t_end > 0, "must be > 0")
+        check("dt", dt, 0 < dt <= t_end, f"must lie in (0, t_end = {t_end}]")
+        u, v = (vec.copy() for vec in self._state())
+        self.ts.setSolution2(u, v)
+        self.ts.setTime(0.0)
+        self.ts.setStepNumber(0)
+        self.ts.setTimeStep(dt)
+        self.ts.setMaxTime(t_end)
+        self.ts.setMaxSteps(10**9)
+        records: list[dict] = []
+        clock = [time.perf_counter(), 0, 0]
+
+        def regrow(ts):  # after a cut-back, back to the step asked for
+            if self.fixed_steps and ts.getTimeStep() < dt:
+                ts.setTimeStep(min(2.0 * ts.getTimeStep(), dt))
+
+        def monitor(ts, step, t, x):
+            snes_its, rejected = ts.getSNESIterations(), ts.getStepRejections()
+            record = {"time": float(t), "dt": 0.0,
+                      "newton_iterations": snes_its - clock[1],
+                      "rejected_steps": rejected - clock[2],
+                      "wall_time_s": time.perf_counter() - clock[0]}
+            clock[:] = time.perf_counter(), snes_its, rejected
+            if step:  # the fields hold the last residual evaluation: load the accepted state
+                self._load(x, ts.getSolution2()[1], None)
+                record["dt"] = float(t - records[-1]["time"])
+            if observe is not None:
+                record.update(observe(float(t)))
+            records.append(record)
+            if on_step is not None:
+                on_step(record)
+
+        self.ts.setMonitor(monitor)
+        self.ts.setPostStep(regrow)
+        self.ts.solve(u)
+        self.ts.cancelMonitor()
+        self.ts.setPostStep(None)
+        reason = self.ts.getConvergedReason()
+        x, x_dot = self.ts.getSolution2()
+        self._load(x, x_dot, None)  # also after a failure: the last accepted state
+        for target, vec in zip(self._state(), (x, x_dot), strict=True):
+            vec.copy(target)
+        u.destroy()
+        v.destroy()
+        if reason < 0:
+            raise DynamicsError(f"TS stopped at t = {self.ts.getTime():.6g} with reason "
+                                f"{reason} after {self.ts.getStepNumber()} steps", records)
+        return records
+
+
+class DynamicsSolver(Alpha2Integrator):
+    """Generalized-α (TSALPHA2) integration of the one residual of a FE model.
 
     Args:
         residual: the residual; ``u`` and ``u_dot`` hold the initial state (e.g. a steady
@@ -70,9 +191,6 @@ class DynamicsSolver:
         prefix: PETSc options prefix of the TS (and its SNES/KSP/PC).
         options: defaults over :data:`DEFAULT_OPTIONS`; options in the database win.
         atol: absolute Newton tolerance on the residual (force units).
-
-    Attributes:
-        ts: the PETSc TS, exposed for monitoring or further configuration.
     """
 
     def __init__(self, residual: Residual, prefix: str = "dynamics_",
@@ -91,13 +209,10 @@ class DynamicsSolver:
         self.a = _compat.form(jacobian)
         self.b = dolfinx.fem.petsc.create_vector(self.L)
         self.A = dolfinx.fem.petsc.create_matrix(self.a)
-        self.ts = PETSc.TS().create(msh.comm)
-        self.ts.setOptionsPrefix(prefix)
-        self.ts.setI2Function(self._F, self.b)
-        self.ts.setI2Jacobian(self._J, self.A)
-        with options_with_defaults(prefix, {**DEFAULT_OPTIONS, "snes_atol": atol,
-                                            **(options or {})}):
-            self.ts.setFromOptions()
+        super().__init__(msh.comm, prefix, self.b, self.A, options, atol)
+
+    def _state(self) -> tuple[PETSc.Vec, PETSc.Vec]:
+        return _compat.petsc_vec(self.residual.u), _compat.petsc_vec(self.residual.u_dot)
 
     def _load(self, x, xdot, xddot) -> None:
         """Copy a state into the fields (``xddot=None`` leaves the acceleration alone)."""
@@ -115,63 +230,7 @@ class DynamicsSolver:
         self.shift_v.value = shift_v
         self.shift_a.value = shift_a
         assemble_jacobian(J, self.a, self.residual.bcs, self.residual.springs)
-
-    def run(self, t_end: float, dt: float,
-            observe: typing.Optional[typing.Callable[[float], dict]] = None,
-            on_step: typing.Optional[typing.Callable[[dict], None]] = None) -> list[dict]:
-        """Integrate from t = 0 to ``t_end`` with (initial) step ``dt``.
-
-        Args:
-            observe: called after every accepted step (fields hold the state), its dict is
-                merged into the step's record.
-            on_step: called with each record (progress output, field output).
-
-        Returns:
-            One record per accepted step (and one for t = 0): ``time``, ``dt``,
-            ``newton_iterations``, ``wall_time_s`` and what ``observe`` adds.
-
-        Raises:
-            DynamicsError: TS stopped early (e.g. too many step rejections); the fields hold
-                the last accepted state and ``error.records`` the steps done.
-        """
-        check("t_end", t_end, t_end > 0, "must be > 0")
-        check("dt", dt, 0 < dt <= t_end, f"must lie in (0, t_end = {t_end}]")
-        u = _compat.petsc_vec(self.residual.u).copy()
-        v = _compat.petsc_vec(self.residual.u_dot).copy()
-        self.ts.setSolution2(u, v)
-        self.ts.setTime(0.0)
-        self.ts.setStepNumber(0)
-        self.ts.setTimeStep(dt)
-        self.ts.setMaxTime(t_end)
-        self.ts.setMaxSteps(10**9)
-        records: list[dict] = []
-        clock = [time.perf_counter(), 0]
-
-        def monitor(ts, step, t, x):
-            snes_its = ts.getSNESIterations()
-            record = {"time": float(t), "dt": 0.0,
-                      "newton_iterations": snes_its - clock[1],
-                      "wall_time_s": time.perf_counter() - clock[0]}
-            clock[0], clock[1] = time.perf_counter(), snes_its
-            if step:  # the fields hold the last residual evaluation: load the accepted state
-                self._load(x, ts.getSolution2()[1], None)
-                record["dt"] = float(t - records[-1]["time"])
-            if observe is not None:
-                record.update(observe(float(t)))
-            records.append(record)
-            if on_step is not None:
-                on_step(record)
-
-        self.ts.setMonitor(monitor)
-        self.ts.solve(u)
-        self.ts.cancelMonitor()
-        reason = self.ts.getConvergedReason()
-        u.destroy()
-        v.destroy()
-        if reason < 0:
-            raise DynamicsError(f"TS stopped at t = {self.ts.getTime():.6g} with reason "
-                                f"{reason} after {self.ts.getStepNumber()} steps", records)
-        return records
+        self.convergence.jacobian_assembled(J)
 
 
 class CentralDifference:
@@ -250,7 +309,7 @@ class CentralDifference:
 
         def record(step_dt: float) -> None:
             nonlocal clock
-            entry = {"time": t, "dt": step_dt, "newton_iterations": 0,
+            entry = {"time": t, "dt": step_dt, "newton_iterations": 0, "rejected_steps": 0,
                      "wall_time_s": time.perf_counter() - clock}
             clock = time.perf_counter()
             if observe is not None:

@@ -29,7 +29,8 @@ import dolfinx.fem.petsc  # noqa: F401
 from petsc4py import PETSc
 
 from fenicsfriction import _compat
-from fenicsfriction.assembly import assemble_jacobian, assemble_residual, options_with_defaults
+from fenicsfriction.assembly import (RoundoffConvergence, assemble_jacobian, assemble_residual,
+                                     options_with_defaults)
 from fenicsfriction.forms import Residual
 from fenicsfriction.laws import check
 
@@ -105,7 +106,6 @@ class SteadySolver:
                  options: typing.Optional[dict] = None, jit_cache_dir: typing.Optional[str] = None,
                  roundoff_safety: float = 1.0):
         self.residual = residual
-        self.roundoff_safety = roundoff_safety
         self.u = residual.u
         t0 = time.perf_counter()
         self.L = _compat.form(residual.steady(), jit_cache_dir)
@@ -123,32 +123,8 @@ class SteadySolver:
             self.snes.setFromOptions()
             self.snes.getKSP().setFromOptions()
             self.snes.getKSP().getPC().setFromOptions()
-        self.rtol, self.atol = self.snes.getTolerances()[:2]
-        self._jacobian_norm = 0.0
-        self._f0 = np.inf
-        self._atol_used = self.atol
-        self.snes.setConvergenceTest(self._converged)
-
-    def roundoff_floor(self, x: PETSc.Vec) -> float:
-        """sqrt(n) ε_mach ‖J‖_∞ ‖x‖_∞ with the last assembled Jacobian J."""
-        return float(np.sqrt(x.getSize()) * np.finfo(float).eps * self._jacobian_norm
-                     * x.norm(PETSc.NormType.INFINITY))
-
-    def _converged(self, snes, it, norms):
-        """SNES convergence test: PETSc's atol/rtol tests, atol raised to the round-off floor
-        of the current iterate (``max_it`` and line-search failures stay PETSc's)."""
-        fnorm = norms[2]
-        if not np.isfinite(fnorm):
-            return PETSc.SNES.ConvergedReason.DIVERGED_FNORM_NAN
-        if it == 0:
-            self._f0 = fnorm
-        atol = max(self.atol, self.roundoff_safety * self.roundoff_floor(snes.getSolution()))
-        self._atol_used = atol
-        if fnorm <= atol:
-            return PETSc.SNES.ConvergedReason.CONVERGED_FNORM_ABS
-        if it > 0 and fnorm <= self.rtol * self._f0:
-            return PETSc.SNES.ConvergedReason.CONVERGED_FNORM_RELATIVE
-        return PETSc.SNES.ConvergedReason.ITERATING
+        self.convergence = RoundoffConvergence(self.snes, roundoff_safety)
+        self.snes.setConvergenceTest(self.convergence)
 
     def _update(self, x: PETSc.Vec) -> None:
         x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
@@ -161,7 +137,7 @@ class SteadySolver:
 
     def _J(self, snes, x, A, P):
         assemble_jacobian(A, self.a, self.residual.bcs, self.residual.springs)
-        self._jacobian_norm = A.norm(PETSc.NormType.INFINITY)
+        self.convergence.jacobian_assembled(A)
 
     def solve(self) -> SolveReport:
         """Solve from the current ``u``; on failure restore ``u`` and raise :class:`SolveError`."""
@@ -175,7 +151,7 @@ class SteadySolver:
             converged=reason > 0, reason=_REASONS.get(reason, str(reason)),
             iterations=self.snes.getIterationNumber(),
             residual_norm=float(self.snes.getFunctionNorm()),
-            wall_time_s=time.perf_counter() - t0, atol=self._atol_used)
+            wall_time_s=time.perf_counter() - t0, atol=self.convergence.atol_used)
         finite = np.isfinite(report.residual_norm)
         if report.converged and finite:
             self._update(self.x)
