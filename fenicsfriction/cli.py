@@ -91,6 +91,9 @@ def _parser() -> argparse.ArgumentParser:
     dynamics.add_argument("--perturbation", type=float, default=-0.01,
                           help="initial normal velocity added to the steady state [cm/s]")
     dynamics.add_argument("--stride", type=int, default=20, help="steps between field outputs")
+    dynamics.add_argument("--probe-x", type=float,
+                          help="abscissa [cm] of the contact node whose tractions are recorded "
+                               "(default: L/2, the paper's node 29)")
     dynamics.add_argument("--scheme", choices=["alpha2", "central"], default="alpha2",
                           help="implicit generalized-α, or explicit central differences with "
                                "a lumped mass (dt capped at 0.9 of the stable step)")
@@ -111,8 +114,10 @@ def _run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
     import csv
 
     from fenicsfriction import io
-    from fenicsfriction.dynamics import CentralDifference, DynamicsError, DynamicsSolver
+    from fenicsfriction.dynamics import (CentralDifference, DynamicsError, DynamicsSolver,
+                                         stick_slip_statistics)
     from fenicsfriction.laws import check
+    from fenicsfriction.plotting import plot_stick_slip
     from fenicsfriction.scenes import SCENES
     from fenicsfriction.steady import SteadySolver, continuation
 
@@ -138,20 +143,7 @@ def _run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
         dynamics = DynamicsSolver(model.residual, prefix="dynamics_",
                                   atol=1e-10 * model.force_scale)
     out: pathlib.Path = args.out
-    energy0, work, last = model.energies()["total"], [0.0], {}
-
-    def observe(t: float) -> dict:
-        q, powers, energies = model.quantities(), model.powers(), model.energies()
-        power = powers["friction"] + powers["damping"]
-        if last:  # trapezoidal rule for the work of the interface forces
-            work[0] += 0.5 * (power + last["power"]) * (t - last["time"])
-        last.update(time=t, power=power)
-        return {key: q[key] for key in ("normal_force", "friction_force", "spring_force",
-                                        "centre_of_pressure", "min_penetration",
-                                        "max_penetration")} | model.contact_states() | {
-            "kinetic_energy": energies["kinetic"], "friction_power": powers["friction"],
-            "damping_power": powers["damping"],
-            "energy_error": energies["total"] - energy0 - work[0]}
+    observe = model.dynamics_observer(args.probe_x)
 
     records = []
     with io.FieldWriter(out / "dynamics.xdmf", model) as fields:
@@ -176,10 +168,22 @@ def _run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
             writer = csv.DictWriter(handle, fieldnames=list(records[0]))
             writer.writeheader()
             writer.writerows(records)
+    statistics = None
+    if len(records) > 2:  # over the second half of what was integrated
+        statistics = stick_slip_statistics(records, args.mu, float(model.eps.value),
+                                           t_from=0.5 * records[-1]["time"])
+        if comm.rank == 0:
+            plot_stick_slip({f"U = {scene.belt_speed} cm/s": records}, out / "stick_slip.png",
+                            args.mu, float(model.eps.value))
+        log.info(f"apparent friction coefficient {statistics['apparent_coefficient']:.4f} "
+                 f"(μ = {args.mu}), probe node sticks {statistics['probe_stick_fraction']:.1%} "
+                 f"of the time (second half of the run)")
     io.write_json(out / "summary.json", {"scene": args.scene,
                                          "parameters": dataclasses.asdict(scene),
-                                         "steps": len(records) - 1, "failure": failure}, comm)
-    log.info(f"results in {out}/: timeseries.csv, summary.json, dynamics.xdmf")
+                                         "scheme": args.scheme, "dt": args.dt,
+                                         "steps": len(records) - 1, "failure": failure,
+                                         "statistics": statistics}, comm)
+    log.info(f"results in {out}/: timeseries.csv, summary.json, dynamics.xdmf, stick_slip.png")
     if failure is not None:
         log.error(f"fenicsfriction: {failure}")
         return 1

@@ -11,7 +11,8 @@ from mpi4py import MPI
 
 from fenicsfriction import _compat
 
-__all__ = ["cell_outlines", "plot_deformed", "plot_growth", "plot_loci", "plot_steady_forces"]
+__all__ = ["cell_outlines", "plot_deformed", "plot_growth", "plot_loci", "plot_steady_forces",
+           "plot_stick_slip"]
 
 
 def _pyplot():
@@ -158,6 +159,64 @@ def plot_growth(records: list[dict], rigid_steps: list[dict], path,
     ax.set_ylabel("max Re λ [1/s]")
     ax.legend()
     ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def _last_cycle(t: np.ndarray, signal: np.ndarray) -> slice:
+    """Indices of the last full cycle of an oscillating signal (between its last two upward
+    crossings of the mean); the last tenth of the record if there are fewer than two."""
+    centred = signal - signal.mean()
+    up = np.flatnonzero((centred[:-1] < 0) & (centred[1:] >= 0))
+    if len(up) >= 2:
+        return slice(up[-2], up[-1] + 1)
+    return slice(int(0.9 * len(t)), len(t))
+
+
+def plot_stick_slip(runs: dict, path, mu: float, eps: float) -> None:
+    """Seed 000 Figs. 10-15 for one or more runs (``{label: records}``, records from
+    ``BlockModel.dynamics_observer``): phase plane of the normal motion of the centre of mass,
+    tangential velocity of the probe node against the belt speed (last ~5 ms), spring
+    elongation against time, and the probe's normal and friction stress over the last cycle
+    of the normal oscillation (sticking marked)."""
+    plt = _pyplot()
+    fig, axes = plt.subplots(2, 2, figsize=(12, 8.5))
+    (phase, velocity), (spring, traction) = axes
+    for (label, records), colour in zip(runs.items(), plt.rcParams["axes.prop_cycle"]
+                                        .by_key()["color"], strict=False):
+        get = lambda key, rs=records: np.array([r[key] for r in rs])  # noqa: E731
+        t = get("time")
+        phase.plot(1e4 * get("u_yG"), get("v_yG"), lw=0.4, color=colour, label=label)
+        late = t >= t[-1] - 5e-3
+        velocity.plot(1e3 * t[late], get("probe_v_x")[late], lw=0.8, color=colour, label=label)
+        belt = get("probe_v_x")[0] - get("probe_slip")[0]
+        velocity.axhline(belt, color=colour, ls="--", lw=0.8)
+        spring.plot(t, get("spring_elongation"), color=colour, label=label)
+        cycle = _last_cycle(t, get("normal_force"))
+        tc = 1e3 * (t[cycle] - t[cycle][0])
+        traction.plot(tc, get("probe_pressure")[cycle], color=colour, label=f"{label}: normal")
+        friction = get("probe_friction")[cycle]
+        traction.plot(tc, friction, color=colour, ls="--", label=f"{label}: friction")
+        stick = (get("probe_pressure")[cycle] > 0) & (np.abs(get("probe_slip")[cycle]) < eps)
+        traction.plot(tc[stick], friction[stick], "o", ms=3, color=colour)
+        traction.plot(tc, mu * get("probe_pressure")[cycle], ":", color=colour, lw=0.8)
+    phase.set_xlabel("vertical displacement of the centre of mass u_yG [1e-4 cm]")
+    phase.set_ylabel("vertical velocity v_yG [cm/s]")
+    phase.set_title("Normal motion, phase plane (Fig. 10)")
+    velocity.set_xlabel("time [ms]")
+    velocity.set_ylabel("tangential velocity of the probe node [cm/s]")
+    velocity.set_title("Contact point velocity; dashed: belt speed (Fig. 11)")
+    spring.set_xlabel("time [s]")
+    spring.set_ylabel("spring elongation [cm]")
+    spring.set_title("Spring elongation (Figs. 12-13)")
+    traction.set_xlabel("time in the last cycle [ms]")
+    traction.set_ylabel("stress at the probe node")
+    traction.set_title("Normal (solid), friction (dashed), μ × normal (dotted); "
+                       "dots: stick (Figs. 14-15)", fontsize=9)
+    for ax in axes.flat:
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)

@@ -352,7 +352,8 @@ class BlockModel:
         return laws.normal_pressure(self.penetration(n), self.c_n, self.m_n)
 
     def friction_traction(self, n=None):
-        """UFL friction traction on the body at rest (u̇ = 0), a vector tangent to Γ_C."""
+        """UFL friction traction on the body at the current velocity ``u_dot`` (zero in steady
+        sliding), a vector tangent to Γ_C."""
         if not self.with_friction:
             return ufl.zero(self.scene.dim)
         n = self.normal if n is None else n
@@ -361,8 +362,7 @@ class BlockModel:
         if is_speed_law(c_T):
             c_T = c_T(ufl.sqrt(ufl.inner(w, w)))
         direction = laws.REGULARISATIONS[self.scene.regularisation][1](w, self.eps)
-        traction = -laws.friction_bound(self.penetration(n), c_T, self.m_T) * direction
-        return ufl.replace(traction, {self.residual.u_dot: ufl.zero(self.scene.dim)})
+        return -laws.friction_bound(self.penetration(n), c_T, self.m_T) * direction
 
     def contact_traction(self):
         """UFL traction of the foundation on the body, valid in cells (for output fields).
@@ -373,9 +373,10 @@ class BlockModel:
         n = ufl.as_vector(-np.eye(self.scene.dim)[1])
         return -self.pressure(n) * n + self.friction_traction(n)
 
-    def _integral(self, key: str, integrand) -> float:
+    def _integral(self, key: str, integrand: typing.Callable) -> float:
+        """∫_Γc integrand() ds (times the thickness), compiled at the first call only."""
         if key not in self._functionals:
-            self._functionals[key] = _compat.form(self.thickness * integrand * self.ds_contact)
+            self._functionals[key] = _compat.form(self.thickness * integrand() * self.ds_contact)
         value = fem.assemble_scalar(self._functionals[key])
         return self.msh.comm.allreduce(value, op=MPI.SUM)
 
@@ -442,6 +443,42 @@ class BlockModel:
         n_open, n_stick, n_slip = self.msh.comm.allreduce(counts, op=MPI.SUM)
         return {"n_open": int(n_open), "n_stick": int(n_stick), "n_slip": int(n_slip)}
 
+    def dynamics_observer(self, probe_x: typing.Optional[float] = None) -> typing.Callable:
+        """An ``observe(t)`` for the time integrators: one flat record of the state per step.
+
+        Resultants (:meth:`quantities`), centre-of-mass motion (``u_yG``, ``v_yG``, ``theta``),
+        the spring elongation, contact-state counts, the probe node (:meth:`probe`, prefix
+        ``probe_``; default: mid-base, the paper's node 29) and the energy balance: ``energy_error``
+        = E(t) − E(0) − W(t), with E the kinetic + strain + interface + spring + load-potential
+        energies and W the work of the friction and damping stresses (trapezoidal rule over
+        the observed steps): zero for the exact solution, its drift measures the time error.
+        """
+        x = self.scene.L / 2 if probe_x is None else probe_x
+        energy0 = self.energies()["total"]
+        last: dict = {}
+
+        def observe(t: float) -> dict:
+            q, powers, energies = self.quantities(), self.powers(), self.energies()
+            centre, probe = self.centre_of_mass(), self.probe(x)
+            power = powers["friction"] + powers["damping"]
+            work = last.get("work", 0.0)
+            if last:
+                work += 0.5 * (power + last["power"]) * (t - last["time"])
+            last.update(time=t, power=power, work=work)
+            return {**{key: q[key] for key in ("normal_force", "friction_force", "spring_force",
+                                               "centre_of_pressure", "min_penetration",
+                                               "max_penetration")},
+                    "spring_elongation": -q["spring_force"] / self.scene.K_x,
+                    "u_yG": float(centre["u_G"][1]), "v_yG": float(centre["v_G"][1]),
+                    "v_xG": float(centre["v_G"][0]), "theta": centre["theta"],
+                    **self.contact_states(),
+                    **{f"probe_{k}": v for k, v in probe.items()},
+                    "kinetic_energy": energies["kinetic"], "friction_power": powers["friction"],
+                    "damping_power": powers["damping"],
+                    "energy_error": energies["total"] - energy0 - work}
+
+        return observe
+
     @property
     def force_scale(self) -> float:
         """Total load pressing the block down [force]: the scale of the residual's entries."""
@@ -460,19 +497,76 @@ class BlockModel:
         value = np.array([ux, -(d0 + s.g), 0.0][:s.dim])
         self.residual.u.interpolate(lambda x: np.tile(value[:, None], (1, x.shape[1])))
 
+    def centre_of_mass(self) -> dict:
+        """Displacement ``u_G`` and velocity ``v_G`` of the centre of mass (uniform density:
+        the mean over the body), and the mean rotation ``theta`` = ∫ ½ curl u / area [rad]."""
+        if "centre" not in self._functionals:
+            R, dx = self.residual, self.dx
+            forms = [f * dx for f in (*R.u, *R.u_dot)]
+            curl = 0.5 * (R.u[1].dx(0) - R.u[0].dx(1))
+            self._functionals["centre"] = [_compat.form(f) for f in (*forms, curl * dx,
+                                                                      fem.Constant(self.msh, 1.0)
+                                                                      * dx)]
+        comm = self.msh.comm
+        values = np.array([comm.allreduce(fem.assemble_scalar(f), op=MPI.SUM)
+                           for f in self._functionals["centre"]])
+        mean = values[:-1] / values[-1]
+        dim = self.scene.dim
+        return {"u_G": mean[:dim], "v_G": mean[dim:2 * dim], "theta": float(mean[-1])}
+
+    def probe(self, x: float) -> dict:
+        """Nodal values at the contact node nearest to abscissa ``x`` (same on every rank).
+
+        ``x`` [cm] of the node; ``u_y``, ``v_x``, ``v_y``: its displacement and velocity;
+        ``slip`` = v_x - U_T; ``pressure``: c_n d^{m_n} + b_n d^{l_n} ḋ; ``friction``: the
+        x-traction of the belt on the body, -c_T d^{m_T} φ'_ε(slip) (Coulomb law only).
+        """
+        if "probe" not in self._functionals or self._functionals["probe"][0] != x:
+            coords = self.V.tabulate_dof_coordinates()
+            y = self._contact_y
+            nodes = y // self.scene.dim
+            distance = np.abs(coords[nodes, 0] - x) if y.size else np.array([np.inf])
+            best = int(np.argmin(distance))
+            comm = self.msh.comm
+            _, owner = comm.allreduce((float(distance[best]), comm.rank), op=MPI.MINLOC)
+            self._functionals["probe"] = (x, owner, int(y[best]) if y.size else -1,
+                                          float(coords[nodes[best], 0]) if y.size else 0.0)
+        _, owner, dof, node_x = self._functionals["probe"]
+        s, law, comm = self.scene, self.scene.law, self.msh.comm
+        values = None
+        if comm.rank == owner:
+            u, v = self.residual.u.x.array, self.residual.u_dot.x.array
+            d = max(-u[dof] - s.g, 0.0)
+            slip = v[dof - 1] - s.belt_direction * s.belt_speed
+            rate = -v[dof] if d > 0 else 0.0
+            pressure = laws.normal_pressure(d, law.c_n, law.m_n) \
+                + laws.normal_damping_pressure(d, rate, law.b_n, law.l_n)
+            direction = laws.REGULARISATIONS[s.regularisation][1](
+                np.array([slip]), float(self.eps.value))[0]
+            c_T = float(self.mu.value) * law.c_n if self.with_friction else 0.0
+            values = {"x": node_x, "u_y": float(u[dof]), "v_x": float(v[dof - 1]),
+                      "v_y": float(v[dof]), "slip": float(slip), "pressure": float(pressure),
+                      "friction": float(-laws.friction_bound(d, c_T, law.m_T) * direction)}
+        return comm.bcast(values, root=owner)
+
     def quantities(self) -> dict:
         """Resultants and penetration extremes of the current state (same on every rank).
 
-        ``normal_force`` [force]: total normal contact force on the body (upwards > 0);
+        ``normal_force`` [force]: total normal contact force on the body (upwards > 0),
+        normal damping included; ``centre_of_pressure`` uses its elastic part;
         ``friction_force`` and ``spring_force`` [force]: x-components of the forces on the
         body; ``centre_of_pressure`` [cm]: x of the normal resultant minus L/2;
         ``min_penetration``/``max_penetration`` [cm] over the contact nodes.
         """
-        x = ufl.SpatialCoordinate(self.msh)
-        p = self.pressure()
-        normal = self._integral("normal", p)
-        moment = self._integral("moment", (x[0] - self.scene.L / 2) * p)
-        friction_force = self._integral("friction", self.friction_traction()[0]) \
+        normal = self._integral("normal", self.pressure)
+        if self.scene.law.b_n > 0:  # the damping part of the normal stress (zero at rest)
+            law, n = self.scene.law, self.normal
+            normal += self._integral("damping", lambda: laws.normal_damping_pressure(
+                self.penetration(), normal_part(self.residual.u_dot, n), law.b_n, law.l_n))
+        elastic = self._integral("normal", self.pressure)
+        moment = self._integral("moment", lambda: (ufl.SpatialCoordinate(self.msh)[0]
+                                                   - self.scene.L / 2) * self.pressure())
+        friction_force = self._integral("friction", lambda: self.friction_traction()[0]) \
             if self.with_friction else 0.0
         uy = self.residual.u.x.array[self._contact_y]
         d = np.maximum(-uy - self.scene.g, 0.0)
@@ -481,6 +575,6 @@ class BlockModel:
                 "normal_force": normal,
                 "friction_force": friction_force,
                 "spring_force": self.spring.force(self.residual.u),
-                "centre_of_pressure": moment / normal if normal > 0 else float("nan"),
+                "centre_of_pressure": moment / elastic if elastic > 0 else float("nan"),
                 "min_penetration": comm.allreduce(d.min() if d.size else np.inf, op=MPI.MIN),
                 "max_penetration": comm.allreduce(d.max() if d.size else -np.inf, op=MPI.MAX)}
