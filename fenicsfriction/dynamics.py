@@ -144,9 +144,10 @@ class Alpha2Integrator:
         records: list[dict] = []
         clock = [time.perf_counter(), 0, 0]
 
-        def regrow(ts):  # after a cut-back, back to the step asked for
-            if self.fixed_steps and ts.getTimeStep() < dt:
-                ts.setTimeStep(min(2.0 * ts.getTimeStep(), dt))
+        def regrow(ts):  # after a cut-back, back to the step asked for (not past t_end)
+            remaining = t_end - ts.getTime()
+            if self.fixed_steps and ts.getTimeStep() < min(dt, remaining):
+                ts.setTimeStep(min(2.0 * ts.getTimeStep(), dt, remaining))
 
         def monitor(ts, step, t, x):
             snes_its, rejected = ts.getSNESIterations(), ts.getStepRejections()
