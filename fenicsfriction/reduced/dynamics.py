@@ -47,7 +47,13 @@ class ReducedDynamics(Alpha2Integrator):
     Attributes:
         q, q_dot: the current state (NumPy arrays): the initial one, the accepted step while
             ``observe`` runs, the final one after :meth:`run`. Assigning to them before a run
-            sets its initial state.
+            sets its initial state; a second run continues from the final state (the time
+            restarts at 0).
+
+    With the default ρ∞ = 1 the scheme advances (q, q̇) by the implicit midpoint rule, and the
+    starting acceleration does not enter. With ρ∞ < 1 it does, and PETSc 3.18's start
+    (``TSAlpha_Restart``) estimates it twice too large: a free fall at ρ∞ = 0.5 keeps a
+    velocity error g h/6 after the first step.
     """
 
     def __init__(self, model, q0, q_dot0, prefix: str = "reduced_",
