@@ -136,8 +136,9 @@ def _run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
     continuation(steady, model.mu, np.linspace(0.0, args.mu, 1 + int(np.ceil(args.mu / 0.05))))
     model.residual.u_dot.x.array[1::model.V.dofmap.index_map_bs] += args.perturbation
     if args.scheme == "central":
-        dynamics = CentralDifference(model.residual)
-        log.info(f"central differences: stable step {dynamics.stable_dt:.3e} s, using "
+        dynamics = CentralDifference(model.residual, band_damping=model.band_damping())
+        log.info(f"central differences: stable step {dynamics.stable_dt_elastic:.3e} s "
+                 f"(elastic), {dynamics.stable_dt_band:.3e} s (stick band), using "
                  f"{min(args.dt, dynamics.safety * dynamics.stable_dt):.3e} s")
     else:
         dynamics = DynamicsSolver(model.residual, prefix="dynamics_",

@@ -32,6 +32,7 @@ from dolfinx import fem
 
 import dolfinx.fem.petsc  # noqa: F401
 
+from mpi4py import MPI
 from petsc4py import PETSc
 
 from fenicsfriction import _compat
@@ -246,10 +247,22 @@ class CentralDifference:
     :math:`\\Delta t < 2/\\omega_{max}`, :math:`\\omega_{max}^2` the largest eigenvalue of
     :math:`\\bar K w = \\omega^2 M_L w` (SLEPc EPS, at the initial state); steps are capped at
     ``safety`` times that bound. Tensor-product Lagrange elements have positive row sums.
+
+    Friction is explicit too: inside the regularisation band a sticking node feels a dashpot
+    :math:`c_i = c_T d_i^{m_T} A_i/\varepsilon`, stable only for
+    :math:`\\Delta t < 2 m_i / c_i` — with a small ε far below :math:`2/\\omega_{max}`. Given
+    ``band_damping`` (a linear form whose assembled vector holds the :math:`c_i`, e.g.
+    ``BlockModel.band_damping()``) the cap also includes :math:`\\min_i 2 m_i/(\\kappa c_i)`,
+    evaluated at the initial state with the margin κ = ``band_margin`` for the growth of the
+    contact pressure during the run (the block's nodal pressure reaches ~3× its steady value
+    past the flutter onset). ``stable_dt`` is the smaller bound, ``stable_dt_elastic`` and
+    ``stable_dt_band`` the two.
     """
 
-    def __init__(self, residual: Residual, safety: float = 0.9):
+    def __init__(self, residual: Residual, safety: float = 0.9,
+                 band_damping: typing.Optional[ufl.Form] = None, band_margin: float = 4.0):
         check("safety", safety, 0 < safety < 1, "must lie in (0, 1)")
+        check("band_margin", band_margin, band_margin >= 1, "must be >= 1")
         self.residual, self.safety = residual, safety
         zero = ufl.zero(*residual.u.ufl_shape)
         self.L = _compat.form(ufl.replace(residual.form, {residual.u_ddot: zero}))
@@ -262,7 +275,18 @@ class CentralDifference:
         bc_dofs = [i for bc in residual.bcs for i in bc.dof_indices()[0]]
         with self.lumped.localForm() as m:
             m.array[bc_dofs] = np.inf  # constrained dofs never accelerate
-        self.stable_dt = self._stable_step(residual)
+        self.stable_dt_elastic = self._stable_step(residual)
+        self.stable_dt_band = np.inf
+        if band_damping is not None:
+            c = dolfinx.fem.petsc.assemble_vector(_compat.form(band_damping))
+            c.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+            with c.localForm() as c_local, self.lumped.localForm() as m_local:
+                active = c_local.array > 0
+                local = (2.0 * m_local.array[active] / (band_margin * c_local.array[active])
+                         ).min(initial=np.inf)
+            self.stable_dt_band = float(c.getComm().tompi4py().allreduce(local, op=MPI.MIN))
+            c.destroy()
+        self.stable_dt = min(self.stable_dt_elastic, self.stable_dt_band)
         M.destroy()
 
     def _stable_step(self, residual: Residual) -> float:

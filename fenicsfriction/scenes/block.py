@@ -443,6 +443,19 @@ class BlockModel:
         n_open, n_stick, n_slip = self.msh.comm.allreduce(counts, op=MPI.SUM)
         return {"n_open": int(n_open), "n_stick": int(n_stick), "n_slip": int(n_slip)}
 
+    def band_damping(self) -> typing.Optional[ufl.Form]:
+        """Linear form of the nodal dashpots of sticking nodes, ∫ c_T d^{m_T}/ε v_T ds (per
+        tangential dof), for the explicit scheme's stable step; None without friction."""
+        if not self.with_friction:
+            return None
+        c_T = self.friction_c_T
+        if is_speed_law(c_T):
+            c_T = c_T(0.0)
+        v = self.residual.v
+        tangential = sum(v[i] for i in range(self.scene.dim) if i != 1)
+        return self.thickness * laws.friction_bound(self.penetration(), c_T, self.m_T) \
+            / self.eps * tangential * self.ds_contact
+
     def dynamics_observer(self, probe_x: typing.Optional[float] = None) -> typing.Callable:
         """An ``observe(t)`` for the time integrators: one flat record of the state per step.
 
@@ -465,7 +478,8 @@ class BlockModel:
             if last:
                 work += 0.5 * (power + last["power"]) * (t - last["time"])
             last.update(time=t, power=power, work=work)
-            return {**{key: q[key] for key in ("normal_force", "friction_force", "spring_force",
+            return {**{key: q[key] for key in ("normal_force", "normal_force_elastic",
+                                               "friction_force", "spring_force",
                                                "centre_of_pressure", "min_penetration",
                                                "max_penetration")},
                     "spring_elongation": -q["spring_force"] / self.scene.K_x,
@@ -553,17 +567,18 @@ class BlockModel:
         """Resultants and penetration extremes of the current state (same on every rank).
 
         ``normal_force`` [force]: total normal contact force on the body (upwards > 0),
-        normal damping included; ``centre_of_pressure`` uses its elastic part;
+        normal damping included; ``normal_force_elastic``: its elastic part c_n d^{m_n}, which
+        bounds the friction force (|F| <= μ N_elastic) and locates ``centre_of_pressure``;
         ``friction_force`` and ``spring_force`` [force]: x-components of the forces on the
         body; ``centre_of_pressure`` [cm]: x of the normal resultant minus L/2;
         ``min_penetration``/``max_penetration`` [cm] over the contact nodes.
         """
-        normal = self._integral("normal", self.pressure)
+        elastic = self._integral("normal", self.pressure)
+        normal = elastic
         if self.scene.law.b_n > 0:  # the damping part of the normal stress (zero at rest)
             law, n = self.scene.law, self.normal
             normal += self._integral("damping", lambda: laws.normal_damping_pressure(
                 self.penetration(), normal_part(self.residual.u_dot, n), law.b_n, law.l_n))
-        elastic = self._integral("normal", self.pressure)
         moment = self._integral("moment", lambda: (ufl.SpatialCoordinate(self.msh)[0]
                                                    - self.scene.L / 2) * self.pressure())
         friction_force = self._integral("friction", lambda: self.friction_traction()[0]) \
@@ -572,7 +587,7 @@ class BlockModel:
         d = np.maximum(-uy - self.scene.g, 0.0)
         comm = self.msh.comm
         return {"mu": float(self.mu.value),
-                "normal_force": normal,
+                "normal_force": normal, "normal_force_elastic": elastic,
                 "friction_force": friction_force,
                 "spring_force": self.spring.force(self.residual.u),
                 "centre_of_pressure": moment / elastic if elastic > 0 else float("nan"),
