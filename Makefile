@@ -31,6 +31,7 @@ setup: .venv/.installed
 demo: setup
 	$(PY) -m fenicsfriction steady block --mu-max 1.55 --steps 31 --out $(OUT)/steady-block
 	$(PY) -m fenicsfriction stability block --mu-max 1.55 --steps 62 --out $(OUT)/stability-block
+	FENICSFRICTION_DEMO_OUT=$(OUT)/stick-slip-block $(MPIRUN) $(PY) demos/demo_block_stick_slip.py
 
 test-serial: setup
 	$(PY) -m pytest -q tests
@@ -42,6 +43,8 @@ test: test-serial test-mpi
 
 benchmark: setup
 	$(PY) benchmarks/bench_steady.py --out $(OUT)/benchmarks
+	$(PY) benchmarks/bench_stability.py --out $(OUT)/benchmarks
+	$(PY) benchmarks/bench_dynamics.py --out $(OUT)/benchmarks
 
 clean:
 	rm -rf .venv results *.egg-info

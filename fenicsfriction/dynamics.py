@@ -168,7 +168,11 @@ class Alpha2Integrator:
 
         self.ts.setMonitor(monitor)
         self.ts.setPostStep(regrow)
-        self.ts.solve(u)
+        error = None
+        try:
+            self.ts.solve(u)
+        except PETSc.Error as err:  # e.g. a NaN in the error estimate: report, keep the state
+            error = err
         self.ts.cancelMonitor()
         self.ts.setPostStep(None)
         reason = self.ts.getConvergedReason()
@@ -178,6 +182,11 @@ class Alpha2Integrator:
             vec.copy(target)
         u.destroy()
         v.destroy()
+        if error is not None:
+            raise DynamicsError(f"TS failed at t = {self.ts.getTime():.6g} after "
+                                f"{self.ts.getStepNumber()} steps with PETSc error {error.ierr} "
+                                f"(see the PETSc trace above); the fields hold the last "
+                                f"accepted state", records) from error
         if reason < 0:
             raise DynamicsError(f"TS stopped at t = {self.ts.getTime():.6g} with reason "
                                 f"{reason} after {self.ts.getStepNumber()} steps", records)
@@ -374,8 +383,10 @@ def stick_slip_statistics(records: list[dict], mu: float, eps: float,
                           t_from: float = 0.0) -> dict:
     r"""What an experimenter would measure on a run, over the records with time ≥ ``t_from``.
 
-    Needs ``normal_force``, ``friction_force``, ``spring_elongation``, ``energy_error`` and the
-    probe's ``probe_slip``/``probe_pressure`` (see ``BlockModel.dynamics_observer``).
+    Needs ``normal_force``, ``friction_force``, ``spring_elongation`` and the probe's
+    ``probe_slip``/``probe_pressure`` (see ``BlockModel.dynamics_observer``;
+    ``rigid_block_observables`` gives them for the rigid block), and ``energy_error`` if
+    there is one (``max_energy_error`` is None otherwise).
 
     Returns:
         ``apparent_coefficient``: :math:`\bar F_T / \bar N` (time means), the friction
@@ -409,7 +420,8 @@ def stick_slip_statistics(records: list[dict], mu: float, eps: float,
             "spring_elongation": {"start": float(series["spring_elongation"][0]),
                                   "end": float(series["spring_elongation"][-1]),
                                   "mean": _time_mean(t, series["spring_elongation"])},
-            "max_energy_error": float(max(abs(r["energy_error"]) for r in records)),
+            "max_energy_error": (float(max(abs(r["energy_error"]) for r in records))
+                                 if "energy_error" in records[0] else None),
             "duration": float(t_all[-1] - t_all[0]), "steps": len(records) - 1,
             "rejected_steps": int(sum(r["rejected_steps"] for r in records)),
             "newton_iterations": int(sum(r["newton_iterations"] for r in records))}

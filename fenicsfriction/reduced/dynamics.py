@@ -28,6 +28,7 @@ from petsc4py import PETSc
 from fenicsfriction import laws
 from fenicsfriction.dynamics import Alpha2Integrator
 from fenicsfriction.laws import check
+from fenicsfriction.reduced.rigid_block import _dphi
 
 __all__ = ["BouncingMass", "ReducedDynamics", "rigid_block_observables"]
 
@@ -179,15 +180,25 @@ class BouncingMass:
             + self.c_n * self.area * d ** (self.m_n + 1) / (self.m_n + 1) + self.weight * y
 
 
-def rigid_block_observables(block, q, q_dot) -> dict:
-    r"""Forces and contact state of a :class:`~fenicsfriction.reduced.RigidBlock` at (q, q̇).
+def rigid_block_observables(block, q, q_dot, probe_x: typing.Optional[float] = None) -> dict:
+    r"""Forces, motion and contact state of a :class:`~fenicsfriction.reduced.RigidBlock` at
+    (q, q̇), under the names of :meth:`~fenicsfriction.scenes.block.BlockModel.dynamics_observer`
+    so that :func:`~fenicsfriction.dynamics.stick_slip_statistics` and
+    :func:`~fenicsfriction.plotting.plot_stick_slip` read FE and rigid runs alike.
 
     Returns:
-        ``normal_force`` B0 ∫ p ds, ``friction_force`` B0 ∫ t_x ds (along x),
-        ``spring_force`` F_s, ``slip_velocity`` w = u̇_xG + θ̇ H/2 - U and ``contact``:
-        ``"open"`` (no penetration anywhere on the base), ``"stick"`` (|w| < ε) or ``"slip"``.
+        ``normal_force`` B0 ∫ p ds (normal damping included), ``normal_force_elastic``
+        B0 ∫ c_n d^{m_n} ds, ``friction_force`` B0 ∫ t_x ds (along x), ``spring_force`` F_s and
+        ``spring_elongation`` -F_s/K_x, ``u_yG``, ``v_xG``, ``v_yG``, ``theta``;
+        ``slip_velocity`` w = u̇_xG + θ̇ H/2 - U (the same at every base point) and ``contact``:
+        ``"open"`` (no penetration anywhere on the base), ``"stick"`` (|w| < ε) or ``"slip"``;
+        and at the base point ``probe_x`` (from the rear end, default L/2): ``probe_x``,
+        ``probe_u_y``, ``probe_v_x``, ``probe_v_y``, ``probe_slip`` (= w), ``probe_pressure``
+        c_n d^{m_n} and ``probe_friction`` (the tangential traction).
     """
     q, q_dot = np.asarray(q, float), np.asarray(q_dot, float)
+    check("probe_x", probe_x, probe_x is None or 0 <= probe_x <= block.L,
+          f"must lie on the base, in [0, L = {block.L}]")
     Q = block.generalised_forces(q, q_dot)  # interface integrals + (F_s, -W, -F_s arm)
     spring = block._spring(q)
     w = q_dot[0] + q_dot[2] * block.H / 2 - block.belt_direction * block.belt_speed
@@ -195,5 +206,19 @@ def rigid_block_observables(block, q, q_dot) -> dict:
         contact = "open"
     else:
         contact = "stick" if abs(w) < block.eps else "slip"
-    return {"normal_force": float(Q[1] + block.weight), "friction_force": float(Q[0] - spring),
-            "spring_force": float(spring), "slip_velocity": float(w), "contact": contact}
+    elastic = block._integrate(q, lambda s, d: block.c_n * d**block.m_n, 1)[0]
+    x = 0.5 * block.L if probe_x is None else float(probe_x)
+    s = x - 0.5 * block.L  # from G's vertical
+    d = max(-q[1] - block.g - q[2] * s, 0.0)
+    direction = _dphi(block.regularisation, w, block.eps)[0]
+    return {"normal_force": float(Q[1] + block.weight), "normal_force_elastic": float(elastic),
+            "friction_force": float(Q[0] - spring), "spring_force": float(spring),
+            "spring_elongation": float(-spring / block.K_x),
+            "u_yG": float(q[1]), "v_xG": float(q_dot[0]), "v_yG": float(q_dot[1]),
+            "theta": float(q[2]), "slip_velocity": float(w), "contact": contact,
+            "probe_x": x, "probe_u_y": float(q[1] + q[2] * s),
+            "probe_v_x": float(q_dot[0] + q_dot[2] * block.H / 2),
+            "probe_v_y": float(q_dot[1] + q_dot[2] * s), "probe_slip": float(w),
+            "probe_pressure": float(block.c_n * d**block.m_n),
+            "probe_friction": float(-block.mu * block.c_n * d**block.m_T * direction)}
+
