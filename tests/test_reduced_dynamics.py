@@ -20,6 +20,9 @@ import pytest
 import scipy.integrate
 import scipy.optimize
 
+from petsc4py import PETSc
+
+from fenicsfriction.dynamics import DynamicsError
 from fenicsfriction.reduced import (BouncingMass, ReducedDynamics, RigidBlock,
                                     rigid_block_observables)
 
@@ -353,6 +356,29 @@ def test_rigid_block_probe_tractions_integrate_to_the_resultants():
         assert whole["probe_v_x"] - whole["probe_slip"] == rb.belt_speed
     assert (pressure == 0).any() and (pressure > 0).any()  # the tilted state is partly open
     assert whole["normal_force_elastic"] == whole["normal_force"]  # at rest: no damping part
+
+
+def test_a_petsc_error_inside_the_time_step_is_reported_with_the_last_state_kept():
+    """An error raised by PETSc inside TSSolve (as TSALPHA2's error norm does when it meets a
+    NaN) stops the run with a DynamicsError naming the time and the error code; the records
+    of the accepted steps and their last state are kept."""
+
+    class Failing(BouncingMass):
+        calls = 0
+
+        def residual(self, q, q_dot, q_ddot):
+            Failing.calls += 1
+            if Failing.calls == 40:
+                raise PETSc.Error(72)  # PETSC_ERR_FP
+            return super().residual(q, q_dot, q_ddot)
+
+    mass = Failing()
+    dyn = ReducedDynamics(mass, [mass.equilibrium()], [0.1], prefix=prefix("failing"))
+    with pytest.raises(DynamicsError, match=r"TS failed at t = .* PETSc error 72") as err:
+        dyn.run(1e-2, 1e-4, observe=lambda t: {"y": float(dyn.q[0]), "v": float(dyn.q_dot[0])})
+    records = err.value.records
+    assert 1 < len(records) < 100 and records[-1]["time"] < 1e-2
+    assert (dyn.q[0], dyn.q_dot[0]) == (records[-1]["y"], records[-1]["v"])
 
 
 # --- bad input --------------------------------------------------------------------------------
