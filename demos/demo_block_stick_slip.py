@@ -27,7 +27,6 @@
 
 # +
 import csv
-import itertools
 import logging
 import os
 import pathlib
@@ -97,19 +96,29 @@ def run(belt_speed: float, comm: MPI.Comm) -> tuple[list, dict]:
 # perturbation, step and statistics (its base slides or sticks as a whole).
 
 
-def run_rigid(belt_speed: float) -> tuple[list, dict]:
-    block = RigidBlock.from_scene(ff.BlockOnBelt(mu=MU, belt_speed=belt_speed, b_n=0.381e10,
-                                                 eps=EPS))
+def run_rigid(block: RigidBlock, name: str) -> tuple[list, dict]:
     q = block.steady_state()
     growth = max(block.eigenvalues(q), key=lambda lam: lam.real)
-    solver = ReducedDynamics(block, q, [0.0, PERTURBATION, 0.0], prefix=f"rb{belt_speed}_ts_")
+    solver = ReducedDynamics(block, q, [0.0, PERTURBATION, 0.0], prefix=f"rb_{name}_ts_")
     records = solver.run(T_END, DT, observe=lambda t: rigid_block_observables(
         block, solver.q, solver.q_dot))
-    statistics = stick_slip_statistics(records, MU, EPS, t_from=T_END / 2)
-    statistics.update(belt_speed=belt_speed, weight=block.weight,
+    statistics = stick_slip_statistics(records, block.mu, block.eps, t_from=T_END / 2)
+    statistics.update(belt_speed=block.belt_speed, weight=block.weight,
                       unstable_eigenvalue=[growth.real, growth.imag],
                       wall_time_s=sum(r["wall_time_s"] for r in records))
     return records, statistics
+
+
+# The FE block's data (Figs. 13-15) at each belt speed, and the rigid model's own data of
+# Figs. 10-12: B0 = 14 cm, I = 70, a stiffer spring K_x = 2388, μ = 1, belt 0.127 cm/s, modal
+# damping ratios 0.005 (x), 0.04 (y, θ) at μ = 0. With the stiff spring the block's mean
+# motion follows the friction deficit within a few ms, so sticking sets in within the run.
+
+RIGID = {f"U = {U} cm/s": RigidBlock.from_scene(ff.BlockOnBelt(
+    mu=MU, belt_speed=U, b_n=0.381e10, eps=EPS)) for U in BELT_SPEEDS}
+RIGID["Figs. 10-12: μ = 1, U = 0.127 cm/s"] = RigidBlock.with_modal_damping(
+    (0.005, 0.04, 0.04), mu=1.0, belt_speed=0.127, B0=14.0, inertia=70.0, K_x=2388.0,
+    b_n=0.381e10, eps=EPS)
 
 
 # ## Both belt speeds (one per rank when there are two)
@@ -118,7 +127,12 @@ def run_rigid(belt_speed: float) -> tuple[list, dict]:
 mine = BELT_SPEEDS[world.rank::world.size]
 comm = MPI.COMM_SELF if world.size > 1 else world
 results = {U: run(U, comm) for U in mine}
-rigid = {U: run_rigid(U) for U in mine}
+# the rigid runs: each next to its FE run; the Figs. 10-12 run on the last rank
+names = list(RIGID)
+owner = {name: i % world.size for i, name in enumerate(names[:len(BELT_SPEEDS)])}
+owner[names[-1]] = world.size - 1
+rigid = {name: run_rigid(RIGID[name], f"r{i}") for i, name in enumerate(names)
+         if owner[name] == world.rank}
 gathered = world.gather((results, rigid), root=0)
 
 # ## What a friction experiment would measure
@@ -128,36 +142,42 @@ gathered = world.gather((results, rigid), root=0)
 
 if world.rank == 0:
     results = {U: r for part, _ in gathered for U, r in part.items()}
-    rigid = {U: r for _, part in gathered for U, r in part.items()}
+    rigid = {name: r for _, part in gathered for name, r in part.items()}
     out.mkdir(parents=True, exist_ok=True)
-    summary, summary_rigid = [], []
-    for U, (name, runs, table) in itertools.product(BELT_SPEEDS, (
-            ("FE", results, summary), ("rigid", rigid, summary_rigid))):
-        records, stats = runs[U]
-        with open(out / f"timeseries_{name}_U{U}.csv", "w", newline="") as handle:
+    # (kind, label, file stem, records, statistics)
+    entries = [("FE", f"U = {U} cm/s", f"FE_U{U}", *results[U]) for U in BELT_SPEEDS] + \
+        [("rigid", name, f"rigid_{i}", *rigid[name]) for i, name in enumerate(names)]
+    for kind, label, stem, records, stats in entries:
+        with open(out / f"timeseries_{stem}.csv", "w", newline="") as handle:
             writer = csv.DictWriter(handle, fieldnames=list(records[0]))
             writer.writeheader()
             writer.writerows(records)
-        table.append(stats)
         energy = "" if stats["max_energy_error"] is None else \
             f", energy error ≤ {stats['max_energy_error']:.2e}"
-        print(f"{name:5s} U = {U} cm/s: apparent coefficient {stats['apparent_coefficient']:.4f} "
-              f"(μ = {MU}, ratio {stats['ratio_to_mu']:.4f}); mean N "
+        anywhere = "" if stats["any_stick_fraction"] is None else \
+            f", some node {stats['any_stick_fraction']:.1%}"
+        print(f"{kind:5s} {label}: apparent coefficient {stats['apparent_coefficient']:.4f} "
+              f"(μ = {stats['mu']}, ratio {stats['ratio_to_mu']:.4f}); mean N "
               f"{stats['mean_normal_force']:.1f} (W = {stats['weight']:.0f}), N in "
               f"[{stats['normal_force_range'][0]:.0f}, "
-              f"{stats['normal_force_range'][1]:.0f}]; mid-base point sticks "
-              f"{stats['probe_stick_fraction']:.1%}, open {stats['probe_open_fraction']:.1%}; "
-              f"spring elongation {stats['spring_elongation']['start']:.5f} → "
+              f"{stats['normal_force_range'][1]:.0f}]; sticks: mid-base point "
+              f"{stats['probe_stick_fraction']:.1%}{anywhere} of the time, open "
+              f"{stats['probe_open_fraction']:.1%}; spring elongation "
+              f"{stats['spring_elongation']['start']:.5f} → "
               f"{stats['spring_elongation']['end']:.5f} cm; {stats['steps']} steps "
               f"({stats['rejected_steps']} cut back){energy}, {stats['wall_time_s']:.0f} s",
               flush=True)
-    ff.io.write_json(out / "stick_slip.json", {"mu": MU, "eps": EPS, "dt": DT, "t_end": T_END,
-                                               "perturbation": PERTURBATION, "runs": summary,
-                                               "rigid": summary_rigid}, MPI.COMM_SELF)
+    summary = [{"model": kind, "label": label, **stats}
+               for kind, label, _, _, stats in entries]
+    ff.io.write_json(out / "stick_slip.json", {"eps": EPS, "dt": DT, "t_end": T_END,
+                                               "perturbation": PERTURBATION, "runs": summary},
+                     MPI.COMM_SELF)
     plot_stick_slip({f"U = {U} cm/s": results[U][0] for U in BELT_SPEEDS},
                     out / "stick_slip.png", MU, EPS)
-    plot_stick_slip({f"rigid, U = {U} cm/s": rigid[U][0] for U in BELT_SPEEDS},
+    plot_stick_slip({f"rigid, {name}": rigid[name][0] for name in names[:len(BELT_SPEEDS)]},
                     out / "stick_slip_rigid.png", MU, EPS)
+    plot_stick_slip({f"rigid, {names[-1]}": rigid[names[-1]][0]},
+                    out / "stick_slip_rigid_figs10-12.png", RIGID[names[-1]].mu, EPS)
 
     # ## Checks
     # The perturbation has grown (the normal force leaves ±20 % of the weight), and friction
@@ -165,8 +185,8 @@ if world.rank == 0:
     # the apparent coefficient cannot exceed μ — up to the normal damping in N, whose stress
     # b_n d^{l_n} ḋ is a time derivative: its mean over a window is a boundary term (< 1 % of W
     # over 5 ms, less over longer windows).
-    for stats in summary + summary_rigid:
+    for stats in summary:
         low, high = stats["normal_force_range"]
         assert high - low > 0.4 * stats["weight"], stats["normal_force_range"]
-        assert stats["apparent_coefficient"] <= MU * 1.02, stats
-    say(f"wrote {out}/stick_slip.json, stick_slip.png, stick_slip_rigid.png and the time series")
+        assert stats["apparent_coefficient"] <= stats["mu"] * 1.02, stats
+    say(f"wrote {out}/stick_slip.json, stick_slip*.png and the time series")

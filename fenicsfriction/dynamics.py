@@ -393,7 +393,9 @@ def stick_slip_statistics(records: list[dict], mu: float, eps: float,
         coefficient a measurement of mean forces would report, against the law's ``mu``
         (``ratio_to_mu``); ``probe_stick_fraction`` / ``probe_open_fraction``: share of the
         time the probe node sticks (in contact, :math:`|\dot u_T - U_T| < \varepsilon`) or is
-        out of contact; ``mean_normal_force``, ``mean_friction_force``, ``normal_force_range``;
+        out of contact; ``any_stick_fraction``: share of the time some contact node sticks
+        (from ``n_stick``; None without it); ``mean_normal_force``, ``mean_friction_force``,
+        ``normal_force_range``;
         the spring elongation at the start and end of the window and its mean;
         ``max_energy_error`` over the whole run; ``steps``, ``rejected_steps``,
         ``newton_iterations`` over the whole run.
@@ -417,6 +419,9 @@ def stick_slip_statistics(records: list[dict], mu: float, eps: float,
             "ratio_to_mu": abs(mean_f) / mean_n / mu if mu > 0 else float("nan"),
             "probe_stick_fraction": _time_mean(t, sticks.astype(float)),
             "probe_open_fraction": _time_mean(t, (~in_contact).astype(float)),
+            "any_stick_fraction": (_time_mean(t, np.array([r["n_stick"] > 0 for r in window],
+                                                          dtype=float))
+                                   if "n_stick" in window[0] else None),
             "spring_elongation": {"start": float(series["spring_elongation"][0]),
                                   "end": float(series["spring_elongation"][-1]),
                                   "mean": _time_mean(t, series["spring_elongation"])},

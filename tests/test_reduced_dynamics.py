@@ -298,6 +298,27 @@ def rigid_block(mu: float) -> RigidBlock:
     return RigidBlock(mu=mu, viscous=viscous, **data)
 
 
+def test_modal_damping_gives_the_asked_damping_ratios_at_mu_0():
+    """``RigidBlock.with_modal_damping``: at μ = 0 the eigenvalues λ = -ζω ± iω√(1-ζ²) of the
+    damped block give back ζ = -Re λ/|λ| for each of the three modes (the tangential pair with
+    the spring, the normal and the rotation pairs; sorted by frequency); the coefficients are
+    those of the helper above at any μ. Exact up to the eigensolver: tolerance 1e-9."""
+    data = {"B0": 14.0, "inertia": 70.0, "K_x": 2388.0, "belt_speed": 0.127}
+    ratios = (0.005, 0.04, 0.04)
+    block = RigidBlock.with_modal_damping(ratios, **data)
+    lam = block.eigenvalues(block.steady_state())
+    lam = lam[lam.imag > 0]
+    assert len(lam) == 3
+    measured = -lam.real / abs(lam)
+    # frequencies: tangential (spring) < normal/rotation; the x ratio is the smallest one
+    assert measured[np.argmin(abs(lam))] == pytest.approx(ratios[0], rel=1e-9)
+    assert sorted(measured) == pytest.approx(sorted(ratios), rel=1e-9)
+    assert RigidBlock.with_modal_damping(ratios, mu=1.0, **data).viscous == pytest.approx(
+        rigid_block(1.0).viscous, rel=1e-12)
+    with pytest.raises(ValueError, match="viscous"):
+        RigidBlock(viscous=(1.0, float("nan"), 1.0))
+
+
 def two_modes(t, a1, w1, c1, s1, a2, w2, c2, s2, c0):
     return (np.exp(a1 * t) * (c1 * np.cos(w1 * t) + s1 * np.sin(w1 * t))
             + np.exp(a2 * t) * (c2 * np.cos(w2 * t) + s2 * np.sin(w2 * t)) + c0)

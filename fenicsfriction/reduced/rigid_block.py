@@ -71,8 +71,9 @@ class RigidBlock(BlockData):
         check("inertia", self.inertia, np.isfinite(self.inertia) and self.inertia > 0,
               "must be a finite number > 0")
         check("weight", self.weight, self.weight > 0, "must be > 0")
-        check("viscous", self.viscous, len(self.viscous) == 3 and min(self.viscous) >= 0,
-              "must be three coefficients >= 0")
+        check("viscous", self.viscous, len(self.viscous) == 3
+              and all(np.isfinite(c) and c >= 0 for c in self.viscous),
+              "must be three finite coefficients >= 0")
 
     @classmethod
     def from_scene(cls, scene: BlockData, **changes) -> "RigidBlock":
@@ -88,6 +89,22 @@ class RigidBlock(BlockData):
                              "the rigid block supports a constant mu only")
         shared["weight"] += getattr(scene, "top_pressure", 0.0) * scene.L * scene.B0
         return cls(**{**shared, **changes})
+
+    @classmethod
+    def with_modal_damping(cls, ratios: tuple, **data) -> "RigidBlock":
+        """A block with viscous damping c_i = 2 ζ_i sqrt(k_i m_i), ζ = ``ratios`` for
+        (u_xG, u_yG, θ), k_i the diagonal of K̄ at the frictionless steady state of the block
+        ``data`` describes (where K̄ and the mass matrix are diagonal, so the ζ_i are exactly its
+        modal damping ratios at μ = 0); the c_i are then kept at every μ (seed 000 Figs. 10-12:
+        ζ = 0.005, 0.04, 0.04)."""
+        check("ratios", ratios, len(ratios) == 3 and all(np.isfinite(z) and z >= 0
+                                                         for z in ratios),
+              "must be three finite ratios >= 0")
+        frictionless = cls(**{**data, "mu": 0.0})
+        M, _, K = frictionless.linearisation(frictionless.steady_state())
+        viscous = tuple(float(2 * z * np.sqrt(k * m))
+                        for z, k, m in zip(ratios, np.diag(K), np.diag(M), strict=True))
+        return cls(**{**data, "viscous": viscous})
 
     @property
     def mass_matrix(self) -> np.ndarray:
