@@ -374,6 +374,19 @@ class CentralDifference:
         return records
 
 
+def _longest_run(t: np.ndarray, flags: np.ndarray) -> float:
+    """Longest time span over which ``flags`` holds at consecutive samples (0 if never)."""
+    longest, start = 0.0, None
+    for time_k, flag in zip(t, flags, strict=True):
+        if flag and start is None:
+            start = time_k
+        elif not flag and start is not None:
+            start = None
+        if start is not None:
+            longest = max(longest, time_k - start)
+    return float(longest)
+
+
 def _time_mean(t: np.ndarray, values: np.ndarray) -> float:
     """Time average of a sampled signal (trapezoidal rule; steps may vary)."""
     return float(np.trapz(values, t) / (t[-1] - t[0]))
@@ -393,9 +406,10 @@ def stick_slip_statistics(records: list[dict], mu: float, eps: float,
         coefficient a measurement of mean forces would report, against the law's ``mu``
         (``ratio_to_mu``); ``probe_stick_fraction`` / ``probe_open_fraction``: share of the
         time the probe node sticks (in contact, :math:`|\dot u_T - U_T| < \varepsilon`) or is
-        out of contact; ``any_stick_fraction``: share of the time some contact node sticks
-        (from ``n_stick``; None without it); ``mean_normal_force``, ``mean_friction_force``,
-        ``normal_force_range``;
+        out of contact; ``probe_longest_stick`` [s]: its longest uninterrupted stick (a
+        stick-slip relaxation cycle against brief adhesions); ``any_stick_fraction``: share of
+        the time some contact node sticks (from ``n_stick``; None without it);
+        ``mean_normal_force``, ``mean_friction_force``, ``normal_force_range``;
         the spring elongation at the start and end of the window and its mean;
         ``max_energy_error`` over the whole run; ``steps``, ``rejected_steps``,
         ``newton_iterations`` over the whole run.
@@ -419,6 +433,7 @@ def stick_slip_statistics(records: list[dict], mu: float, eps: float,
             "ratio_to_mu": abs(mean_f) / mean_n / mu if mu > 0 else float("nan"),
             "probe_stick_fraction": _time_mean(t, sticks.astype(float)),
             "probe_open_fraction": _time_mean(t, (~in_contact).astype(float)),
+            "probe_longest_stick": _longest_run(t, sticks),
             "any_stick_fraction": (_time_mean(t, np.array([r["n_stick"] > 0 for r in window],
                                                           dtype=float))
                                    if "n_stick" in window[0] else None),
