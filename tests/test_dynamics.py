@@ -102,6 +102,30 @@ def test_central_differences_agree_with_generalized_alpha_and_respect_the_stable
     assert np.abs(forces[0] - forces[1]).max() < 1e-2 * signal
 
 
+def test_central_differences_need_the_stick_band_bound_inside_the_band():
+    """With the belt slower than ε (0.005 < 0.01 cm/s) the steady state lies inside the
+    regularisation band, where friction is the stiff dashpot c = c_T d^{m_T}/ε per unit area
+    (F = μ N U/ε = 135 = 0.3 W here). The step bound from the elasticity alone, 2/ω_max
+    (9.7e-6 s), is 36 times the band's (2.7e-7 s at κ = 4): at that step the explicit dashpot
+    overshoots and the friction force chatters up to the saturated μN (measured 0.62 W); at
+    the enforced band bound the steady state is kept (F within 1e-6 of 135 over 1 ms,
+    measured 4e-10)."""
+    from fenicsfriction.dynamics import CentralDifference
+    peaks = {}
+    for band in (False, True):
+        model = steady_block(0.6, prefix=f"band{band}", eps=1e-2, belt_speed=0.005)
+        weight = model.scene.weight
+        explicit = CentralDifference(model.residual,
+                                     band_damping=model.band_damping() if band else None)
+        records = explicit.run(1e-3, 1e-3, observe=lambda t, m=model: {
+            "friction": m.quantities()["friction_force"]})
+        friction = np.array([r["friction"] for r in records])
+        assert friction[0] == pytest.approx(0.6 * weight * 0.005 / 1e-2, rel=1e-6)
+        peaks[band] = np.abs(friction - friction[0]).max() / weight
+    assert explicit.stable_dt_band < explicit.stable_dt_elastic / 10
+    assert peaks[False] > 0.1 and peaks[True] < 1e-6 * 0.3, peaks
+
+
 def test_stable_mu_decays_at_the_rate_of_its_eigenvalue():
     """Below the flutter onset, with normal damping, every eigenvalue has Re λ < 0: a small
     normal velocity perturbation must decay. N(t) is dominated (10:1) by the normal mode; a
