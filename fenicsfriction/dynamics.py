@@ -289,10 +289,9 @@ class CentralDifference:
         if band_damping is not None:
             c = dolfinx.fem.petsc.assemble_vector(_compat.form(band_damping))
             c.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-            with c.localForm() as c_local, self.lumped.localForm() as m_local:
-                active = c_local.array > 0
-                local = (2.0 * m_local.array[active] / (band_margin * c_local.array[active])
-                         ).min(initial=np.inf)
+            owned_c, owned_m = c.array_r, self.lumped.array_r  # owned entries (no ghosts)
+            active = owned_c > 0
+            local = (2.0 * owned_m[active] / (band_margin * owned_c[active])).min(initial=np.inf)
             self.stable_dt_band = float(c.getComm().tompi4py().allreduce(local, op=MPI.MIN))
             c.destroy()
         self.stable_dt = min(self.stable_dt_elastic, self.stable_dt_band)
