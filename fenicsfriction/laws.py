@@ -145,6 +145,10 @@ class ConstantFriction:
     def __call__(self, speed: Scalar) -> Scalar:
         return self.mu + 0 * abs(speed)
 
+    def derivative(self, speed):
+        """dμ/dv at the signed relative velocity ``speed`` (NumPy): zero."""
+        return 0.0 * np.asarray(speed, dtype=float)
+
 
 @dataclasses.dataclass(frozen=True)
 class PiecewiseLinearFriction:
@@ -167,6 +171,15 @@ class PiecewiseLinearFriction:
     def __call__(self, speed: Scalar) -> Scalar:
         """μ at relative velocity ``speed`` (its magnitude is used: signed input is fine)."""
         return self.mu_s - self.slope * _min(abs(speed), self.v_c)
+
+    def derivative(self, speed):
+        """dμ/dv at the signed relative velocity ``speed`` (NumPy).
+
+        μ is even in v, so the derivative is odd: -slope sgn(v) below v_c, 0 above. At v = 0 and
+        at |v| = v_c the one-sided values differ; the value returned there is 0.
+        """
+        v = np.asarray(speed, dtype=float)
+        return np.where(np.abs(v) < self.v_c, -self.slope * np.sign(v), 0.0)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -191,6 +204,15 @@ class StribeckFriction:
         """μ at relative velocity ``speed`` (its magnitude is used: signed input is fine)."""
         ratio = abs(speed) / self.v_s
         return self.mu_k + (self.mu_s - self.mu_k) * _exp(-(ratio**self.exponent))
+
+    def derivative(self, speed):
+        """dμ/dv at the signed relative velocity ``speed`` (NumPy); 0 at v = 0."""
+        v = np.asarray(speed, dtype=float)
+        ratio = np.abs(v) / self.v_s
+        with np.errstate(divide="ignore", invalid="ignore"):
+            d = -(self.mu_s - self.mu_k) * self.exponent * ratio ** (self.exponent - 1) \
+                * np.exp(-(ratio**self.exponent)) / self.v_s
+        return np.where(v == 0, 0.0, d * np.sign(v))
 
 
 FrictionCoefficient = typing.Union[ConstantFriction, PiecewiseLinearFriction, StribeckFriction]

@@ -193,3 +193,13 @@ def test_friction_coefficients_reject_bad_parameter_by_name(law, name, value):
     with pytest.raises(ValueError) as error:
         law(value)
     assert_names(error, name, value)
+
+
+@pytest.mark.parametrize("law", [laws.ConstantFriction(0.4), laws.PiecewiseLinearFriction(),
+                                 laws.StribeckFriction(0.6, 0.3, 2.0, 1.5)])
+def test_friction_coefficient_derivative_is_its_central_difference(law):
+    # away from the kinks (0 and v_c = 15): central differences are O(h²) accurate
+    v = np.array([-20.0, -7.3, -0.9, 0.4, 3.1, 14.0, 30.0])
+    h = 1e-6
+    fd = (law(v + h) - law(v - h)) / (2 * h)
+    assert np.allclose(law.derivative(v), fd, rtol=1e-7, atol=1e-9)
