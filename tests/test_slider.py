@@ -1,0 +1,114 @@
+"""The 2m+1 d.o.f. slider of seed 004: natural frequencies, averaging against Floquet."""
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from fenicsfriction import laws
+from fenicsfriction.reduced.slider import Contact, Slider, table2_slider
+
+
+def test_table2_natural_frequencies_are_the_roots_of_the_frequency_equation():
+    # det(K - Ω² M) = 0 for M = diag(1, 0.01), K = [[11, -10], [-10, 10]]:
+    # Ω⁴ - 1011 Ω² + 1000 = 0 (seed 004 eq. 60: Ω1 = 0.9950, Ω2 = 31.7807)
+    roots = np.sqrt(np.sort(np.roots([1.0, -1011.0, 1000.0])))
+    omega, R = table2_slider(30.78).natural_frequencies()
+    assert omega == pytest.approx(roots, rel=1e-13)
+    assert np.round(omega, 4) == pytest.approx([0.9950, 31.7807], abs=1e-12)
+    M, _, _ = table2_slider(30.78).tangential_matrices()
+    assert R.T @ M @ R == pytest.approx(np.eye(2), abs=1e-13)
+
+
+def test_two_identical_contacts_have_the_antisymmetric_mode_sqrt_kt_over_m():
+    # contacts moving in opposition leave the slider at rest: Ω = sqrt(k_t/m) exactly
+    contact = table2_slider(30.0).contacts[0]
+    slider = Slider(1.0, 1.0, 0.015, [contact, contact])
+    omega, R = slider.natural_frequencies()
+    k = int(np.argmin(np.abs(omega - math.sqrt(contact.k_t / contact.mass))))
+    assert omega[k] == pytest.approx(math.sqrt(contact.k_t / contact.mass), rel=1e-12)
+    assert abs(R[0, k]) < 1e-12 and R[1, k] == pytest.approx(-R[2, k], rel=1e-12)
+    assert slider.matrices()[0].shape == (5, 5)
+
+
+def test_floquet_multipliers_of_a_smooth_surface_are_exp_of_the_eigenvalues_times_the_period():
+    # roughness 0: constant coefficients, so the monodromy matrix is exp(A T); its eigenvalues
+    # are exp(λ T) with λ from the quadratic eigenproblem (λ² M + λ C̄ + K) q = 0
+    slider = table2_slider(30.78)
+    smooth = Slider(1.0, 1.0, 0.015, [dataclasses.replace(slider.contacts[0], roughness=0.0)])
+    floquet = smooth.floquet()
+    M, C, K = smooth.tangential_matrices()
+    C[1, 1] += smooth.contacts[0].slope() * smooth.contacts[0].normal_load
+    n = M.shape[0]
+    A = np.block([[np.zeros((n, n)), np.eye(n)],
+                  [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+    expected = np.exp(np.linalg.eigvals(A) * floquet.period)
+    assert np.sort_complex(floquet.multipliers) == pytest.approx(np.sort_complex(expected),
+                                                                  rel=1e-8, abs=1e-10)
+
+
+def test_averaging_and_floquet_agree_at_the_principal_resonance_and_its_band_edge():
+    # ω_o ≈ 2Ω2: first-order averaging is O(ε) accurate (ε ~ ξ/Ω ~ 0.05), so growth rates
+    # agree to a few per cent and the band edges to a small fraction of the band width (1.9)
+    a, f = (table2_slider(63.5).averaged(), table2_slider(63.5).floquet())
+    assert a.case.startswith("II: Ω2+Ω2")
+    assert a.growth > 0 and f.growth == pytest.approx(a.growth, rel=0.02)
+
+    def edge(rate, lo, hi):
+        while hi - lo > 1e-3:
+            mid = (lo + hi) / 2
+            lo, hi = (mid, hi) if rate(mid) < 0 else (lo, mid)
+        return (lo + hi) / 2
+
+    upper_avg = edge(lambda w: -table2_slider(w).averaged().growth, 63.6, 66.0)
+    upper_floquet = edge(lambda w: -table2_slider(w).floquet().growth, 63.6, 66.0)
+    assert abs(upper_avg - upper_floquet) < 0.05
+    assert upper_floquet == pytest.approx(64.45, abs=0.05)     # seed 004: 62.70 < ω_o < 64.45
+
+
+def test_steady_sliding_balances_the_mean_friction():
+    slider = table2_slider(30.78)
+    q = slider.steady_sliding()
+    contact = slider.contacts[0]
+    friction = contact.friction(contact.surface_speed) * contact.normal_load
+    assert slider.stiffness * q[0] == pytest.approx(friction, rel=1e-12)   # slider spring
+    assert contact.k_t * (q[1] - q[0]) == pytest.approx(friction, rel=1e-12)
+
+
+@pytest.mark.parametrize("field, value", [("mass", 0.0), ("k_n", -1.0), ("wavelength", 0.0),
+                                          ("wavelength", -2.0), ("k_t", -10.0)])
+def test_bad_contact_parameters_are_named_in_the_error(field, value):
+    contact = table2_slider(30.0).contacts[0]
+    with pytest.raises(ValueError, match=f"{field}={value!r} is invalid"):
+        dataclasses.replace(contact, **{field: value})
+
+
+def test_bad_slider_parameters_are_named_in_the_error():
+    contact = table2_slider(30.0).contacts[0]
+    with pytest.raises(ValueError, match="stiffness=-1.0 is invalid"):
+        Slider(1.0, -1.0, 0.0, [contact])
+    with pytest.raises(ValueError, match="mass=0 is invalid"):
+        Slider(0, 1.0, 0.0, [contact])
+    with pytest.raises(ValueError, match="contacts=.* is invalid"):
+        Slider(1.0, 1.0, 0.0, [])
+    with pytest.raises(ValueError, match="reading='x' is invalid"):
+        table2_slider(30.0, reading="x")
+    with pytest.raises(ValueError, match="unit=0.0 is invalid"):
+        Contact(0.01, 10, 0.015, 0.1, 0.001, 0.05, 1, 16.67, 80,
+                friction=dataclasses.replace(table2_slider(30.0).contacts[0].friction, unit=0.0))
+    assert laws.PiecewiseLinearFriction().derivative(3.0) == pytest.approx(-0.03)
+
+
+@pytest.mark.parametrize("omega, case", [(1.0, "I: Ω1 ≈ ω1"), (31.78, "I: Ω2 ≈ ω1"),
+                                         (15.9, "III: Ω2 ≈ ω1+ω1"), (10.0, "non-resonant")])
+def test_cases_I_III_and_non_resonant_are_stable_at_the_modal_damping_rate(omega, case):
+    # Table 1: away from Case II the averaged growth is -min ξ_ii/2, here < 0 (ξ_ii > 0);
+    # Floquet's exact growth agrees to O(ε) of the damping rate. The weak fluctuation of the
+    # slider-mass reading keeps the wide Case II bands of the paper's reading away from Ω2.
+    slider = table2_slider(omega, reading="slider-mass")
+    averaged = slider.averaged()
+    assert averaged.case == case
+    assert averaged.growth == pytest.approx(-averaged.modal_damping.min() / 2, rel=1e-12)
+    assert averaged.growth < 0
+    assert slider.floquet().growth == pytest.approx(averaged.growth, rel=1e-3)
