@@ -107,7 +107,72 @@ def _parser() -> argparse.ArgumentParser:
             ("--eps", "eps", float, "regularisation ε [cm/s] (1e-3)"),
             ("--regularisation", "regularisation", str, "c1 or smooth (c1)")):
         dynamics.add_argument(flag, dest=dest, type=kind, help=text)
+    _oscillator_parsers(commands)
     return parser
+
+
+def _omega_range(text: str) -> tuple[float, float]:
+    try:
+        lo, hi = (float(v) for v in text.split(":"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected LO:HI, got {text!r}") from None
+    return lo, hi
+
+
+def _oscillator_parsers(commands) -> None:
+    """``oscillator mdof|belt`` and ``stability-map mdof``: the reduced models of seed 004."""
+    from fenicsfriction.reduced.slider import TABLE2_READINGS
+
+    readings = dict(choices=sorted(TABLE2_READINGS), default="paper",
+                    help="reading of seed 004's dimensionless Table 2 model (paper)")
+    smap = commands.add_parser(
+        "stability-map", help="stability of steady sliding vs forcing frequency (seed 004)",
+        description="Growth rate of perturbations of steady sliding of the Table 2 slider by "
+                    "first-order averaging and by Floquet multipliers (PETSc TS), with the "
+                    "unstable bands.")
+    smap.add_argument("scene", choices=["mdof"], help="scene to run")
+    smap.add_argument("--omega-range", type=_omega_range, required=True, metavar="LO:HI")
+    smap.add_argument("--samples", type=int, default=101, help="forcing frequencies sampled")
+    smap.add_argument("--methods", default="averaging,floquet",
+                      help="comma-separated: averaging, floquet")
+    smap.add_argument("--reading", **readings)
+    smap.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    osc = commands.add_parser(
+        "oscillator", help="stick-slip time response of a friction oscillator (seed 004)",
+        description="Integrates the slider of seed 004 (mdof) or the 1-d.o.f. oscillator on a "
+                    "belt (belt) with stick and slip switched at events located by PETSc TS "
+                    "(or a regularised law with --eps); TS options as -hybrid_<option>.")
+    osc.add_argument("scene", choices=["mdof", "belt"], help="scene to run")
+    osc.add_argument("--t-end", type=float, default=100.0, help="final (dimensionless) time")
+    osc.add_argument("--eps", type=float, help="regularised law of this width (no events)")
+    osc.add_argument("--rtol", type=float, default=1e-8, help="relative tolerance of the steps")
+    osc.add_argument("--sample-dt", type=float, default=0.01, help="output sampling step")
+    osc.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    mdof = osc.add_argument_group("mdof (seed 004, Table 2)")
+    mdof.add_argument("--omega", type=float, default=30.78, help="forcing frequency ω_o")
+    mdof.add_argument("--reading", **readings)
+    mdof.add_argument("--normal-force", choices=["signed", "absolute", "clipped"],
+                      default="signed", help="how N enters friction (signed, as eq. 21)")
+    mdof.add_argument("--coupled", action="store_true",
+                      help="the roughness under a contact follows its tangential motion")
+    mdof.add_argument("--perturbation", type=float, default=0.01,
+                      help="initial slider velocity added to steady sliding")
+    belt = osc.add_argument_group("belt (m ẍ + c ẋ + k x = μ(v_b − ẋ) N)")
+    for flag, default, text in (("--m", 1.0, "mass"), ("--k", 1.0, "stiffness"),
+                                ("--c", 0.0, "damping"), ("--N", 1.0, "normal force"),
+                                ("--v-belt", 0.5, "belt speed"),
+                                ("--mu-s", 0.6, "static coefficient"),
+                                ("--mu-k", 0.3, "kinetic coefficient (constant, stribeck)"),
+                                ("--slope", 0.03, "dμ/d|v| (piecewise)"),
+                                ("--v-c", 15.0, "end of the slope (piecewise)"),
+                                ("--v-s", 0.5, "Stribeck speed (stribeck)")):
+        belt.add_argument(flag, type=float, default=default, help=f"{text} ({default})")
+    belt.add_argument("--law", choices=["constant", "piecewise", "stribeck"],
+                      default="constant", help="μ(v) while slipping (constant: μ_k, with μ_s "
+                                               "for stick)")
+    belt.add_argument("--x0", type=float, default=0.0, help="initial displacement (0)")
+    belt.add_argument("--v0", type=float,
+                      help="initial velocity (the belt's: the mass starts stuck to the belt)")
 
 
 def _run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
@@ -381,6 +446,143 @@ def _run_stability(args: argparse.Namespace, log: logging.Logger) -> int:
     return 0
 
 
+def _run_stability_map(args: argparse.Namespace, log: logging.Logger) -> int:
+    import functools
+
+    from fenicsfriction import io
+    from fenicsfriction.laws import check
+    from fenicsfriction.plotting import plot_stability_map
+    from fenicsfriction.reduced.slider import stability_map, table2_slider
+
+    lo, hi = args.omega_range
+    check("--omega-range", f"{lo:g}:{hi:g}", 0 < lo < hi, "needs 0 < LO < HI")
+    check("--samples", args.samples, args.samples >= 2, "must be >= 2")
+    methods = [m.strip() for m in args.methods.split(",") if m.strip()]
+    result = stability_map(functools.partial(table2_slider, reading=args.reading),
+                           np.linspace(lo, hi, args.samples), methods=methods)
+    for method in methods:
+        bands = [(round(a, 3), round(b, 3)) for a, b in result.bands[method]]
+        per_omega = result.seconds[method] / args.samples * 1e3
+        log.info(f"{method}: unstable bands {bands} ({per_omega:.2f} ms per ω_o)")
+    out: pathlib.Path = args.out
+    paper = [(30.74, 30.83), (32.72, 32.83), (62.70, 64.45)]
+    slider = table2_slider(lo, reading=args.reading)
+    io.write_json(out / "stability_map.json", {
+        "reading": args.reading, "natural_frequencies": slider.natural_frequencies()[0],
+        "omega": result.omega, "growth": result.growth, "bands": result.bands,
+        "seconds_per_omega": {k: v / args.samples for k, v in result.seconds.items()},
+        "paper_bands": paper})
+    if MPI.COMM_WORLD.rank == 0:
+        plot_stability_map(result.omega, result.growth, result.bands, out / "stability_map.png",
+                           reference_bands=paper)
+    MPI.COMM_WORLD.Barrier()
+    return 0
+
+
+def _stick_intervals(t: np.ndarray, stuck: np.ndarray) -> list[tuple[float, float]]:
+    """Intervals of t where ``stuck`` holds (events are recorded twice, so edges are exact)."""
+    edges = np.flatnonzero(np.diff(np.r_[0, stuck.astype(int), 0]))
+    return [(float(t[a]), float(t[min(b, len(t) - 1)])) for a, b in zip(edges[::2], edges[1::2],
+                                                                        strict=True)]
+
+
+def _run_oscillator(args: argparse.Namespace, log: logging.Logger) -> int:
+    import csv
+
+    from fenicsfriction import io, laws
+    from fenicsfriction.laws import check
+    from fenicsfriction.plotting import plot_oscillator
+    from fenicsfriction.reduced import BeltOscillator, belt_summary
+    from fenicsfriction.reduced.events import HybridError, integrate_hybrid
+    from fenicsfriction.reduced.slider import SliderMotion, table2_slider
+
+    check("--t-end", args.t_end, args.t_end > 0, "must be > 0")
+    check("--sample-dt", args.sample_dt, 0 < args.sample_dt <= args.t_end,
+          "must lie in (0, t-end]")
+    out: pathlib.Path = args.out
+    rank0 = MPI.COMM_WORLD.rank == 0
+    next_report = [0.0]
+
+    def progress(t, y, mode) -> dict:
+        if t >= next_report[0]:
+            log.info(f"t = {t:10.4f} / {args.t_end:g}  mode {mode}")
+            next_report[0] += args.t_end / 10
+        return {}
+
+    start = time.perf_counter()
+    if args.scene == "belt":
+        law = {"constant": lambda: laws.ConstantFriction(args.mu_k),
+               "piecewise": lambda: laws.PiecewiseLinearFriction(args.mu_s, args.slope, args.v_c),
+               "stribeck": lambda: laws.StribeckFriction(args.mu_s, args.mu_k, args.v_s)}
+        oscillator = BeltOscillator(args.m, args.k, args.c, args.N, args.v_belt,
+                                    law[args.law](), mu_static=args.mu_s)
+        method = "events" if args.eps is None else "regularised"
+        run = oscillator.simulate(args.t_end, x0=args.x0,
+                                  v0=args.v_belt if args.v0 is None else args.v0, method=method,
+                                  eps=args.eps, rtol=args.rtol, atol=1e-2 * args.rtol,
+                                  sample_dt=args.sample_dt)
+        t, x, v, force = run.t, run.x, run.v, run.friction_force
+        stick, surface = run.stick_intervals, args.v_belt
+        summary = {**belt_summary(run), "stick_fraction": belt_summary(run)["stick_fraction_run"],
+                   "effective_damping": oscillator.effective_damping(),
+                   "steady_sliding_stable": oscillator.is_steady_sliding_stable(),
+                   "linear_eigenvalues": [[s.real, s.imag]
+                                          for s in oscillator.linear_eigenvalues()]}
+        if args.law == "constant" and args.c == 0 and args.mu_s > args.mu_k:
+            summary["classic_cycle"] = dataclasses.asdict(oscillator.classic_limit_cycle())
+        columns = {"t": t, "x": x, "v": v, "friction_force": force,
+                   "stick": [int(m == "stick") for m in run.modes]}
+        names = ("x", "ẋ")
+    else:
+        check("--omega", args.omega, args.omega > 0, "must be > 0")
+        slider = table2_slider(args.omega, reading=args.reading)
+        motion = SliderMotion(slider, normal_force=args.normal_force, coupled=args.coupled,
+                              eps=args.eps)
+        try:
+            run = integrate_hybrid(motion, motion.initial_state([args.perturbation]),
+                                   motion.slip_mode(), args.t_end, rtol=args.rtol,
+                                   atol=1e-2 * args.rtol, sample_dt=args.sample_dt,
+                                   observe=progress)
+        except HybridError as error:
+            log.info(f"stopped: {error}")
+            run = error.result
+        n = motion.size // 2
+        t, y = run.t, run.y
+        force = np.array([motion.friction(ti, yi, mode)[0]
+                          for ti, yi, mode in zip(t, y, run.modes, strict=True)])
+        normal = np.array([motion.normal_forces(ti, yi)[0] for ti, yi in zip(t, y, strict=True)])
+        stuck = np.array([args.eps is None and mode[0] == 0 for mode in run.modes])
+        stick, surface = _stick_intervals(t, stuck), slider.contacts[0].surface_speed
+        omega, _ = slider.natural_frequencies()
+        late = t >= t[-1] / 2
+        summary = {"omega": args.omega, "reading": args.reading,
+                   "natural_frequencies": omega, "surface_speed": surface,
+                   "averaged_growth": slider.averaged().growth,
+                   "floquet_growth": slider.floquet().growth, "events": len(run.events),
+                   "stick_fraction": sum(b - a for a, b in stick) / t[-1],
+                   "slider_amplitude_first_half": float(np.ptp(y[~late, 0])) / 2,
+                   "slider_amplitude_second_half": float(np.ptp(y[late, 0])) / 2,
+                   "steps": run.steps, "t_end": float(t[-1])}
+        columns = {"t": t, "y_s": y[:, 0], "y_1": y[:, 1], "x_1": y[:, 2], "v_s": y[:, n],
+                   "v_1": y[:, n + 1], "normal_force": normal, "friction_force": force,
+                   "stick": stuck.astype(int)}
+        x, v, names = y[:, 0], y[:, n + 1], ("slider y_s", "velocity of mass 1, ẏ_1")
+    summary["wall_seconds"] = time.perf_counter() - start
+    log.info(f"{summary['events']} events, stick fraction {summary['stick_fraction']:.3f}, "
+             f"{summary['wall_seconds']:.1f} s")
+    io.write_json(out / "summary.json", summary)
+    if rank0:
+        with open(out / "timeseries.csv", "w", newline="") as f:
+            writer = csv.writer(f)
+            writer.writerow(columns)
+            writer.writerows(zip(*columns.values(), strict=True))
+        plot_oscillator(t, x, v, surface, stick, out / "oscillator.png",
+                        title=f"{args.scene}: {summary['events']} stick/slip events",
+                        names=names)
+    MPI.COMM_WORLD.Barrier()
+    return 0
+
+
 def main(argv: typing.Optional[list[str]] = None) -> int:
     """Entry point of the ``fenicsfriction`` console script and ``python -m fenicsfriction``."""
     argv = sys.argv[1:] if argv is None else list(argv)
@@ -397,7 +599,8 @@ def main(argv: typing.Optional[list[str]] = None) -> int:
     from fenicsfriction.io import get_logger
     log = get_logger(MPI.COMM_WORLD)
     try:
-        commands = {"steady": _run_steady, "stability": _run_stability, "dynamics": _run_dynamics}
+        commands = {"steady": _run_steady, "stability": _run_stability, "dynamics": _run_dynamics,
+                    "stability-map": _run_stability_map, "oscillator": _run_oscillator}
         return commands[args.command](args, log)
     except ValueError as err:
         if MPI.COMM_WORLD.rank == 0:

@@ -220,3 +220,49 @@ def plot_stick_slip(runs: dict, path, mu: float, eps: float) -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
+
+
+def plot_oscillator(t: np.ndarray, displacement: np.ndarray, velocity: np.ndarray,
+                    surface_speed: float, stick: list[tuple[float, float]], path,
+                    title: str, names: tuple[str, str] = ("x", "ẋ")) -> None:
+    """Response of a friction oscillator: the whole run with its envelope, a close-up of the
+    last cycles, and the velocity of the contact against the surface speed, stick shaded."""
+    plt = _pyplot()
+    fig, axes = plt.subplots(3, 1, figsize=(8, 8))
+    axes[0].plot(t, displacement, lw=0.4)
+    axes[0].set(xlabel="t", ylabel=names[0], title=title)
+    close = t >= t[-1] - 0.1 * (t[-1] - t[0])
+    axes[1].plot(t[close], displacement[close], lw=0.8)
+    axes[1].set(xlabel="t", ylabel=f"{names[0]} (last 10 %)")
+    axes[2].plot(t[close], velocity[close], lw=0.8, label=names[1])
+    axes[2].axhline(surface_speed, color="k", ls="--", lw=0.8, label="surface speed")
+    for a, b in stick:
+        if b >= t[close][0]:
+            axes[2].axvspan(max(a, t[close][0]), b, color="tab:red", alpha=0.2, lw=0)
+    axes[2].set(xlabel="t", ylabel=f"{names[1]} (stick shaded)")
+    axes[2].legend(loc="lower right")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_stability_map(omega: np.ndarray, growth: dict, bands: dict, path,
+                       reference_bands: typing.Sequence[tuple[float, float]] = ()) -> None:
+    """Growth rate of perturbations of steady sliding against the forcing frequency, by each
+    method, with the unstable bands shaded and reference bands (e.g. a paper's) marked."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(8, 4))
+    for (method, g), colour in zip(growth.items(), ("tab:blue", "tab:orange"), strict=False):
+        ax.plot(omega, g, color=colour, label=method)
+        for a, b in bands.get(method, []):
+            ax.axvspan(a, b, color=colour, alpha=0.15, lw=0)
+    for i, (a, b) in enumerate(reference_bands):
+        if a <= omega[-1] and b >= omega[0]:
+            ax.axvspan(a, b, ymin=0.95, ymax=1.0, color="k",
+                       label="paper" if i == 0 else None)
+    ax.axhline(0.0, color="k", lw=0.6)
+    ax.set(xlabel="forcing frequency ω_o", ylabel="growth rate (max Re)")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

@@ -143,3 +143,4 @@ def test_bad_arguments_name_the_parameter():
         integrate_hybrid(HalfSwings(), [1.0], "down", 1.0)
     with pytest.raises(ValueError, match="t_end="):
         integrate_hybrid(HalfSwings(), [1.0, 0.0], "down", 0.0)
+

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from fenicsfriction import laws
-from fenicsfriction.reduced.events import integrate_hybrid
+from fenicsfriction.reduced.events import HybridError, integrate_hybrid
 from fenicsfriction.reduced.slider import Contact, Slider, SliderMotion, table2_slider
 
 
@@ -157,3 +157,20 @@ def test_bad_motion_options_are_named_in_the_error():
         SliderMotion(table2_slider(30.0), normal_force="x")
     with pytest.raises(ValueError, match="eps=0.0 is invalid"):
         SliderMotion(table2_slider(30.0), eps=0.0)
+
+
+class _UnscaledEvents(SliderMotion):
+    """Events ×80 (V_ref): 1e-12 is below their time resolution."""
+
+    def events(self, t, y, mode):
+        return super().events(t, y, mode) * self._V
+
+
+def test_an_event_that_cannot_be_located_to_tolerance_raises_instead_of_hanging():
+    # PETSc 3.18 retries an event location until |g| <= tol without limit: here it looped
+    # forever before the driver's bound on evaluations without an accepted step
+    motion = _UnscaledEvents(table2_slider(30.16))
+    with pytest.raises(HybridError, match="event location does not converge") as error:
+        integrate_hybrid(motion, motion.initial_state([0.01]), motion.slip_mode(), 10.0,
+                         rtol=1e-8, atol=1e-10)
+    assert 0 < error.value.t < 10 and error.value.result.t[-1] == error.value.t

@@ -53,6 +53,11 @@ DEFAULT_OPTIONS = {
     "ts_event_tol": 1e-12,
 }
 
+# Right-hand sides evaluated without an accepted step after which the run is given up:
+# PETSc 3.18 retries an event location until |g| <= tol, with no limit, so a tolerance below
+# what the time resolution allows (|dg/dt| × ulp(t)) would loop forever
+_MAX_LOCATION_TRIES = 5000
+
 # Events this close in time (relative to t_end) happen "at the same instant" for the guard
 # against a mode re-entered without the time advancing.
 _SAME_INSTANT = 1e-9
@@ -133,6 +138,10 @@ class HybridError(DynamicsError):
         self.t, self.y, self.mode, self.result = t, y, mode, result
 
 
+class _Stop(Exception):
+    """Raised in a callback to end TSSolve (the segment's ``failure`` says why)."""
+
+
 class _History:
     """Recorded times, states, modes and observations, plus the run's counters."""
 
@@ -175,9 +184,19 @@ class _Segment:
         self.left_after: typing.Optional[float] = None  # time to an event starting at zero
         # found negative: then the mode was left at once, or left and re-entered in that time
         self.dt_max = 0.0
+        self.locating = 0  # event evaluations since the last accepted step
 
     def _rhs(self, ts, t, x, f):
         self.history.rhs_evaluations += 1
+        self.locating += 1  # reset by each accepted step
+        if self.locating > _MAX_LOCATION_TRIES and self.failure is None:
+            self.failure = (f"no step accepted in {_MAX_LOCATION_TRIES} evaluations at "
+                            f"t = {t:.15g} in mode {self.mode!r} (event values "
+                            f"{np.asarray(self.g).tolist()}): the event location does not "
+                            f"converge; raise the event tolerance (-<prefix>ts_event_tol, now "
+                            f"{self.event_tol:g}) or scale the event functions")
+        if self.failure is not None:
+            raise _Stop  # ends TSSolve: converged reasons do not end the location loop
         f.setArray(self.system.rhs(t, x.getArray(readonly=True), self.mode))
 
     def _events(self, ts, t, x, fvalue):
@@ -187,6 +206,7 @@ class _Segment:
         self.fired = sorted(int(k) for k in fired)
 
     def _post_step(self, ts):
+        self.locating = 0
         if self.pending.any():  # PETSc skips events that start at zero: watch them here
             g = np.asarray(self.g, dtype=float)
             wrong = self.pending & (g < -self.event_tol)
@@ -248,9 +268,12 @@ class _Segment:
                     self.failure = (f"TS stopped at t = {ts.getTime():.12g} in mode "
                                     f"{self.mode!r} with reason {reason} after "
                                     f"{ts.getStepNumber()} steps")
+        except _Stop:
+            pass
         except PETSc.Error as error:  # e.g. a NaN in the error estimate
-            self.failure = (f"TS failed in mode {self.mode!r} after t = {self.t:.12g} with "
-                            f"PETSc error {error.ierr}")
+            if self.failure is None:
+                self.failure = (f"TS failed in mode {self.mode!r} after t = {self.t:.12g} "
+                                f"with PETSc error {error.ierr}")
         finally:
             self.history.steps += ts.getStepNumber()
             self.history.rejected_steps += ts.getStepRejections()
