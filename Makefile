@@ -45,6 +45,7 @@ benchmark: setup
 	$(PY) benchmarks/bench_steady.py --out $(OUT)/benchmarks
 	$(PY) benchmarks/bench_stability.py --out $(OUT)/benchmarks
 	$(PY) benchmarks/bench_dynamics.py --out $(OUT)/benchmarks
+	$(PY) benchmarks/bench_oscillators.py --out $(OUT)/benchmarks
 
 clean:
 	rm -rf .venv results *.egg-info
