@@ -509,7 +509,7 @@ class SliderMotion:
     State :math:`y = (q, \dot q)` with :math:`q = (y_s, y_1..y_m, x_1..x_m)` (eq. 8). The mode is
     a tuple with one entry per contact: +1 / −1 slipping with :math:`V_{rel} \gtrless 0`, 0
     sticking (:math:`\dot y_i = V_{ref,i}`, eq. 5). Events (each >= 0 while the mode holds,
-    scaled by :math:`V_{ref,i}` and :math:`\mu_s N_{o,i}`): slipping, :math:`\pm V_{rel,i}`;
+    scaled by :math:`V_{ref,i}` and :math:`\mu_s \max|N_i|`): slipping, :math:`\pm V_{rel,i}`;
     sticking, :math:`\mu_s |N_i| - |F_{req,i}|` with the
     force that keeps the contact on the surface,
     :math:`F_{req,i} = c_{t,i}(V_{ref,i} - \dot y_s) + k_{t,i}(y_i - y_s)`. At an event a
@@ -545,7 +545,8 @@ class SliderMotion:
         self._h, self._lam, self._V = get("roughness"), get("wavelength"), get("surface_speed")
         self._f = get("normal_force_factor")
         self._mu_s = np.array([c.static_coefficient for c in slider.contacts])
-        self._force_scale = np.maximum(self._mu_s, 1e-3) * self._N0
+        self._force_scale = np.maximum(self._mu_s, 1e-3) * np.array(
+            [c.normal_load + c.fluctuation_amplitude() for c in slider.contacts])
         self._tangential = slice(1, m + 1)
         self._normal = slice(m + 1, 2 * m + 1)
 
@@ -604,7 +605,7 @@ class SliderMotion:
             return np.zeros(0)
         _, _, N, V_rel, F_req, _ = self._contact_state(t, y)
         sign = np.array(mode, dtype=float)
-        # scaled to O(1) (by V_ref and μ_s N_o) so that one absolute event tolerance fits all
+        # scaled to O(1) (by V_ref and μ_s max|N|) so that one absolute event tolerance fits all
         return np.where(sign == 0, (self._mu_s * np.abs(N) - np.abs(F_req)) / self._force_scale,
                         sign * V_rel / self._V)
 
