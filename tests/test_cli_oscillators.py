@@ -4,8 +4,6 @@ import csv
 import json
 import math
 import pathlib
-import shutil
-import tempfile
 
 import pytest
 
@@ -15,13 +13,8 @@ from fenicsfriction.cli import main
 
 
 @pytest.fixture
-def out_dir() -> pathlib.Path:
-    comm = MPI.COMM_WORLD
-    path = pathlib.Path(comm.bcast(tempfile.mkdtemp(prefix="ff-osc-") if comm.rank == 0 else None))
-    yield path / "out"
-    comm.Barrier()
-    if comm.rank == 0:
-        shutil.rmtree(path, ignore_errors=True)
+def out_dir(shared_tmp_path) -> pathlib.Path:
+    return shared_tmp_path / "out"
 
 
 def test_stability_map_cli_finds_the_principal_band_by_both_methods(out_dir):
