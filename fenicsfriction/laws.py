@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import numbers
 import typing
 
 import numpy as np
@@ -45,6 +46,13 @@ def check(name: str, value, ok: bool, allowed: str) -> None:
     """Raise ``ValueError("name=value is invalid: allowed")`` unless ``ok``."""
     if not ok:
         raise ValueError(f"{name}={value!r} is invalid: {allowed}")
+
+
+def check_positive(name: str, value, strict: bool = True) -> None:
+    """:func:`check` that ``value`` is a finite real number, > 0 (``strict``) or >= 0."""
+    ok = isinstance(value, numbers.Real) and math.isfinite(value) \
+        and (value > 0 if strict else value >= 0)
+    check(name, value, ok, f"must be a finite number {'>' if strict else '>='} 0")
 
 
 def _is_ufl(*xs) -> bool:

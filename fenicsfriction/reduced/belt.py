@@ -36,7 +36,7 @@ import typing
 import numpy as np
 
 from fenicsfriction import laws
-from fenicsfriction.laws import check
+from fenicsfriction.laws import check, check_positive
 from fenicsfriction.reduced.events import HybridEvent, HybridResult, integrate_hybrid
 
 __all__ = ["BeltOscillator", "BeltResult", "LimitCycle", "belt_summary", "displacement_extrema",
@@ -94,12 +94,6 @@ class LimitCycle:
     period_change: float = 0.0
 
 
-def _positive(name: str, value, strict: bool = True) -> None:
-    ok = isinstance(value, (int, float)) and math.isfinite(value) \
-        and (value > 0 if strict else value >= 0)
-    check(name, value, ok, f"must be a finite number {'>' if strict else '>='} 0")
-
-
 @dataclasses.dataclass
 class BeltOscillator:
     """Mass-spring-damper on a belt with a friction coefficient law (a
@@ -131,18 +125,18 @@ class BeltOscillator:
     size: typing.ClassVar[int] = 2
 
     def __post_init__(self):
-        _positive("m", self.m)
-        _positive("k", self.k)
-        _positive("c", self.c, strict=False)
-        _positive("N", self.N)
-        _positive("v_belt", self.v_belt)
+        check_positive("m", self.m)
+        check_positive("k", self.k)
+        check_positive("c", self.c, strict=False)
+        check_positive("N", self.N)
+        check_positive("v_belt", self.v_belt)
         check("friction", self.friction,
               callable(self.friction) and hasattr(self.friction, "derivative"),
               "must be a friction coefficient law of fenicsfriction.laws")
         mu_0 = float(self.friction(0.0))
         if self.mu_static is None:
             self.mu_static = mu_0
-        _positive("mu_static", self.mu_static, strict=False)
+        check_positive("mu_static", self.mu_static, strict=False)
         check("mu_static", self.mu_static, self.mu_static >= mu_0,
               f"must be >= mu(0) = {mu_0:g}: sticking may not hold less than sliding starts with")
 
@@ -304,7 +298,7 @@ class BeltOscillator:
                       prefix=prefix)
         if method == "regularised":
             eps = 1e-3 * self.v_belt if eps is None else eps
-            _positive("eps", eps)
+            check_positive("eps", eps)
             hybrid = integrate_hybrid(_Regularised(self, eps), [x0, v0], "smooth", t_end,
                                       **kwargs)
             force = self.regularised_force(self.v_belt - hybrid.y[:, 1], eps)

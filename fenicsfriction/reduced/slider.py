@@ -56,7 +56,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from fenicsfriction import laws
-from fenicsfriction.laws import check
+from fenicsfriction.laws import check, check_positive
 
 __all__ = ["AveragedStability", "Contact", "FloquetStability", "ScaledFriction", "Slider",
            "StabilityMap", "stability_map", "table2_slider", "TABLE2_READINGS"]
@@ -82,14 +82,6 @@ class ScaledFriction:
 
     def derivative(self, speed):
         return self.law.derivative(np.asarray(speed, dtype=float) / self.unit) / self.unit
-
-
-def _positive(name: str, value: float) -> None:
-    check(name, value, math.isfinite(value) and value > 0, "must be a positive number")
-
-
-def _non_negative(name: str, value: float) -> None:
-    check(name, value, math.isfinite(value) and value >= 0, "must be a number >= 0")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -124,11 +116,11 @@ class Contact:
 
     def __post_init__(self):
         for name in ("mass", "k_n", "normal_load", "wavelength", "surface_speed"):
-            _positive(name, getattr(self, name))
+            check_positive(name, getattr(self, name))
         for name in ("k_t", "c_t", "c_n", "roughness", "normal_force_factor"):
-            _non_negative(name, getattr(self, name))
+            check_positive(name, getattr(self, name), strict=False)
         if self.mu_static is not None:
-            _non_negative("mu_static", self.mu_static)
+            check_positive("mu_static", self.mu_static, strict=False)
 
     @property
     def omega(self) -> float:
@@ -205,9 +197,9 @@ class Slider:
 
     def __init__(self, mass: float, stiffness: float, damping: float,
                  contacts: typing.Sequence[Contact]):
-        _positive("mass", mass)
-        _non_negative("stiffness", stiffness)
-        _non_negative("damping", damping)
+        check_positive("mass", mass)
+        check_positive("stiffness", stiffness, strict=False)
+        check_positive("damping", damping, strict=False)
         contacts = tuple(contacts)
         check("contacts", contacts, len(contacts) > 0 and all(
             isinstance(c, Contact) for c in contacts), "must be one or more Contact")
