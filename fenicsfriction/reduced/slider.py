@@ -47,6 +47,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import time
 import typing
 
 import numpy as np
@@ -205,18 +206,18 @@ class Slider:
             isinstance(c, Contact) for c in contacts), "must be one or more Contact")
         self.mass, self.stiffness, self.damping = float(mass), float(stiffness), float(damping)
         self.contacts = contacts
+        self._tangential_system = self._assemble_tangential()
+        self._slopes = np.array([c.slope() for c in contacts])
 
     @property
     def m(self) -> int:
         return len(self.contacts)
 
-    def with_surface_speed(self, scale: float) -> "Slider":
-        """The same slider with every surface speed multiplied by ``scale``."""
-        return Slider(self.mass, self.stiffness, self.damping, [
-            dataclasses.replace(c, surface_speed=c.surface_speed * scale) for c in self.contacts])
-
     def tangential_matrices(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """M̂, Ĉ, K̂ of the tangential co-ordinates (y_s, y_1..y_m) (eqs. 9-10)."""
+        """M̂, Ĉ, K̂ of the tangential co-ordinates (y_s, y_1..y_m) (eqs. 9-10), fresh copies."""
+        return tuple(A.copy() for A in self._tangential_system)
+
+    def _assemble_tangential(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         n = self.m + 1
         M, C, K = np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n))
         M[0, 0], C[0, 0], K[0, 0] = self.mass, self.damping, self.stiffness
@@ -251,8 +252,12 @@ class Slider:
 
     def periodic_damping(self, t: float) -> np.ndarray:
         """Ĉ + diag(0, S_i N_i(t)): the damping of the linear periodic system."""
-        _, C, _ = self.tangential_matrices()
-        C[1:, 1:] += np.diag([c.slope() * c.normal_force(t) for c in self.contacts])
+        return self._friction_damping([c.normal_force(t) for c in self.contacts])
+
+    def _friction_damping(self, normal_forces) -> np.ndarray:
+        """Ĉ + diag(0, S_i N_i): linearised friction adds S_i N_i to each contact's damping."""
+        C = self._tangential_system[1].copy()
+        C[1:, 1:] += np.diag(self._slopes * np.asarray(normal_forces, dtype=float))
         return C
 
     # --- first-order averaging -------------------------------------------------------------
@@ -265,13 +270,12 @@ class Slider:
         σ = ω_k − (Ω_i ± Ω_j); the other cases contribute −ξ_ii/2. The largest real part wins.
         """
         Omega, R = self.natural_frequencies()
-        _, C, _ = self.tangential_matrices()
-        C[1:, 1:] += np.diag([c.slope() * c.normal_load for c in self.contacts])
+        C = self._friction_damping([c.normal_load for c in self.contacts])
         xi = np.diag(R.T @ C @ R)
         growth, case, gamma_crit = -float(xi.min()) / 2, self._damping_case(Omega), None
         gammas = []
         for k, contact in enumerate(self.contacts, start=1):
-            gamma = -contact.slope() * contact.fluctuation_amplitude()   # γ_k of eq. 26
+            gamma = -self._slopes[k - 1] * contact.fluctuation_amplitude()   # γ_k of eq. 26
             G = gamma * np.outer(R[k], R[k])
             gammas.append(G)
             for i in range(len(Omega)):
@@ -402,8 +406,6 @@ def stability_map(make_slider: typing.Callable[[float], Slider], omegas: typing.
             (:meth:`Slider.floquet`).
         tol: the band edges are bisected to this width in ω.
     """
-    import time
-
     omegas = np.asarray(omegas, dtype=float)
     check("omegas", omegas.size, omegas.size >= 2 and np.all(np.diff(omegas) > 0),
           "needs two or more increasing frequencies")
@@ -566,7 +568,10 @@ class SliderMotion:
     def friction(self, t: float, y: np.ndarray, mode) -> np.ndarray:
         """Friction force on each contact (+ along the surface's motion); the reaction F_req
         for a sticking contact."""
-        _, _, N, V_rel, F_req, _ = self._contact_state(t, y)
+        return self._friction(self._contact_state(t, y), mode)
+
+    def _friction(self, state: tuple, mode) -> np.ndarray:
+        _, _, N, V_rel, F_req, _ = state
         mu = np.array([c.friction(V) for c, V in zip(self.slider.contacts, V_rel, strict=True)])
         if self.eps is not None:
             return mu * N * V_rel / np.sqrt(V_rel * V_rel + self.eps * self.eps)
@@ -578,10 +583,11 @@ class SliderMotion:
 
     def rhs(self, t: float, y: np.ndarray, mode) -> np.ndarray:
         n = self.size // 2
-        q, v, _, _, _, normal_spring = self._contact_state(t, y)
+        state = self._contact_state(t, y)
+        q, v, normal_spring = state[0], state[1], state[5]
         force = -self._C @ v - self._K @ q
         force[self._normal] = -normal_spring            # the normal d.o.f. see the surface
-        force[self._tangential] += self.friction(t, y, mode)
+        force[self._tangential] += self._friction(state, mode)
         a = force * self._Minv
         if self.eps is None:
             stick = np.flatnonzero(np.array(mode) == 0)
