@@ -479,13 +479,6 @@ def _run_stability_map(args: argparse.Namespace, log: logging.Logger) -> int:
     return 0
 
 
-def _stick_intervals(t: np.ndarray, stuck: np.ndarray) -> list[tuple[float, float]]:
-    """Intervals of t where ``stuck`` holds (events are recorded twice, so edges are exact)."""
-    edges = np.flatnonzero(np.diff(np.r_[0, stuck.astype(int), 0]))
-    return [(float(t[a]), float(t[min(b, len(t) - 1)])) for a, b in zip(edges[::2], edges[1::2],
-                                                                        strict=True)]
-
-
 def _run_oscillator(args: argparse.Namespace, log: logging.Logger) -> int:
     import csv
 
@@ -493,7 +486,7 @@ def _run_oscillator(args: argparse.Namespace, log: logging.Logger) -> int:
     from fenicsfriction.laws import check
     from fenicsfriction.plotting import plot_oscillator
     from fenicsfriction.reduced import BeltOscillator, belt_summary
-    from fenicsfriction.reduced.events import HybridError, integrate_hybrid
+    from fenicsfriction.reduced.events import HybridError, integrate_hybrid, mode_intervals
     from fenicsfriction.reduced.slider import SliderMotion, table2_slider
 
     check("--t-end", args.t_end, args.t_end > 0, "must be > 0")
@@ -523,7 +516,8 @@ def _run_oscillator(args: argparse.Namespace, log: logging.Logger) -> int:
                                   sample_dt=args.sample_dt)
         t, x, v, force = run.t, run.x, run.v, run.friction_force
         stick, surface = run.stick_intervals, args.v_belt
-        summary = {**belt_summary(run), "stick_fraction": belt_summary(run)["stick_fraction_run"],
+        summary = belt_summary(run)
+        summary = {**summary, "stick_fraction": summary["stick_fraction_run"],
                    "effective_damping": oscillator.effective_damping(),
                    "steady_sliding_stable": oscillator.is_steady_sliding_stable(),
                    "linear_eigenvalues": [[s.real, s.imag]
@@ -551,8 +545,9 @@ def _run_oscillator(args: argparse.Namespace, log: logging.Logger) -> int:
         force = np.array([motion.friction(ti, yi, mode)[0]
                           for ti, yi, mode in zip(t, y, run.modes, strict=True)])
         normal = np.array([motion.normal_forces(ti, yi)[0] for ti, yi in zip(t, y, strict=True)])
-        stuck = np.array([args.eps is None and mode[0] == 0 for mode in run.modes])
-        stick, surface = _stick_intervals(t, stuck), slider.contacts[0].surface_speed
+        stuck = np.array([mode[0] == 0 for mode in run.modes])
+        stick = mode_intervals(run, lambda mode: mode[0] == 0)
+        surface = slider.contacts[0].surface_speed
         omega, _ = slider.natural_frequencies()
         late = t >= t[-1] / 2
         summary = {"omega": args.omega, "reading": args.reading,

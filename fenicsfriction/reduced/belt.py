@@ -37,7 +37,8 @@ import numpy as np
 
 from fenicsfriction import laws
 from fenicsfriction.laws import check, check_positive
-from fenicsfriction.reduced.events import HybridEvent, HybridResult, integrate_hybrid
+from fenicsfriction.reduced.events import (HybridEvent, HybridResult, integrate_hybrid,
+                                           mode_intervals)
 
 __all__ = ["BeltOscillator", "BeltResult", "LimitCycle", "belt_summary", "displacement_extrema",
            "limit_cycle"]
@@ -311,7 +312,7 @@ class BeltOscillator:
             hybrid = integrate_hybrid(self, [x0, v0], mode0, t_end, **kwargs)
             force = np.array([self.friction_force(y, mode)
                               for y, mode in zip(hybrid.y, hybrid.modes, strict=True)])
-            stick = _stick_intervals(mode0, hybrid.events, float(hybrid.t[-1]))
+            stick = mode_intervals(hybrid, lambda mode: mode == STICK)
         return BeltResult(t=hybrid.t, x=hybrid.y[:, 0], v=hybrid.y[:, 1],
                           modes=np.array(hybrid.modes), friction_force=force,
                           events=hybrid.events, stick_intervals=stick, hybrid=hybrid,
@@ -336,17 +337,6 @@ class _Regularised:
 
     def switch(self, t, y, mode, fired):
         raise AssertionError("the regularised law has no events")
-
-
-def _stick_intervals(mode0, events: list[HybridEvent], t_end: float):
-    intervals, start, mode = [], 0.0, mode0
-    for event in events:
-        if event.mode_before == STICK:
-            intervals.append((start, event.t))
-        start, mode = event.t, event.mode_after
-    if mode == STICK:
-        intervals.append((start, t_end))
-    return intervals
 
 
 def displacement_extrema(result: BeltResult) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -40,7 +40,7 @@ from fenicsfriction.dynamics import DynamicsError
 from fenicsfriction.laws import check
 
 __all__ = ["DEFAULT_OPTIONS", "HybridError", "HybridEvent", "HybridResult", "HybridSystem",
-           "integrate_hybrid"]
+           "integrate_hybrid", "mode_intervals"]
 
 DEFAULT_OPTIONS = {
     "ts_type": "rk",
@@ -370,3 +370,19 @@ def integrate_hybrid(system: HybridSystem, y0, mode0, t_end: float, *, rtol: flo
         y, mode = y_new, mode_new
         if t >= t_end:
             return history.result()
+
+
+def mode_intervals(result: HybridResult, holds: typing.Callable[[object], bool]
+                   ) -> list[tuple[float, float]]:
+    """The (start, end) time intervals of a run during which ``holds(mode)`` is true, from the
+    located events (exact to the event tolerance), e.g. a contact's stick phases."""
+    intervals, start = [], float(result.t[0]) if holds(result.modes[0]) else None
+    for event in result.events:
+        before, after = holds(event.mode_before), holds(event.mode_after)
+        if before and not after:
+            intervals.append((start, event.t))
+        elif after and not before:
+            start = event.t
+    if holds(result.modes[-1]):
+        intervals.append((start, float(result.t[-1])))
+    return intervals
