@@ -184,7 +184,7 @@ class _Segment:
         self.left_after: typing.Optional[float] = None  # time to an event starting at zero
         # found negative: then the mode was left at once, or left and re-entered in that time
         self.dt_max = 0.0
-        self.locating = 0  # event evaluations since the last accepted step
+        self.locating = 0  # right-hand sides evaluated since the last accepted step
 
     def _rhs(self, ts, t, x, f):
         self.history.rhs_evaluations += 1
