@@ -452,7 +452,7 @@ def _run_stability_map(args: argparse.Namespace, log: logging.Logger) -> int:
     from fenicsfriction import io
     from fenicsfriction.laws import check
     from fenicsfriction.plotting import plot_stability_map
-    from fenicsfriction.reduced.slider import stability_map, table2_slider
+    from fenicsfriction.reduced.slider import TABLE2_PAPER_BANDS, stability_map, table2_slider
 
     lo, hi = args.omega_range
     check("--omega-range", f"{lo:g}:{hi:g}", 0 < lo < hi, "needs 0 < LO < HI")
@@ -465,7 +465,7 @@ def _run_stability_map(args: argparse.Namespace, log: logging.Logger) -> int:
         per_omega = result.seconds[method] / args.samples * 1e3
         log.info(f"{method}: unstable bands {bands} ({per_omega:.2f} ms per ω_o)")
     out: pathlib.Path = args.out
-    paper = [(30.74, 30.83), (32.72, 32.83), (62.70, 64.45)]
+    paper = [list(band) for band in TABLE2_PAPER_BANDS]
     slider = table2_slider(lo, reading=args.reading)
     io.write_json(out / "stability_map.json", {
         "reading": args.reading, "natural_frequencies": slider.natural_frequencies()[0],

@@ -64,6 +64,43 @@ def test_event_location_converges_with_the_step_tolerance():
     assert errors[2] < 1e-10
 
 
+def test_steep_events_below_the_time_resolution_are_located_with_a_relaxed_tolerance():
+    # ω = 1e3: |dg/dt| = ω² = 1e6 at the turning points, so |g| <= 1e-12 needs the time to
+    # 1e-18, below ulp(t); PETSc 3.18 would retry forever (or accept a larger |g|)
+    class Steep(HalfSwings):
+        def rhs(self, t, y, mode):
+            return np.array([y[1], -1e6 * y[0]])
+
+    result = integrate_hybrid(Steep(), [1.0, 0.0], "down", 0.5)
+    times = np.array([event.t for event in result.events])
+    k = np.arange(1, times.size + 1)
+    assert times.size == int(0.5 * 1e3 / np.pi) and result.relaxed_locations > 0
+    # the same relative accuracy as at ω = 2 (test above: 1e-8 in time there, ×2/ω here)
+    assert np.abs(times - k * np.pi / 1e3).max() < 1e-10
+
+
+class Tangent:
+    """y' = 2t from y(0) = 0: g = y leaves its starting zero tangentially (no crossing)."""
+
+    size = 1
+
+    def rhs(self, t, y, mode):
+        return np.array([2.0 * t])
+
+    def events(self, t, y, mode):
+        return np.array([y[0]])
+
+    def switch(self, t, y, mode, fired):
+        raise AssertionError(f"no event expected, fired {fired} at t = {t}")
+
+
+def test_an_event_leaving_its_starting_zero_tangentially_does_not_fire():
+    # a first step of 1e-7 gives g = 1e-14 < tol: PETSc reports that as an event
+    result = integrate_hybrid(Tangent(), [0.0], "up", 1.0, dt0=1e-7)
+    assert result.events == [] and result.t[-1] == 1.0
+    assert abs(result.y[-1, 0] - 1.0) < 1e-12
+
+
 def test_dense_samples_follow_the_closed_form():
     result = integrate_hybrid(HalfSwings(), [1.0, 0.0], "down", 5.0, sample_dt=0.01,
                               observe=lambda t, y, mode: {"energy": y[1]**2 + (OMEGA * y[0])**2})

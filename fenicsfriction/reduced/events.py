@@ -13,7 +13,15 @@ depends on a discrete *mode* :math:`m` (any hashable value the system defines, e
 3. restarts a new TS from there, until ``t_end``.
 
 The switch is responsible for picking a consistent mode: one whose event functions are >= 0 at
-the switch and stay so. Two failures are caught and reported (:class:`HybridError`, naming the
+the switch and stay so.
+
+The event tolerance (``ts_event_tol``: |g| below it counts as zero) cannot be met once it is
+below what the time resolution allows, |dg/dt| × ulp(t): late in a long run, or where g is
+steep. PETSc 3.18 then retries the location without end (or accepts a time whose |g| exceeds
+the tolerance). The driver watches for both: a location that makes no progress is resumed from
+the last accepted step with the tolerance raised ×100 (up to ``_MAX_EVENT_TOL``; each such
+relaxation is counted in ``HybridResult.relaxed_locations``), and the mode entered after an
+event is checked against the tolerance its location actually achieved. Two failures are caught and reported (:class:`HybridError`, naming the
 time and the mode) instead of looping: a mode that starts with some :math:`g_k < 0` or whose
 :math:`g_k` starting at zero turns negative at once, and a mode entered twice at the same
 instant (events re-firing without time advancing: an inconsistent switch or Zeno chattering).
@@ -53,10 +61,17 @@ DEFAULT_OPTIONS = {
     "ts_event_tol": 1e-12,
 }
 
-# Right-hand sides evaluated without an accepted step after which the run is given up:
+# Right-hand sides evaluated without an accepted step after which a location counts as stalled:
 # PETSc 3.18 retries an event location until |g| <= tol, with no limit, so a tolerance below
 # what the time resolution allows (|dg/dt| × ulp(t)) would loop forever
-_MAX_LOCATION_TRIES = 5000
+_MAX_LOCATION_TRIES = 1000
+
+# A stalled location is resumed with the event tolerance ×_RELAX, up to this; beyond, it fails
+_RELAX = 100.0
+_MAX_EVENT_TOL = 1e-6
+
+# Segments in a row that PETSc ends at an event still within the tolerance of its starting zero
+_MAX_SPURIOUS = 100
 
 # Events this close in time (relative to t_end) happen "at the same instant" for the guard
 # against a mode re-entered without the time advancing.
@@ -111,7 +126,10 @@ class HybridResult:
         steps: accepted TS steps, all segments together (event-location steps included).
         rejected_steps: steps rejected by the error control.
         rhs_evaluations: calls of ``system.rhs``.
-        segments: smooth segments integrated (one more than the events, unless stopped).
+        segments: smooth segments integrated (one more than the events, unless stopped, plus
+            one per relaxed location).
+        relaxed_locations: event locations that stalled at the event tolerance (below the time
+            resolution there) and were completed with a larger one.
     """
 
     t: np.ndarray
@@ -123,6 +141,7 @@ class HybridResult:
     rejected_steps: int
     rhs_evaluations: int
     segments: int
+    relaxed_locations: int = 0
 
 
 class HybridError(DynamicsError):
@@ -154,6 +173,7 @@ class _History:
         self.events: list[HybridEvent] = []
         self.next_sample = 1  # index j of the next sample time j * sample_dt
         self.steps = self.rejected_steps = self.rhs_evaluations = self.segments = 0
+        self.relaxed_locations = 0
 
     def record(self, t: float, y: np.ndarray, mode) -> None:
         self.t.append(float(t))
@@ -166,7 +186,8 @@ class _History:
         return HybridResult(t=np.array(self.t), y=np.array(self.y), modes=list(self.modes),
                             events=list(self.events), observations=list(self.observations),
                             steps=self.steps, rejected_steps=self.rejected_steps,
-                            rhs_evaluations=self.rhs_evaluations, segments=self.segments)
+                            rhs_evaluations=self.rhs_evaluations, segments=self.segments,
+                            relaxed_locations=self.relaxed_locations)
 
 
 class _Segment:
@@ -174,7 +195,10 @@ class _Segment:
 
     Attributes after :meth:`run`: ``t``, ``y`` (the last accepted state: at the event, at t_end
     or before a failure), ``fired`` (event indices; empty at t_end), ``dt_max`` (largest
-    accepted step), ``failure`` (a message, or None).
+    accepted step), ``failure`` (a message, or None), ``stalled`` (the failure is an event
+    location that made no progress: resumable from ``t``, ``y`` with a larger tolerance),
+    ``spurious`` (PETSc ended the segment at events that have not left their starting zero:
+    the mode holds, resumable from ``t``, ``y``).
     """
 
     def __init__(self, system: HybridSystem, mode, history: _History):
@@ -185,11 +209,13 @@ class _Segment:
         # found negative: then the mode was left at once, or left and re-entered in that time
         self.dt_max = 0.0
         self.locating = 0  # right-hand sides evaluated since the last accepted step
+        self.stalled = self.spurious = False
 
     def _rhs(self, ts, t, x, f):
         self.history.rhs_evaluations += 1
         self.locating += 1  # reset by each accepted step
         if self.locating > _MAX_LOCATION_TRIES and self.failure is None:
+            self.stalled = True
             self.failure = (f"no step accepted in {_MAX_LOCATION_TRIES} evaluations at "
                             f"t = {t:.15g} in mode {self.mode!r} (event values "
                             f"{np.asarray(self.g).tolist()}): the event location does not "
@@ -203,7 +229,14 @@ class _Segment:
         fvalue[:] = self.g = self.system.events(t, x.getArray(readonly=True), self.mode)
 
     def _post_event(self, ts, fired, t, x, forward):
-        self.fired = sorted(int(k) for k in fired)
+        # PETSc counts |g| < tol as an event even for a g that started at zero and has not
+        # left that band yet. If it is still moving away from zero (up since the last
+        # accepted step) nothing crossed: the mode holds and the driver resumes it; if it is
+        # coming back, it is an event (e.g. a bounce below the tolerance's height)
+        g = np.asarray(self.g, dtype=float)
+        self.fired = sorted(int(k) for k in fired
+                            if not (self.pending[int(k)] and g[int(k)] > self.g_accepted[int(k)]))
+        self.spurious = not self.fired
 
     def _post_step(self, ts):
         self.locating = 0
@@ -218,6 +251,7 @@ class _Segment:
                 ts.setConvergedReason(PETSc.TS.ConvergedReason.CONVERGED_USER)
                 return
             self.pending &= ~(g > self.event_tol)
+        self.g_accepted = np.asarray(self.g, dtype=float).copy()
         t, t_prev = ts.getTime(), ts.getPrevTime()
         self.t, self.y = t, ts.getSolution().getArray(readonly=True).copy()
         self.dt_max = max(self.dt_max, t - t_prev)
@@ -232,7 +266,9 @@ class _Segment:
                 history.next_sample += 1
 
     def run(self, t0: float, y0: np.ndarray, t_end: float, dt: float, options: dict,
-            prefix: str) -> None:
+            prefix: str, event_tol: typing.Optional[float] = None) -> None:
+        """Integrate from (t0, y0) to the first event or t_end; ``event_tol`` overrides the
+        ``ts_event_tol`` option (which sets the base tolerance)."""
         self.t0, self.t, self.y = t0, t0, y0
         comm = MPI.COMM_SELF
         x = PETSc.Vec().createSeq(y0.size, comm=comm)
@@ -245,8 +281,9 @@ class _Segment:
         if g0.size:
             ts.setEventHandler([0] * g0.size, [True] * g0.size, self._events, self._post_event)
         with options_with_defaults(prefix, options) as opts:
-            self.event_tol = opts.getReal("ts_event_tol")
+            self.base_event_tol = opts.getReal("ts_event_tol")
             ts.setFromOptions()
+        self.event_tol = self.base_event_tol if event_tol is None else event_tol
         if g0.size:
             ts.setEventTolerances(tol=self.event_tol)
         wrong = np.flatnonzero(g0 < -self.event_tol)
@@ -254,7 +291,7 @@ class _Segment:
             self.failure = (f"mode {self.mode!r} is inconsistent at t = {t0:.12g}: its event "
                             f"functions {wrong.tolist()} are negative, {g0[wrong].tolist()}")
         self.pending = np.abs(g0) <= self.event_tol
-        self.g = g0
+        self.g = self.g_accepted = g0
         ts.setTime(t0)
         ts.setTimeStep(min(dt, t_end - t0))
         ts.setMaxTime(t_end)
@@ -338,20 +375,51 @@ def integrate_hybrid(system: HybridSystem, y0, mode0, t_end: float, *, rtol: flo
     def fail(message: str) -> typing.NoReturn:
         raise HybridError(message, t, y, mode, history.result())
 
+    event_tol = None  # None: the base tolerance; else what the last location achieved
+    spurious = 0  # segments in a row ended by a spurious event (see _Segment._post_event)
     while True:
         segment = _Segment(system, mode, history)
-        segment.run(t, y, t_end, dt, options, prefix)
+        segment.run(t, y, t_end, dt, options, prefix, event_tol)
         while segment.left_after is not None and segment.left_after > _SAME_INSTANT * t_end:
             dt = segment.left_after / 16  # look closer: the first step may have jumped over
             segment = _Segment(system, mode, history)  # a short excursion
-            segment.run(t, y, t_end, dt, options, prefix)
+            segment.run(t, y, t_end, dt, options, prefix, event_tol)
+        while segment.stalled and segment.event_tol < _MAX_EVENT_TOL:
+            # the location cannot reach |g| <= tol at this time resolution: resume from the
+            # last accepted step (same mode, nothing recorded twice) with a larger tolerance
+            history.relaxed_locations += 1
+            tol = min(segment.event_tol * _RELAX, _MAX_EVENT_TOL)
+            g = np.abs(np.asarray(system.events(segment.t, segment.y, mode), dtype=float))
+            close = np.flatnonzero((g <= tol) & ~segment.pending)
+            if close.size:  # that step is on the event already, to the larger tolerance
+                segment.fired, segment.failure, segment.stalled = close.tolist(), None, False
+                segment.event_tol = tol
+                break
+            resume_t, resume_y = segment.t, segment.y
+            segment = _Segment(system, mode, history)
+            segment.run(resume_t, resume_y, t_end, dt, options, prefix, tol)
         if segment.t != history.t[-1] or history.modes[-1] != mode:
             history.record(segment.t, segment.y, mode)
         t, y, dt = segment.t, segment.y, segment.dt_max or dt
         if segment.failure is not None:
             fail(segment.failure)
+        if segment.spurious:  # only events still at their starting zero: same mode, go on
+            spurious += 1
+            if spurious > _MAX_SPURIOUS:
+                fail(f"events of mode {mode!r} stay within the event tolerance of zero for "
+                     f"{_MAX_SPURIOUS} steps after t = {t:.12g}: the motion does not leave "
+                     f"the switching surface")
+            continue
+        spurious = 0
         if not segment.fired:
             return history.result()
+        # PETSc may accept a location whose |g| exceeds the tolerance (the time step reached
+        # its resolution): the next mode's events may start that far from zero
+        g = np.abs(np.asarray(system.events(t, y, mode), dtype=float))[segment.fired]
+        event_tol = min(max(segment.base_event_tol, 2.0 * float(g.max(initial=0.0))),
+                        _MAX_EVENT_TOL)
+        if event_tol == segment.base_event_tol:
+            event_tol = None
         if len(history.events) >= max_events:
             fail(f"more than max_events = {max_events} events by t = {t:.12g} (mode "
                  f"{mode!r}): chattering or Zeno behaviour?")

@@ -60,7 +60,8 @@ from fenicsfriction import laws
 from fenicsfriction.laws import check, check_positive
 
 __all__ = ["AveragedStability", "Contact", "FloquetStability", "ScaledFriction", "Slider",
-           "StabilityMap", "stability_map", "table2_slider", "TABLE2_READINGS"]
+           "StabilityMap", "stability_map", "stroboscopic_growth", "table2_slider",
+           "TABLE2_PAPER_BANDS", "TABLE2_READINGS"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -429,6 +430,28 @@ def stability_map(make_slider: typing.Callable[[float], Slider], omegas: typing.
     return StabilityMap(omegas, growth, bands, seconds)
 
 
+def stroboscopic_growth(t: np.ndarray, y: np.ndarray, period: float,
+                        t_from: float = 0.0) -> tuple[np.ndarray, np.ndarray, float]:
+    """Growth rate of a time response away from its periodic solution, from the samples at
+    the multiples of ``period``: d_k = |y(kT) − y((k−1)T)| grows like |ρ|^k for the largest
+    Floquet multiplier ρ, whatever the (unknown) periodic solution.
+
+    Returns:
+        (t_k, d_k, rate): the stroboscopic times and differences, and the least-squares slope
+        of log d_k over t_k >= ``t_from``.
+    """
+    on = np.isclose(t / period, np.round(t / period), rtol=0.0, atol=1e-9)
+    tk, yk = np.asarray(t)[on], np.asarray(y)[on]
+    _, first = np.unique(np.round(tk / period), return_index=True)  # events repeat times
+    tk, yk = tk[first], yk[first]
+    d = np.linalg.norm(np.diff(yk, axis=0), axis=1)
+    tk = tk[1:]
+    fit = (tk >= t_from) & (d > 0)
+    check("t", float(tk[-1]) if tk.size else 0.0, fit.sum() >= 2,
+          "needs two or more forcing periods sampled after t_from")
+    return tk, d, float(np.polyfit(tk[fit], np.log(d[fit]), 1)[0])
+
+
 def _bisect(f, a: float, b: float, tol: float) -> float:
     fa = f(a)
     while b - a > tol:
@@ -439,6 +462,9 @@ def _bisect(f, a: float, b: float, tol: float) -> float:
 
 
 # --- seed 004's numerical example (Table 2) ---------------------------------------------------
+
+#: The unstable bands seed 004 reports (§5) near Ω2 − Ω1, Ω2 + Ω1 and 2 Ω2.
+TABLE2_PAPER_BANDS = ((30.74, 30.83), (32.72, 32.83), (62.70, 64.45))
 
 #: Readings of seed 004's dimensionless model that the paper leaves open, by name:
 #: (normal_force_factor f_N, velocity unit U of eq. 59, end of eq. 59's sloping branch in its
@@ -520,15 +546,23 @@ class SliderMotion:
             :math:`X_i = V_{ref,i} t`.
         eps: None: true stick by events; > 0: no stick, the regularised law
             :math:`F = \mu(V) N\,V/\sqrt{V^2+\varepsilon^2}` (one mode, no events).
+        linearised: friction linearised about steady sliding (eq. 25),
+            :math:`F_i = (\mu^*_i - S_i \dot y_i) N_i(t)` with the signed N, no stick, no
+            events: the linear periodic system of :meth:`Slider.averaged` and
+            :meth:`Slider.floquet`, forcing included, integrated in time.
     """
 
     def __init__(self, slider: Slider, normal_force: str = "signed", coupled: bool = False,
-                 eps: typing.Optional[float] = None):
+                 eps: typing.Optional[float] = None, linearised: bool = False):
         check("normal_force", normal_force, normal_force in _NORMAL_FORCE_MODELS,
               f"must be one of {_NORMAL_FORCE_MODELS}")
         check("eps", eps, eps is None or (math.isfinite(eps) and eps > 0),
               "must be None (events) or a number > 0 (regularised law)")
+        check("linearised", linearised, not linearised or (
+            eps is None and normal_force == "signed" and not coupled),
+            "the linearised friction of eq. 25 takes the signed N, no eps and no coupling")
         self.slider, self.normal_force, self.coupled, self.eps = slider, normal_force, coupled, eps
+        self.linearised = linearised
         m = slider.m
         self.size = 2 * (2 * m + 1)
         self._M, self._C, self._K = slider.matrices()
@@ -539,6 +573,8 @@ class SliderMotion:
         self._h, self._lam, self._V = get("roughness"), get("wavelength"), get("surface_speed")
         self._f = get("normal_force_factor")
         self._mu_s = np.array([c.static_coefficient for c in slider.contacts])
+        self._mu_star = np.array([float(c.friction(c.surface_speed)) for c in slider.contacts])
+        self._slope = np.array([c.slope() for c in slider.contacts])
         self._force_scale = np.maximum(self._mu_s, 1e-3) * np.array(
             [c.normal_load + c.fluctuation_amplitude() for c in slider.contacts])
         self._tangential = slice(1, m + 1)
@@ -572,6 +608,8 @@ class SliderMotion:
 
     def _friction(self, state: tuple, mode) -> np.ndarray:
         _, _, N, V_rel, F_req, _ = state
+        if self.linearised:  # μ(V_rel) ≈ μ* + S (V_rel − V_ref) = μ* − S ẏ_i
+            return (self._mu_star - self._slope * (self._V - V_rel)) * N
         mu = np.array([c.friction(V) for c, V in zip(self.slider.contacts, V_rel, strict=True)])
         if self.eps is not None:
             return mu * N * V_rel / np.sqrt(V_rel * V_rel + self.eps * self.eps)
@@ -599,7 +637,7 @@ class SliderMotion:
         return out
 
     def events(self, t: float, y: np.ndarray, mode) -> np.ndarray:
-        if self.eps is not None:
+        if self.eps is not None or self.linearised:
             return np.zeros(0)
         _, _, N, V_rel, F_req, _ = self._contact_state(t, y)
         sign = np.array(mode, dtype=float)
