@@ -32,6 +32,7 @@ demo: setup
 	$(PY) -m fenicsfriction steady block --mu-max 1.55 --steps 31 --out $(OUT)/steady-block
 	$(PY) -m fenicsfriction stability block --mu-max 1.55 --steps 62 --out $(OUT)/stability-block
 	FENICSFRICTION_DEMO_OUT=$(OUT)/stick-slip-block $(MPIRUN) $(PY) demos/demo_block_stick_slip.py
+	FENICSFRICTION_DEMO_OUT=$(OUT)/slider $(MPIRUN) $(PY) demos/demo_slider_table2.py
 
 test-serial: setup
 	$(PY) -m pytest -q tests

@@ -266,3 +266,25 @@ def plot_stability_map(omega: np.ndarray, growth: dict, bands: dict, path,
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def plot_stroboscopic_growth(runs: dict, path) -> None:
+    """Distance of time responses from their periodic solution, |y(kT) − y((k−1)T)| at the
+    forcing periods (log scale), each with the line of its predicted rate.
+
+    Args:
+        runs: label -> (t_k, d_k, predicted rate).
+    """
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(8, 4))
+    for (label, (t, d, rate)), colour in zip(runs.items(), plt.rcParams["axes.prop_cycle"],
+                                             strict=False):
+        ax.semilogy(t, d, color=colour["color"], lw=0.9, label=label)
+        ax.semilogy(t, d[-1] * np.exp(rate * (t - t[-1])), color=colour["color"], lw=0.8,
+                    ls="--")
+    ax.set(xlabel="t", ylabel="|y(kT) − y((k−1)T)|",
+           title="linearised motion (solid) against the Floquet rate (dashed)")
+    ax.legend(fontsize="small")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

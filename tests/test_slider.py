@@ -86,6 +86,23 @@ def test_the_linearised_motion_integrated_in_time_grows_at_the_floquet_rate():
     assert rate == pytest.approx(slider.floquet().growth, rel=1e-4)
 
 
+def test_forced_response_is_the_periodic_motion_of_the_linear_system():
+    # constant μ: no slope, no parametric term, the linearised motion is exactly linear and
+    # its transient (heavily damped here) leaves the forced oscillation Im(Ŷ e^{iωt})
+    contact = Contact(mass=0.1, k_t=10.0, c_t=1.0, k_n=1.0, c_n=0.2, normal_load=5.0,
+                      roughness=0.1, wavelength=1.0, surface_speed=1.0,
+                      friction=laws.ConstantFriction(0.4))
+    slider = Slider(1.0, 2.0, 2.0, [contact])
+    motion = SliderMotion(slider, linearised=True)
+    result = integrate_hybrid(motion, motion.initial_state(), motion.slip_mode(), 40.0,
+                              rtol=1e-10, atol=1e-12, sample_dt=0.01)
+    late = result.t > 30.0  # the slowest transient decays like e^{-0.91 t}
+    Y = slider.forced_response()
+    exact = np.imag(np.outer(np.exp(1j * contact.omega * result.t[late]), Y))
+    deviation = result.y[late, :2] - slider.steady_sliding()
+    assert np.abs(deviation - exact).max() < 1e-6 * np.abs(Y).max()
+
+
 def test_steady_sliding_balances_the_mean_friction():
     slider = table2_slider(30.78)
     q = slider.steady_sliding()

@@ -21,8 +21,12 @@ steep. PETSc 3.18 then retries the location without end (or accepts a time whose
 the tolerance). The driver watches for both: a location that makes no progress is resumed from
 the last accepted step with the tolerance raised ×100 (up to ``_MAX_EVENT_TOL``; each such
 relaxation is counted in ``HybridResult.relaxed_locations``), and the mode entered after an
-event is checked against the tolerance its location actually achieved. Two failures are caught and reported (:class:`HybridError`, naming the
-time and the mode) instead of looping: a mode that starts with some :math:`g_k < 0` or whose
+event is checked against the tolerance its location actually achieved. An event function
+that starts at zero and stays within the tolerance while moving away from it (a tangential
+departure, as stick -> slip with μ(0) = μ_s) is not taken for an event.
+
+Two failures are caught and reported (:class:`HybridError`, naming the time and the mode)
+instead of looping: a mode that starts with some :math:`g_k < 0` or whose
 :math:`g_k` starting at zero turns negative at once, and a mode entered twice at the same
 instant (events re-firing without time advancing: an inconsistent switch or Zeno chattering).
 ``max_events`` bounds the number of events in all.

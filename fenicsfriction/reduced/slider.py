@@ -251,6 +251,23 @@ class Slider:
         rhs = np.r_[0.0, [c.friction(c.surface_speed) * c.normal_load for c in self.contacts]]
         return np.linalg.solve(K, rhs)
 
+    def forced_response(self) -> np.ndarray:
+        """Complex amplitudes Ŷ of the tangential co-ordinates' forced oscillation about steady
+        sliding, q − q̄ = Im(Ŷ e^{iωt}), driven by β_i = μ*_i × the normal-force fluctuation
+        (eqs. 25-26) with the mean damping Ĉ + diag(S_i N_o,i); the parametric term γ_i is a
+        higher-order correction. |ω Ŷ_i| against V_ref,i says whether the linear analysis'
+        assumption of continuous sliding (V_rel > 0) holds on the forced motion itself."""
+        omega = self.contacts[0].omega
+        check("contacts", [c.omega for c in self.contacts],
+              all(math.isclose(c.omega, omega, rel_tol=1e-12) for c in self.contacts),
+              "the forced response needs one forcing frequency for all contacts")
+        M, _, K = self.tangential_matrices()
+        C = self._friction_damping([c.normal_load for c in self.contacts])
+        # N − N_o = f_N m ẍ with ẍ = Im(−ω² X̂ e^{iωt}) (eq. 17), times μ*
+        force = np.r_[0.0, [float(c.friction(c.surface_speed)) * c.normal_force_factor
+                            * c.mass * -omega**2 * c.normal_amplitude() for c in self.contacts]]
+        return np.linalg.solve(K - omega**2 * M + 1j * omega * C, force)
+
     def periodic_damping(self, t: float) -> np.ndarray:
         """Ĉ + diag(0, S_i N_i(t)): the damping of the linear periodic system."""
         return self._friction_damping([c.normal_force(t) for c in self.contacts])
