@@ -542,9 +542,9 @@ def _run_oscillator(args: argparse.Namespace, log: logging.Logger) -> int:
             run = error.result
         n = motion.size // 2
         t, y = run.t, run.y
-        force = np.array([motion.friction(ti, yi, mode)[0]
-                          for ti, yi, mode in zip(t, y, run.modes, strict=True)])
-        normal = np.array([motion.normal_forces(ti, yi)[0] for ti, yi in zip(t, y, strict=True)])
+        forces = np.array([motion.contact_forces(ti, yi, mode)
+                           for ti, yi, mode in zip(t, y, run.modes, strict=True)])
+        normal, force = forces[:, 0, 0], forces[:, 1, 0]
         stuck = np.array([mode[0] == 0 for mode in run.modes])
         stick = mode_intervals(run, lambda mode: mode[0] == 0)
         surface = slider.contacts[0].surface_speed

@@ -139,15 +139,22 @@ class Contact:
         return self.roughness * (self.k_n + 1j * self.c_n * w) \
             / (self.k_n - self.mass * w * w + 1j * self.c_n * w)
 
+    def normal_fluctuation(self) -> complex:
+        """Complex amplitude N̂ = −f_N m ω² X̂ of N − N_o = f_N m ẍ = Im(N̂ e^{iωt})."""
+        return -self.normal_force_factor * self.mass * self.omega**2 * self.normal_amplitude()
+
     def normal_force(self, t):
         """N(t) = N_o + f_N m ẍ on the steady normal response (eq. 21)."""
-        w = self.omega
-        x_ddot = np.imag(-w * w * self.normal_amplitude() * np.exp(1j * w * np.asarray(t)))
-        return self.normal_load + self.normal_force_factor * self.mass * x_ddot
+        return self.normal_load + np.imag(
+            self.normal_fluctuation() * np.exp(1j * self.omega * np.asarray(t)))
 
     def fluctuation_amplitude(self) -> float:
         """|N − N_o| at its maximum: f_N m ω² |X̂| (M_i ω_i² of eq. 26)."""
-        return self.normal_force_factor * self.mass * self.omega**2 * abs(self.normal_amplitude())
+        return abs(self.normal_fluctuation())
+
+    def mu_star(self) -> float:
+        """μ*_i = μ(V_ref,i), the coefficient of steady sliding (eq. 23)."""
+        return float(self.friction(self.surface_speed))
 
     def slope(self) -> float:
         """S_i = dμ/dv at v = V_ref,i (eq. 24)."""
@@ -208,7 +215,7 @@ class Slider:
         self.mass, self.stiffness, self.damping = float(mass), float(stiffness), float(damping)
         self.contacts = contacts
         self._tangential_system = self._assemble_tangential()
-        self._slopes = np.array([c.slope() for c in contacts])
+        self.slopes = np.array([c.slope() for c in contacts])  # S_i (eq. 24)
 
     @property
     def m(self) -> int:
@@ -248,7 +255,7 @@ class Slider:
     def steady_sliding(self) -> np.ndarray:
         """Mean tangential position: K̂ q = (0, μ(V_ref,i) N_o,i) (eq. 13)."""
         _, _, K = self.tangential_matrices()
-        rhs = np.r_[0.0, [c.friction(c.surface_speed) * c.normal_load for c in self.contacts]]
+        rhs = np.r_[0.0, [c.mu_star() * c.normal_load for c in self.contacts]]
         return np.linalg.solve(K, rhs)
 
     def forced_response(self) -> np.ndarray:
@@ -257,16 +264,18 @@ class Slider:
         (eqs. 25-26) with the mean damping Ĉ + diag(S_i N_o,i); the parametric term γ_i is a
         higher-order correction. |ω Ŷ_i| against V_ref,i says whether the linear analysis'
         assumption of continuous sliding (V_rel > 0) holds on the forced motion itself."""
-        omega = self.contacts[0].omega
-        check("contacts", [c.omega for c in self.contacts],
-              all(math.isclose(c.omega, omega, rel_tol=1e-12) for c in self.contacts),
-              "the forced response needs one forcing frequency for all contacts")
+        omega = self._common_omega("the forced response")
         M, _, K = self.tangential_matrices()
         C = self._friction_damping([c.normal_load for c in self.contacts])
-        # N − N_o = f_N m ẍ with ẍ = Im(−ω² X̂ e^{iωt}) (eq. 17), times μ*
-        force = np.r_[0.0, [float(c.friction(c.surface_speed)) * c.normal_force_factor
-                            * c.mass * -omega**2 * c.normal_amplitude() for c in self.contacts]]
+        force = np.r_[0.0, [c.mu_star() * c.normal_fluctuation() for c in self.contacts]]
         return np.linalg.solve(K - omega**2 * M + 1j * omega * C, force)
+
+    def _common_omega(self, what: str) -> float:
+        """The forcing frequency all contacts share; an error naming ``what`` needs it."""
+        omegas = [c.omega for c in self.contacts]
+        check("contacts", omegas, np.allclose(omegas, omegas[0], rtol=1e-12),
+              f"{what} needs one forcing frequency for all contacts")
+        return omegas[0]
 
     def periodic_damping(self, t: float) -> np.ndarray:
         """Ĉ + diag(0, S_i N_i(t)): the damping of the linear periodic system."""
@@ -275,7 +284,7 @@ class Slider:
     def _friction_damping(self, normal_forces) -> np.ndarray:
         """Ĉ + diag(0, S_i N_i): linearised friction adds S_i N_i to each contact's damping."""
         C = self._tangential_system[1].copy()
-        C[1:, 1:] += np.diag(self._slopes * np.asarray(normal_forces, dtype=float))
+        C[1:, 1:] += np.diag(self.slopes * np.asarray(normal_forces, dtype=float))
         return C
 
     # --- first-order averaging -------------------------------------------------------------
@@ -293,7 +302,7 @@ class Slider:
         growth, case, gamma_crit = -float(xi.min()) / 2, self._damping_case(Omega), None
         gammas = []
         for k, contact in enumerate(self.contacts, start=1):
-            gamma = -self._slopes[k - 1] * contact.fluctuation_amplitude()   # γ_k of eq. 26
+            gamma = -self.slopes[k - 1] * contact.fluctuation_amplitude()   # γ_k of eq. 26
             G = gamma * np.outer(R[k], R[k])
             gammas.append(G)
             for i in range(len(Omega)):
@@ -329,16 +338,14 @@ class Slider:
         (adaptive Dormand–Prince ``rk``/``5dp``; options under ``prefix``). All contacts must
         share one forcing frequency (one period).
         """
-        omegas = np.array([c.omega for c in self.contacts])
-        check("contacts", [float(w) for w in omegas], np.allclose(omegas, omegas[0], rtol=1e-12),
-              "Floquet analysis needs one forcing frequency for all contacts")
+        omega = self._common_omega("Floquet analysis")
         M, _, K = self.tangential_matrices()
         n = M.shape[0]
         Minv = np.diag(1.0 / np.diag(M))
         A = np.zeros((2 * n, 2 * n))
         A[:n, n:] = np.eye(n)
         A[n:, :n] = -Minv @ K
-        period = 2 * math.pi / omegas[0]
+        period = 2 * math.pi / omega
 
         def rhs(ts, t, y, f):
             A[n:, n:] = -Minv @ self.periodic_damping(t)
@@ -590,8 +597,7 @@ class SliderMotion:
         self._h, self._lam, self._V = get("roughness"), get("wavelength"), get("surface_speed")
         self._f = get("normal_force_factor")
         self._mu_s = np.array([c.static_coefficient for c in slider.contacts])
-        self._mu_star = np.array([float(c.friction(c.surface_speed)) for c in slider.contacts])
-        self._slope = np.array([c.slope() for c in slider.contacts])
+        self._mu_star = np.array([c.mu_star() for c in slider.contacts])
         self._force_scale = np.maximum(self._mu_s, 1e-3) * np.array(
             [c.normal_load + c.fluctuation_amplitude() for c in slider.contacts])
         self._tangential = slice(1, m + 1)
@@ -626,15 +632,18 @@ class SliderMotion:
     def _friction(self, state: tuple, mode) -> np.ndarray:
         _, _, N, V_rel, F_req, _ = state
         if self.linearised:  # μ(V_rel) ≈ μ* + S (V_rel − V_ref) = μ* − S ẏ_i
-            return (self._mu_star - self._slope * (self._V - V_rel)) * N
+            return (self._mu_star - self.slider.slopes * (self._V - V_rel)) * N
         mu = np.array([c.friction(V) for c, V in zip(self.slider.contacts, V_rel, strict=True)])
         if self.eps is not None:
             return mu * N * V_rel / np.sqrt(V_rel * V_rel + self.eps * self.eps)
         sign = np.array(mode, dtype=float)
         return np.where(sign == 0, F_req, mu * N * sign)
 
-    def normal_forces(self, t: float, y: np.ndarray) -> np.ndarray:
-        return self._contact_state(t, y)[2]
+    def contact_forces(self, t: float, y: np.ndarray, mode) -> tuple[np.ndarray, np.ndarray]:
+        """(N, F): normal and friction force of each contact, from one contact-state
+        evaluation."""
+        state = self._contact_state(t, y)
+        return state[2], self._friction(state, mode)
 
     def rhs(self, t: float, y: np.ndarray, mode) -> np.ndarray:
         n = self.size // 2
