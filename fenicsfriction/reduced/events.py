@@ -255,7 +255,7 @@ class _Segment:
                 ts.setConvergedReason(PETSc.TS.ConvergedReason.CONVERGED_USER)
                 return
             self.pending &= ~(g > self.event_tol)
-        self.g_accepted = np.asarray(self.g, dtype=float).copy()
+            self.g_accepted = g.copy()  # read for pending events only (_post_event)
         t, t_prev = ts.getTime(), ts.getPrevTime()
         self.t, self.y = t, ts.getSolution().getArray(readonly=True).copy()
         self.dt_max = max(self.dt_max, t - t_prev)
@@ -324,6 +324,35 @@ class _Segment:
                 obj.destroy()
 
 
+def _smooth_segment(system: HybridSystem, mode, history: _History, t: float, y: np.ndarray,
+                    t_end: float, dt: float, options: dict, prefix: str,
+                    event_tol: typing.Optional[float]) -> _Segment:
+    """Integrate in ``mode`` from (t, y) to its first event or t_end, retrying what can be
+    retried: a first step that jumped over a short excursion of an event starting at zero
+    (smaller step), and a location stalled below the time resolution (larger tolerance)."""
+    segment = _Segment(system, mode, history)
+    segment.run(t, y, t_end, dt, options, prefix, event_tol)
+    while segment.left_after is not None and segment.left_after > _SAME_INSTANT * t_end:
+        dt = segment.left_after / 16  # look closer: the first step may have jumped over
+        segment = _Segment(system, mode, history)  # a short excursion
+        segment.run(t, y, t_end, dt, options, prefix, event_tol)
+    while segment.stalled and segment.event_tol < _MAX_EVENT_TOL:
+        # the location cannot reach |g| <= tol at this time resolution: resume from the last
+        # accepted step (same mode, nothing recorded twice) with a larger tolerance
+        history.relaxed_locations += 1
+        tol = min(segment.event_tol * _RELAX, _MAX_EVENT_TOL)
+        g = np.abs(np.asarray(system.events(segment.t, segment.y, mode), dtype=float))
+        close = np.flatnonzero((g <= tol) & ~segment.pending)
+        if close.size:  # that step is on the event already, to the larger tolerance
+            segment.fired, segment.failure, segment.stalled = close.tolist(), None, False
+            segment.event_tol = tol
+            break
+        resume_t, resume_y = segment.t, segment.y
+        segment = _Segment(system, mode, history)
+        segment.run(resume_t, resume_y, t_end, dt, options, prefix, tol)
+    return segment
+
+
 def integrate_hybrid(system: HybridSystem, y0, mode0, t_end: float, *, rtol: float = 1e-8,
                      atol: float = 1e-10, dt0: typing.Optional[float] = None,
                      max_step: typing.Optional[float] = None, max_events: int = 100000,
@@ -379,29 +408,11 @@ def integrate_hybrid(system: HybridSystem, y0, mode0, t_end: float, *, rtol: flo
     def fail(message: str) -> typing.NoReturn:
         raise HybridError(message, t, y, mode, history.result())
 
-    event_tol = None  # None: the base tolerance; else what the last location achieved
+    event_tol = None  # None: the option's tolerance; else what the last location achieved
     spurious = 0  # segments in a row ended by a spurious event (see _Segment._post_event)
     while True:
-        segment = _Segment(system, mode, history)
-        segment.run(t, y, t_end, dt, options, prefix, event_tol)
-        while segment.left_after is not None and segment.left_after > _SAME_INSTANT * t_end:
-            dt = segment.left_after / 16  # look closer: the first step may have jumped over
-            segment = _Segment(system, mode, history)  # a short excursion
-            segment.run(t, y, t_end, dt, options, prefix, event_tol)
-        while segment.stalled and segment.event_tol < _MAX_EVENT_TOL:
-            # the location cannot reach |g| <= tol at this time resolution: resume from the
-            # last accepted step (same mode, nothing recorded twice) with a larger tolerance
-            history.relaxed_locations += 1
-            tol = min(segment.event_tol * _RELAX, _MAX_EVENT_TOL)
-            g = np.abs(np.asarray(system.events(segment.t, segment.y, mode), dtype=float))
-            close = np.flatnonzero((g <= tol) & ~segment.pending)
-            if close.size:  # that step is on the event already, to the larger tolerance
-                segment.fired, segment.failure, segment.stalled = close.tolist(), None, False
-                segment.event_tol = tol
-                break
-            resume_t, resume_y = segment.t, segment.y
-            segment = _Segment(system, mode, history)
-            segment.run(resume_t, resume_y, t_end, dt, options, prefix, tol)
+        segment = _smooth_segment(system, mode, history, t, y, t_end, dt, options, prefix,
+                                  event_tol)
         if segment.t != history.t[-1] or history.modes[-1] != mode:
             history.record(segment.t, segment.y, mode)
         t, y, dt = segment.t, segment.y, segment.dt_max or dt
@@ -422,8 +433,6 @@ def integrate_hybrid(system: HybridSystem, y0, mode0, t_end: float, *, rtol: flo
         g = np.abs(np.asarray(system.events(t, y, mode), dtype=float))[segment.fired]
         event_tol = min(max(segment.base_event_tol, 2.0 * float(g.max(initial=0.0))),
                         _MAX_EVENT_TOL)
-        if event_tol == segment.base_event_tol:
-            event_tol = None
         if len(history.events) >= max_events:
             fail(f"more than max_events = {max_events} events by t = {t:.12g} (mode "
                  f"{mode!r}): chattering or Zeno behaviour?")
