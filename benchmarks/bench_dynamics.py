@@ -41,9 +41,10 @@ import logging
 import pathlib
 import time
 
-import numpy as np
-
 from mpi4py import MPI
+
+import numpy as np
+from scipy.integrate import trapezoid
 
 import fenicsfriction as ff
 from fenicsfriction.dynamics import CentralDifference, DynamicsError, DynamicsSolver
@@ -98,20 +99,20 @@ def cycle(records: list[dict], t_from: float) -> dict:
     """Period, amplitude and apparent coefficient of the sampled N(t), F(t) on [t_from, end]."""
     rows = [(r["time"], r["N"], r["F"]) for r in records if "N" in r and r["time"] >= t_from]
     t, N, F = (np.array(c) for c in zip(*rows, strict=True))
-    mean_n = np.trapz(N, t) / (t[-1] - t[0])
+    mean_n = trapezoid(N, t) / (t[-1] - t[0])
     s = N - mean_n
     up = np.nonzero((s[:-1] < 0) & (s[1:] >= 0))[0]
     crossings = t[up] - s[up] * (t[up + 1] - t[up]) / (s[up + 1] - s[up])
     amplitudes = [0.5 * (N[a:b + 1].max() - N[a:b + 1].min())
                   for a, b in zip(up[:-1], up[1:], strict=True)]
     return {"period": float(np.diff(crossings).mean()), "amplitude": float(np.mean(amplitudes)),
-            "apparent_coefficient": float(np.trapz(F, t) / np.trapz(N, t)),
+            "apparent_coefficient": float(trapezoid(F, t) / trapezoid(N, t)),
             "cycles": len(amplitudes), "mean_normal_force": float(mean_n)}
 
 
 def run(scene: Scene, name: str, make, dt: float, t_end: float, sample: float) -> dict:
     """Integrate with the solver ``make()`` builds; wall time of ``run`` alone."""
-    say = ff.io.get_logger(MPI.COMM_WORLD).info
+    say = ff.results.get_logger(MPI.COMM_WORLD).info
     scene.reset()
     solver = make()
     observe = scene.observer(sample)
@@ -239,7 +240,7 @@ def main(argv=None) -> None:
     logging.getLogger("ffcx").setLevel(logging.WARNING)
     logging.getLogger().addFilter(lambda record: record.levelno >= logging.WARNING)
     comm = MPI.COMM_WORLD
-    say = ff.io.get_logger(comm).info
+    say = ff.results.get_logger(comm).info
     t0 = time.perf_counter()
     scene = Scene(comm)
     model = scene.model
@@ -272,7 +273,7 @@ def main(argv=None) -> None:
               f"U = {BELT_SPEED} cm/s, ε = {EPS}; central differences: stable step "
               f"{central.stable_dt:.3g} s (elastic {central.stable_dt_elastic:.3g} s); "
               f"total {total:.0f} s\n\n{table(runs, reference)}", flush=True)
-    ff.io.write_json(args.out / "bench_dynamics.json",
+    ff.results.write_json(args.out / "bench_dynamics.json",
                      {"mu": MU, "belt_speed": BELT_SPEED, "b_n": B_N, "eps": EPS,
                       "perturbation": PERTURBATION, "t_end": args.t_end, "sample_s": sample,
                       "default_dt": DEFAULT_DT, "total_time_s": total,

@@ -19,7 +19,7 @@ range of refinement factors r. For every mesh it records:
   the same machine, so it travels between machines where seconds do not: it is the figure to
   drive down, and a few PEP option variants (``VARIANTS``) are measured against it;
 * accuracy: (a) the relative error of every eigenvalue against scipy's dense QZ on the
-  companion linearisation (:func:`~fenicsfriction.stability.dense_eigenvalues`) of the same
+  companion linearisation (:func:`~fenicsfriction.numerics.dense_eigenvalues`) of the same
   K̄, C, M, where n is small enough for that (``--dense-max-dofs``; its wall time is recorded
   too); (b) the growing eigenvalue of the flutter pair and the spring mode against the finest
   mesh of the same dimension (discretisation convergence), and the flutter pair against the
@@ -47,14 +47,15 @@ import logging
 import pathlib
 import time
 
-import numpy as np
-
 from mpi4py import MPI
 from petsc4py import PETSc
 
+import numpy as np
+
 import fenicsfriction as ff
+from fenicsfriction.numerics import dense_eigenvalues
 from fenicsfriction.reduced import RigidBlock
-from fenicsfriction.stability import StabilitySolver, dense_eigenvalues
+from fenicsfriction.stability import StabilitySolver
 
 MU = 0.5
 MAX_MODULUS = 8000.0  # [rad/s]: the spring mode, the flutter pair; the next mode is at 1.8e4
@@ -235,7 +236,7 @@ def steady_state(model, tag: str, comm: MPI.Comm) -> dict:
 def run_mesh(dim: int, refine: int, comm: MPI.Comm, dense_max_dofs: int,
              variants_max_dofs: int) -> dict:
     """Steady state, the PEP and its variants, the baselines and the dense check on one mesh."""
-    say = ff.io.get_logger(comm).info
+    say = ff.results.get_logger(comm).info
     scene = ff.BlockOnBelt(refine=refine, dim=dim)
     model = scene.build(comm, with_friction=True)
     tag = f"b{dim}d{refine}"
@@ -463,7 +464,7 @@ def main(argv=None) -> None:
     logging.getLogger().addFilter(lambda record: record.levelno >= logging.WARNING)
     PETSc.Log.begin()  # the breakdown of each PEP solve comes from PETSc's event log
     comm = MPI.COMM_WORLD
-    say = ff.io.get_logger(comm).info
+    say = ff.results.get_logger(comm).info
     t0 = time.perf_counter()
     rigid = rigid_reference(ff.BlockOnBelt())
     runs = [run_mesh(dim, r, comm, args.dense_max_dofs, args.variants_max_dofs)
@@ -483,7 +484,7 @@ def main(argv=None) -> None:
               f"variant and ≥ 1e4 dofs (or all with every variant): "
               + ", ".join(f"{k} {v:.2f}" for k, v in means.items()) + f"; best: {best}",
               flush=True)
-    ff.io.write_json(args.out / "bench_stability.json",
+    ff.results.write_json(args.out / "bench_stability.json",
                      {"ranks": comm.size, "mu": MU, "max_modulus": MAX_MODULUS, "shift": SHIFT,
                       "repeats": REPEATS, "time_budget_s": TIME_BUDGET,
                       "variants": {k: {"options": o, "solve": s}

@@ -34,11 +34,11 @@ import shutil
 import tempfile
 import time
 
-import numpy as np
-from dolfinx import geometry
-
 from mpi4py import MPI
 from petsc4py import PETSc
+
+import numpy as np
+from dolfinx import geometry
 
 import fenicsfriction as ff
 from fenicsfriction import _compat
@@ -286,7 +286,7 @@ def main(argv=None) -> None:
     # the JIT's C compiler lines come through the root logger, whose level setuptools resets
     logging.getLogger().addFilter(lambda record: record.levelno >= logging.WARNING)
     comm = MPI.COMM_WORLD
-    say = ff.io.get_logger(comm).info
+    say = ff.results.get_logger(comm).info
     runs = []
     for refine in args.refine:
         run = run_mesh(refine, comm)
@@ -304,7 +304,7 @@ def main(argv=None) -> None:
     for run in runs:  # the sampled profiles are long and exist on rank 0 only
         for sample in run["samples"].values():
             sample.pop("penetration")
-    ff.io.write_json(args.out / "bench_steady.json",
+    ff.results.write_json(args.out / "bench_steady.json",
                      {"ranks": comm.size, "mu_steps": MU_STEPS.tolist(), "mu_samples": MU_SAMPLES,
                       "base_points": NUM_BASE_POINTS, "corner_margin": CORNER_MARGIN,
                       "continuation_repeats": CONTINUATION_REPEATS, "bare_repeats": BARE_REPEATS,

@@ -19,9 +19,9 @@
 # +
 import logging
 
-import numpy as np
-
 from mpi4py import MPI
+
+import numpy as np
 
 import fenicsfriction as ff
 from fenicsfriction.reduced import RigidBlock
@@ -29,7 +29,7 @@ from fenicsfriction.stability import Loci, StabilitySolver, unstable_intervals
 
 logging.getLogger("ffcx").setLevel(logging.WARNING)
 comm = MPI.COMM_WORLD
-say = ff.io.get_logger(comm).info
+say = ff.results.get_logger(comm).info
 # -
 
 # ## The operators come from the one residual

@@ -21,16 +21,16 @@
 # +
 import logging
 
-import numpy as np
-
 from mpi4py import MPI
+
+import numpy as np
 
 import fenicsfriction as ff
 from fenicsfriction import forms
 
 logging.getLogger("ffcx").setLevel(logging.WARNING)
 comm = MPI.COMM_WORLD
-say = ff.io.get_logger(comm).info
+say = ff.results.get_logger(comm).info
 # -
 
 # ## The scene and its residual

@@ -31,19 +31,20 @@ import logging
 import os
 import pathlib
 
-import numpy as np
-
 from mpi4py import MPI
 
+import numpy as np
+
 import fenicsfriction as ff
-from fenicsfriction.dynamics import DynamicsSolver, stick_slip_statistics
+from fenicsfriction.dynamics import DynamicsSolver
 from fenicsfriction.plotting import plot_stick_slip
 from fenicsfriction.reduced import ReducedDynamics, RigidBlock, rigid_block_observables
 from fenicsfriction.stability import StabilitySolver
+from fenicsfriction.statistics import stick_slip_statistics
 
 logging.getLogger("ffcx").setLevel(logging.WARNING)
 world = MPI.COMM_WORLD
-say = ff.io.get_logger(world).info
+say = ff.results.get_logger(world).info
 out = pathlib.Path(os.environ.get("FENICSFRICTION_DEMO_OUT", "results/stick_slip"))
 T_END = float(os.environ.get("FENICSFRICTION_DEMO_T_END", "0.6"))  # [s]
 DT = 1e-5  # [s]: Newmark step of the paper's rigid model; cut back where Newton needs it
@@ -69,7 +70,7 @@ def run(belt_speed: float, comm: MPI.Comm) -> tuple[list, dict]:
     model.residual.u_dot.x.array[1::2] += PERTURBATION
     solver = DynamicsSolver(model.residual, prefix=f"ss{belt_speed}_ts_",
                             atol=1e-10 * model.force_scale)
-    log = ff.io.get_logger(comm).info
+    log = ff.results.get_logger(comm).info
     progress = max(1, int(T_END / DT / 20))
 
     def on_step(record: dict) -> None:
@@ -172,7 +173,7 @@ if world.rank == 0:
               flush=True)
     summary = [{"model": kind, "label": label, **stats}
                for kind, label, _, _, stats in entries]
-    ff.io.write_json(out / "stick_slip.json", {"eps": EPS, "dt": DT, "t_end": T_END,
+    ff.results.write_json(out / "stick_slip.json", {"eps": EPS, "dt": DT, "t_end": T_END,
                                                "perturbation": PERTURBATION, "runs": summary},
                      MPI.COMM_SELF)
     plot_stick_slip({f"U = {U} cm/s": results[U][0] for U in BELT_SPEEDS},

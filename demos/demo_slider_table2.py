@@ -30,18 +30,24 @@ import os
 import pathlib
 import time
 
-import numpy as np
-
 from mpi4py import MPI
+
+import numpy as np
 
 import fenicsfriction as ff
 from fenicsfriction.plotting import plot_oscillator, plot_stability_map, plot_stroboscopic_growth
 from fenicsfriction.reduced.events import integrate_hybrid, mode_intervals
-from fenicsfriction.reduced.slider import (TABLE2_PAPER_BANDS, TABLE2_READINGS, SliderMotion,
-                                           stability_map, stroboscopic_growth, table2_slider)
+from fenicsfriction.reduced.slider import (
+    TABLE2_PAPER_BANDS,
+    TABLE2_READINGS,
+    SliderMotion,
+    stability_map,
+    stroboscopic_growth,
+    table2_slider,
+)
 
 world = MPI.COMM_WORLD
-say = ff.io.get_logger(world).info
+say = ff.results.get_logger(world).info
 out = pathlib.Path(os.environ.get("FENICSFRICTION_DEMO_OUT", "results/slider"))
 T_END = float(os.environ.get("FENICSFRICTION_DEMO_T_END", "300"))
 OMEGAS = [30.16, 30.78, 62.0, 63.5]
@@ -134,7 +140,7 @@ for i, (task, w) in enumerate(tasks):
     if i % world.size == world.rank:
         done[(task.__name__, w)] = task(w)
         r = done[(task.__name__, w)]
-        ff.io.get_logger(MPI.COMM_SELF).info(f"rank {world.rank}: {task.__name__} ω_o = {w}: "
+        ff.results.get_logger(MPI.COMM_SELF).info(f"rank {world.rank}: {task.__name__} ω_o = {w}: "
                                              f"{r['seconds']:.1f} s, {r['steps']} steps")
 gathered = world.gather(done, root=0)
 
@@ -169,7 +175,7 @@ if world.rank == 0:
         stem = "principal" if name == "2 Ω2" else "combination"
         plot_stability_map(m.omega, m.growth, m.bands, out / f"stability_map_{stem}.png",
                            reference_bands=TABLE2_PAPER_BANDS)
-    ff.io.write_json(out / "slider.json", {
+    ff.results.write_json(out / "slider.json", {
         "reading": "paper", "natural_frequencies": omega, "bands": bands,
         "paper_bands": TABLE2_PAPER_BANDS, "forced_speed_over_surface_speed": forced,
         "runs": [{"model": kind, **{k: v for k, v in r.items() if not k.startswith("_")}}

@@ -10,14 +10,13 @@ from __future__ import annotations
 
 import typing
 
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import dolfinx.fem.petsc
 import numpy as np
 import ufl
 from dolfinx import fem, mesh
-
-import dolfinx.fem.petsc  # noqa: F401  (registers fem.petsc; explicit import is required from 0.6)
-
-from mpi4py import MPI
-from petsc4py import PETSc
 
 __all__ = [
     "assemble_matrix_into",
@@ -73,7 +72,7 @@ def interpolation_points(V: fem.FunctionSpace) -> np.ndarray:
     return pts() if callable(pts) else pts
 
 
-def jit_options(cache_dir: typing.Optional[str] = None) -> dict:
+def jit_options(cache_dir: str | None = None) -> dict:
     """Keyword arguments for ``fem.form``: the option dict was renamed in 0.7."""
     options: dict = {"cffi_extra_compile_args": ["-O2"]}
     if cache_dir is not None:
@@ -94,6 +93,6 @@ def assemble_matrix_into(A: PETSc.Mat, a: fem.FormMetaClass, bcs: list,
     dolfinx.fem.petsc.assemble_matrix(A, a, bcs, diagonal)
 
 
-def form(expr: ufl.Form, cache_dir: typing.Optional[str] = None) -> fem.FormMetaClass:
+def form(expr: ufl.Form, cache_dir: str | None = None) -> fem.FormMetaClass:
     """Compile a UFL form with the package's JIT options (``cache_dir``: where FFCx caches)."""
     return fem.form(expr, **jit_options(cache_dir))

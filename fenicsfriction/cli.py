@@ -14,9 +14,9 @@ import sys
 import time
 import typing
 
-import numpy as np
-
 from mpi4py import MPI
+
+import numpy as np
 
 __all__ = ["main"]
 
@@ -123,8 +123,8 @@ def _oscillator_parsers(commands) -> None:
     """``oscillator mdof|belt`` and ``stability-map mdof``: the reduced models of seed 004."""
     from fenicsfriction.reduced.slider import TABLE2_READINGS
 
-    readings = dict(choices=sorted(TABLE2_READINGS), default="paper",
-                    help="reading of seed 004's dimensionless Table 2 model (paper)")
+    readings = {"choices": sorted(TABLE2_READINGS), "default": "paper",
+                    "help": "reading of seed 004's dimensionless Table 2 model (paper)"}
     smap = commands.add_parser(
         "stability-map", help="stability of steady sliding vs forcing frequency (seed 004)",
         description="Growth rate of perturbations of steady sliding of the Table 2 slider by "
@@ -178,12 +178,12 @@ def _oscillator_parsers(commands) -> None:
 def _run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
     import csv
 
-    from fenicsfriction import io
-    from fenicsfriction.dynamics import (CentralDifference, DynamicsError, DynamicsSolver,
-                                         stick_slip_statistics)
+    from fenicsfriction import io, results
+    from fenicsfriction.dynamics import CentralDifference, DynamicsError, DynamicsSolver
     from fenicsfriction.laws import check
     from fenicsfriction.plotting import plot_stick_slip
     from fenicsfriction.scenes import SCENES
+    from fenicsfriction.statistics import stick_slip_statistics
     from fenicsfriction.steady import SteadySolver, continuation
 
     comm = MPI.COMM_WORLD
@@ -244,7 +244,7 @@ def _run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
         log.info(f"apparent friction coefficient {statistics['apparent_coefficient']:.4f} "
                  f"(μ = {args.mu}), probe node sticks {statistics['probe_stick_fraction']:.1%} "
                  f"of the time (second half of the run)")
-    io.write_json(out / "summary.json", {"scene": args.scene,
+    results.write_json(out / "summary.json", {"scene": args.scene,
                                          "parameters": dataclasses.asdict(scene),
                                          "scheme": args.scheme, "dt": args.dt,
                                          "steps": len(records) - 1, "failure": failure,
@@ -275,7 +275,7 @@ def _build(args: argparse.Namespace):
 
 
 def _run_steady(args: argparse.Namespace, log: logging.Logger) -> int:
-    from fenicsfriction import io, plotting
+    from fenicsfriction import io, plotting, results
     from fenicsfriction.laws import check
     from fenicsfriction.steady import ContinuationError, continuation, epsilon_sequence
 
@@ -314,12 +314,12 @@ def _run_steady(args: argparse.Namespace, log: logging.Logger) -> int:
             records, failure = err.records, str(err)
     for r in records:
         r.pop("value")
-    io.write_json(out / "steady.json", records, comm)
+    results.write_json(out / "steady.json", records, comm)
     eps_records = None
     if args.eps_sequence and failure is None:
         eps_records = epsilon_sequence(solver, model.eps, args.eps_sequence,
                                        observe=model.quantities)
-        io.write_json(out / "epsilon.json", eps_records, comm)
+        results.write_json(out / "epsilon.json", eps_records, comm)
         log.info("sequential ε process at μ = %.4g:\n%12s %12s %14s %8s", args.mu_max, "eps",
                  "change", "F_T/(μN) - 1", "Newton")
         for r in eps_records:
@@ -327,7 +327,7 @@ def _run_steady(args: argparse.Namespace, log: logging.Logger) -> int:
             change = "-" if r["change"] is None else f"{r['change']:.3e}"
             log.info("%12.3e %12s %14.3e %8d", r["eps"], change, ratio, r["newton_iterations"])
     reached = records[-1]["mu"] if records else None  # last target of the μ grid reached
-    io.write_json(out / "summary.json", {
+    results.write_json(out / "summary.json", {
         "scene": args.scene, "parameters": dataclasses.asdict(scene), "ranks": comm.size,
         "dofs": ndofs, "jit_time_s": solver.jit_time_s,
         "wall_time_s": time.perf_counter() - t_start, "mu_reached": reached,
@@ -387,10 +387,9 @@ def _rigid_loci(scene, targets: np.ndarray, max_frequency: float, growth_tol: fl
 
 
 def _run_stability(args: argparse.Namespace, log: logging.Logger) -> int:
-    from fenicsfriction import io, plotting
+    from fenicsfriction import io, plotting, results
     from fenicsfriction.laws import check
-    from fenicsfriction.stability import EigenSolveError, Loci, StabilitySolver, \
-        unstable_intervals
+    from fenicsfriction.stability import EigenSolveError, Loci, StabilitySolver, unstable_intervals
     from fenicsfriction.steady import ContinuationError
 
     comm = MPI.COMM_WORLD
@@ -428,7 +427,7 @@ def _run_stability(args: argparse.Namespace, log: logging.Logger) -> int:
           "mu_crit": onsets[0]["mu_crit"] if onsets else None,
           "unstable_intervals": {str(k): v for k, v in
                                  unstable_intervals(records, args.growth_tol).items()}}
-    io.write_json(out / "stability.json", {
+    results.write_json(out / "stability.json", {
         "scene": args.scene, "parameters": dataclasses.asdict(scene), "ranks": comm.size,
         "mu_crit": {"fe": fe["mu_crit"], "rigid": rigid["mu_crit"]},
         "fe": fe, "rigid": rigid, "max_frequency": args.max_frequency,
@@ -449,7 +448,7 @@ def _run_stability(args: argparse.Namespace, log: logging.Logger) -> int:
 def _run_stability_map(args: argparse.Namespace, log: logging.Logger) -> int:
     import functools
 
-    from fenicsfriction import io
+    from fenicsfriction import results
     from fenicsfriction.laws import check
     from fenicsfriction.plotting import plot_stability_map
     from fenicsfriction.reduced.slider import TABLE2_PAPER_BANDS, stability_map, table2_slider
@@ -467,7 +466,7 @@ def _run_stability_map(args: argparse.Namespace, log: logging.Logger) -> int:
     out: pathlib.Path = args.out
     paper = [list(band) for band in TABLE2_PAPER_BANDS]
     slider = table2_slider(lo, reading=args.reading)
-    io.write_json(out / "stability_map.json", {
+    results.write_json(out / "stability_map.json", {
         "reading": args.reading, "natural_frequencies": slider.natural_frequencies()[0],
         "omega": result.omega, "growth": result.growth, "bands": result.bands,
         "seconds_per_omega": {k: v / args.samples for k, v in result.seconds.items()},
@@ -482,7 +481,7 @@ def _run_stability_map(args: argparse.Namespace, log: logging.Logger) -> int:
 def _run_oscillator(args: argparse.Namespace, log: logging.Logger) -> int:
     import csv
 
-    from fenicsfriction import io, laws
+    from fenicsfriction import laws, results
     from fenicsfriction.laws import check
     from fenicsfriction.plotting import plot_oscillator
     from fenicsfriction.reduced import BeltOscillator, belt_summary
@@ -565,7 +564,7 @@ def _run_oscillator(args: argparse.Namespace, log: logging.Logger) -> int:
     summary["wall_seconds"] = time.perf_counter() - start
     log.info(f"{summary['events']} events, stick fraction {summary['stick_fraction']:.3f}, "
              f"{summary['wall_seconds']:.1f} s")
-    io.write_json(out / "summary.json", summary)
+    results.write_json(out / "summary.json", summary)
     if rank0:
         with open(out / "timeseries.csv", "w", newline="") as f:
             writer = csv.writer(f)
@@ -578,7 +577,7 @@ def _run_oscillator(args: argparse.Namespace, log: logging.Logger) -> int:
     return 0
 
 
-def main(argv: typing.Optional[list[str]] = None) -> int:
+def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``fenicsfriction`` console script and ``python -m fenicsfriction``."""
     argv = sys.argv[1:] if argv is None else list(argv)
     # everything after the first PETSc-style option (-prefix_name) goes to PETSc
@@ -591,7 +590,7 @@ def main(argv: typing.Optional[list[str]] = None) -> int:
     logging.getLogger("ffcx").setLevel(logging.WARNING)
     logging.getLogger("UFL").setLevel(logging.WARNING)
     logging.getLogger().setLevel(logging.WARNING)
-    from fenicsfriction.io import get_logger
+    from fenicsfriction.results import get_logger
     log = get_logger(MPI.COMM_WORLD)
     try:
         commands = {"steady": _run_steady, "stability": _run_stability, "dynamics": _run_dynamics,

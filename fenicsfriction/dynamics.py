@@ -17,7 +17,7 @@ whose Newton iterations cycle across the steep part of φ_ε at slide-to-stick t
 is small and the step large. With fixed steps the step then grows back (doubling after each
 accepted step) to the one asked for, so a transition costs a few small steps, not the rest of
 the run. Newton stops on the residual (atol raised to its round-off floor, see
-:class:`~fenicsfriction.assembly.RoundoffConvergence`), never on the step length.
+:class:`~fenicsfriction.petsc_options.RoundoffConvergence`), never on the step length.
 Options live under the prefix (default ``dynamics_``).
 """
 
@@ -26,171 +26,21 @@ from __future__ import annotations
 import time
 import typing
 
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import dolfinx.fem.petsc
 import numpy as np
 import ufl
 from dolfinx import fem
 
-import dolfinx.fem.petsc  # noqa: F401
-
-from mpi4py import MPI
-from petsc4py import PETSc
-
 from fenicsfriction import _compat
-from fenicsfriction.assembly import (RoundoffConvergence, assemble_jacobian, assemble_residual,
-                                     options_with_defaults)
+from fenicsfriction.assembly import assemble_jacobian, assemble_residual
 from fenicsfriction.forms import Residual
 from fenicsfriction.laws import check
+from fenicsfriction.timestepping import DEFAULT_OPTIONS, Alpha2Integrator, DynamicsError
 
-__all__ = ["DEFAULT_OPTIONS", "Alpha2Integrator", "CentralDifference", "DynamicsError",
-           "DynamicsSolver", "stick_slip_statistics"]
-
-DEFAULT_OPTIONS = {
-    "ts_type": "alpha2",
-    "ts_alpha_radius": 1.0,
-    "ts_adapt_type": "none",
-    "ts_max_snes_failures": -1,
-    "ts_max_reject": 20,
-    "ts_exact_final_time": "matchstep",
-    "snes_type": "newtonls",
-    "snes_linesearch_type": "bt",
-    "snes_rtol": 1e-10,
-    "snes_max_it": 10,  # converged steps take 2-4; a cycling Newton is cut back sooner
-    "ksp_type": "preonly",
-    "pc_type": "lu",
-    "pc_factor_mat_solver_type": "mumps",
-}
-
-
-class DynamicsError(RuntimeError):
-    """The time integration stopped before the final time; ``records`` holds the steps done."""
-
-    def __init__(self, message: str, records: list):
-        super().__init__(message)
-        self.records = records
-
-
-class Alpha2Integrator:
-    """PETSc TS (TSALPHA2 by default) on a second-order system R(t, x, ẋ, ẍ) = 0: the set-up,
-    the Newton stopping test, the cut-back and regrowth of the step, and the run loop with its
-    records, shared by the FE solver and the few-d.o.f. models of :mod:`fenicsfriction.reduced`.
-
-    A subclass provides the residual ``_F(ts, t, x, xdot, xddot, F)``, the Jacobian
-    ``_J(ts, t, x, xdot, xddot, shift_v, shift_a, J, P)`` (which must call
-    ``self.convergence.jacobian_assembled(J)``), ``_load(x, xdot, xddot)`` (put an accepted state
-    where ``observe`` reads it) and ``_state()`` (the initial displacement and velocity vectors,
-    which receive the final state).
-
-    Attributes:
-        ts: the PETSc TS, exposed for monitoring or further configuration.
-        fixed_steps: no error control (``ts_adapt_type none``): a cut step grows back.
-        convergence: the Newton stopping test (its ``atol_used``: the last tolerance).
-    """
-
-    def __init__(self, comm, prefix: str, F: PETSc.Vec, J: PETSc.Mat,
-                 options: typing.Optional[dict], atol: float):
-        check("atol", atol, np.isfinite(atol) and atol > 0, "must be a finite number > 0")
-        self.ts = PETSc.TS().create(comm)
-        self.ts.setOptionsPrefix(prefix)
-        self.ts.setI2Function(self._F, F)
-        self.ts.setI2Jacobian(self._J, J)
-        with options_with_defaults(prefix, {**DEFAULT_OPTIONS, "snes_atol": atol,
-                                            **(options or {})}) as opts:
-            self.ts.setFromOptions()
-            # petsc4py 3.18 does not wrap TSAdapt: read the choice from the options
-            self.fixed_steps = opts.getString("ts_adapt_type") == "none"
-        self.convergence = RoundoffConvergence(self.ts.getSNES())
-        self.ts.getSNES().setConvergenceTest(self.convergence)
-
-    def _F(self, ts, t, x, xdot, xddot, F):
-        raise NotImplementedError
-
-    def _J(self, ts, t, x, xdot, xddot, shift_v, shift_a, J, P):
-        raise NotImplementedError
-
-    def _load(self, x, xdot, xddot) -> None:
-        raise NotImplementedError
-
-    def _state(self) -> tuple[PETSc.Vec, PETSc.Vec]:
-        raise NotImplementedError
-
-    def run(self, t_end: float, dt: float,
-            observe: typing.Optional[typing.Callable[[float], dict]] = None,
-            on_step: typing.Optional[typing.Callable[[dict], None]] = None) -> list[dict]:
-        """Integrate from t = 0 to ``t_end`` with (initial) step ``dt``.
-
-        Args:
-            observe: called after every accepted step (fields hold the state), its dict is
-                merged into the step's record.
-            on_step: called with each record (progress output, field output).
-
-        Returns:
-            One record per accepted step (and one for t = 0): ``time``, ``dt``,
-            ``newton_iterations`` (rejected attempts included), ``rejected_steps`` (cut-backs
-            and error-control rejections before this step), ``wall_time_s`` and what
-            ``observe`` adds.
-
-        Raises:
-            DynamicsError: TS stopped early (e.g. too many step rejections); the fields hold
-                the last accepted state and ``error.records`` the steps done.
-        """
-        check("t_end", t_end, t_end > 0, "must be > 0")
-        check("dt", dt, 0 < dt <= t_end, f"must lie in (0, t_end = {t_end}]")
-        u, v = (vec.copy() for vec in self._state())
-        self.ts.setSolution2(u, v)
-        self.ts.setTime(0.0)
-        self.ts.setStepNumber(0)
-        self.ts.setTimeStep(dt)
-        self.ts.setMaxTime(t_end)
-        self.ts.setMaxSteps(10**9)
-        records: list[dict] = []
-        clock = [time.perf_counter(), 0, 0]
-
-        def regrow(ts):  # after a cut-back, back to the step asked for (not past t_end)
-            remaining = t_end - ts.getTime()
-            if self.fixed_steps and ts.getTimeStep() < min(dt, remaining):
-                ts.setTimeStep(min(2.0 * ts.getTimeStep(), dt, remaining))
-
-        def monitor(ts, step, t, x):
-            snes_its, rejected = ts.getSNESIterations(), ts.getStepRejections()
-            record = {"time": float(t), "dt": 0.0,
-                      "newton_iterations": snes_its - clock[1],
-                      "rejected_steps": rejected - clock[2],
-                      "wall_time_s": time.perf_counter() - clock[0]}
-            clock[:] = time.perf_counter(), snes_its, rejected
-            if step:  # the fields hold the last residual evaluation: load the accepted state
-                self._load(x, ts.getSolution2()[1], None)
-                record["dt"] = float(t - records[-1]["time"])
-            if observe is not None:
-                record.update(observe(float(t)))
-            records.append(record)
-            if on_step is not None:
-                on_step(record)
-
-        self.ts.setMonitor(monitor)
-        self.ts.setPostStep(regrow)
-        error = None
-        try:
-            self.ts.solve(u)
-        except PETSc.Error as err:  # e.g. a NaN in the error estimate: report, keep the state
-            error = err
-        self.ts.cancelMonitor()
-        self.ts.setPostStep(None)
-        reason = self.ts.getConvergedReason()
-        x, x_dot = self.ts.getSolution2()
-        self._load(x, x_dot, None)  # also after a failure: the last accepted state
-        for target, vec in zip(self._state(), (x, x_dot), strict=True):
-            vec.copy(target)
-        u.destroy()
-        v.destroy()
-        if error is not None:
-            raise DynamicsError(f"TS failed at t = {self.ts.getTime():.6g} after "
-                                f"{self.ts.getStepNumber()} steps with PETSc error {error.ierr} "
-                                f"(see the PETSc trace above); the fields hold the last "
-                                f"accepted state", records) from error
-        if reason < 0:
-            raise DynamicsError(f"TS stopped at t = {self.ts.getTime():.6g} with reason "
-                                f"{reason} after {self.ts.getStepNumber()} steps", records)
-        return records
+__all__ = ["DEFAULT_OPTIONS", "CentralDifference", "DynamicsError", "DynamicsSolver"]
 
 
 class DynamicsSolver(Alpha2Integrator):
@@ -205,7 +55,7 @@ class DynamicsSolver(Alpha2Integrator):
     """
 
     def __init__(self, residual: Residual, prefix: str = "dynamics_",
-                 options: typing.Optional[dict] = None, atol: float = 1e-8):
+                 options: dict | None = None, atol: float = 1e-8):
         self.residual = residual
         msh = residual.V.mesh
         self.shift_v = fem.Constant(msh, 0.0)
@@ -269,7 +119,7 @@ class CentralDifference:
     """
 
     def __init__(self, residual: Residual, safety: float = 0.9,
-                 band_damping: typing.Optional[ufl.Form] = None, band_margin: float = 4.0):
+                 band_damping: ufl.Form | None = None, band_margin: float = 4.0):
         check("safety", safety, 0 < safety < 1, "must lie in (0, 1)")
         check("band_margin", band_margin, band_margin >= 1, "must be >= 1")
         self.residual, self.safety = residual, safety
@@ -318,8 +168,8 @@ class CentralDifference:
         return 2.0 / np.sqrt(omega2)
 
     def run(self, t_end: float, dt: float,
-            observe: typing.Optional[typing.Callable[[float], dict]] = None,
-            on_step: typing.Optional[typing.Callable[[dict], None]] = None) -> list[dict]:
+            observe: typing.Callable[[float], dict] | None = None,
+            on_step: typing.Callable[[dict], None] | None = None) -> list[dict]:
         """Integrate to ``t_end``; ``dt`` above ``safety × stable_dt`` is reduced to it.
 
         Records as :meth:`DynamicsSolver.run` (``newton_iterations`` is 0: nothing to solve).
@@ -371,76 +221,3 @@ class CentralDifference:
         for obj in (a, v_half):
             obj.destroy()
         return records
-
-
-def _longest_run(t: np.ndarray, flags: np.ndarray) -> float:
-    """Longest time span over which ``flags`` holds at consecutive samples (0 if never)."""
-    longest, start = 0.0, None
-    for time_k, flag in zip(t, flags, strict=True):
-        if flag and start is None:
-            start = time_k
-        elif not flag and start is not None:
-            start = None
-        if start is not None:
-            longest = max(longest, time_k - start)
-    return float(longest)
-
-
-def _time_mean(t: np.ndarray, values: np.ndarray) -> float:
-    """Time average of a sampled signal (trapezoidal rule; steps may vary)."""
-    return float(np.trapz(values, t) / (t[-1] - t[0]))
-
-
-def stick_slip_statistics(records: list[dict], mu: float, eps: float,
-                          t_from: float = 0.0) -> dict:
-    r"""What an experimenter would measure on a run, over the records with time ≥ ``t_from``.
-
-    Needs ``normal_force``, ``friction_force``, ``spring_elongation`` and the probe's
-    ``probe_slip``/``probe_pressure`` (see ``BlockModel.dynamics_observer``;
-    ``rigid_block_observables`` gives them for the rigid block), and ``energy_error`` if
-    there is one (``max_energy_error`` is None otherwise).
-
-    Returns:
-        ``apparent_coefficient``: :math:`\bar F_T / \bar N` (time means), the friction
-        coefficient a measurement of mean forces would report, against the law's ``mu``
-        (``ratio_to_mu``); ``probe_stick_fraction`` / ``probe_open_fraction``: share of the
-        time the probe node sticks (in contact, :math:`|\dot u_T - U_T| < \varepsilon`) or is
-        out of contact; ``probe_longest_stick`` [s]: its longest uninterrupted stick (a
-        stick-slip relaxation cycle against brief adhesions); ``any_stick_fraction``: share of
-        the time some contact node sticks (from ``n_stick``; None without it);
-        ``mean_normal_force``, ``mean_friction_force``, ``normal_force_range``;
-        the spring elongation at the start and end of the window and its mean;
-        ``max_energy_error`` over the whole run; ``steps``, ``rejected_steps``,
-        ``newton_iterations`` over the whole run.
-    """
-    check("t_from", t_from, t_from < records[-1]["time"], "must be before the last record")
-    t_all = np.array([r["time"] for r in records])
-    window = [r for r in records if r["time"] >= t_from]
-    t = np.array([r["time"] for r in window])
-    series = {key: np.array([r[key] for r in window]) for key in
-              ("normal_force", "friction_force", "spring_elongation", "probe_slip",
-               "probe_pressure")}
-    in_contact = series["probe_pressure"] > 0
-    sticks = in_contact & (np.abs(series["probe_slip"]) < eps)
-    mean_n = _time_mean(t, series["normal_force"])
-    mean_f = _time_mean(t, series["friction_force"])
-    return {"t_from": float(t[0]), "t_to": float(t[-1]), "mu": mu, "eps": eps,
-            "mean_normal_force": mean_n, "mean_friction_force": mean_f,
-            "normal_force_range": [float(series["normal_force"].min()),
-                                   float(series["normal_force"].max())],
-            "apparent_coefficient": abs(mean_f) / mean_n,
-            "ratio_to_mu": abs(mean_f) / mean_n / mu if mu > 0 else float("nan"),
-            "probe_stick_fraction": _time_mean(t, sticks.astype(float)),
-            "probe_open_fraction": _time_mean(t, (~in_contact).astype(float)),
-            "probe_longest_stick": _longest_run(t, sticks),
-            "any_stick_fraction": (_time_mean(t, np.array([r["n_stick"] > 0 for r in window],
-                                                          dtype=float))
-                                   if "n_stick" in window[0] else None),
-            "spring_elongation": {"start": float(series["spring_elongation"][0]),
-                                  "end": float(series["spring_elongation"][-1]),
-                                  "mean": _time_mean(t, series["spring_elongation"])},
-            "max_energy_error": (float(max(abs(r["energy_error"]) for r in records))
-                                 if "energy_error" in records[0] else None),
-            "duration": float(t_all[-1] - t_all[0]), "steps": len(records) - 1,
-            "rejected_steps": int(sum(r["rejected_steps"] for r in records)),
-            "newton_iterations": int(sum(r["newton_iterations"] for r in records))}

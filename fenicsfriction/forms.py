@@ -45,7 +45,7 @@ __all__ = [
     "tangential_part",
 ]
 
-Value = typing.Union[float, ufl.core.expr.Expr]
+Value = float | ufl.core.expr.Expr
 
 
 # --- kinematics on Γ_C ---------------------------------------------------------------------------
@@ -117,7 +117,7 @@ def normal_damping(u, u_dot, v, n, b_n: Value, l_n: Value, g: Value,
         * normal_part(v, n) * ds
 
 
-def friction(u, u_dot, v, n, c_T: typing.Union[Value, typing.Callable], m_T: Value, g: Value,
+def friction(u, u_dot, v, n, c_T: Value | typing.Callable, m_T: Value, g: Value,
              U_T, eps: Value, ds: ufl.Measure, regularisation: str = "c1") -> ufl.Form:
     """Regularised friction power :math:`\\langle J_\\varepsilon(u,\\dot u), v\\rangle`.
 
@@ -160,7 +160,7 @@ class NodalSpring:
 
     @classmethod
     def at_point(cls, V: fem.FunctionSpace, point: typing.Sequence[float], component: int,
-                 stiffness: float, anchor: float = 0.0, tol: float = 1e-10) -> "NodalSpring":
+                 stiffness: float, anchor: float = 0.0, tol: float = 1e-10) -> NodalSpring:
         """Attach to the node of ``V`` at ``point`` (it must be a node of the mesh)."""
         laws.check("stiffness", stiffness, stiffness > 0, "the spring stiffness must be > 0")
         Vc, to_parent = V.sub(component).collapse()

@@ -1,61 +1,23 @@
-"""Results on disk: JSON for numbers, XDMF for fields (ParaView). Rank 0 writes files."""
+"""Fields on disk: XDMF time series of displacements, tractions and mode shapes (ParaView).
+
+Numbers (JSON, CSV) are written by :mod:`fenicsfriction.results`."""
 
 from __future__ import annotations
 
-import json
-import logging
 import pathlib
-import typing
 
 import numpy as np
 from dolfinx import fem, io
 
-from mpi4py import MPI
-
 from fenicsfriction import _compat
 
-__all__ = ["FieldWriter", "ModeWriter", "get_logger", "write_json"]
-
-
-def get_logger(comm: MPI.Comm = MPI.COMM_WORLD) -> logging.Logger:
-    """The package logger: INFO on rank 0, warnings only elsewhere."""
-    logger = logging.getLogger("fenicsfriction")
-    if not logger.handlers:
-        handler = logging.StreamHandler()
-        handler.setFormatter(logging.Formatter("%(message)s"))
-        logger.addHandler(handler)
-        logger.propagate = False
-    logger.setLevel(logging.INFO if comm.rank == 0 else logging.WARNING)
-    return logger
-
-
-def _plain(value):
-    if isinstance(value, dict):
-        return {k: _plain(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return _plain(value.tolist())
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, float) and not np.isfinite(value):
-        return None
-    return value
-
-
-def write_json(path: typing.Union[str, pathlib.Path], data, comm: MPI.Comm = MPI.COMM_WORLD):
-    """Write ``data`` as JSON on rank 0 (NumPy scalars converted, non-finite floats -> null)."""
-    if comm.rank == 0:
-        path = pathlib.Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(json.dumps(_plain(data), indent=1) + "\n")
-    comm.Barrier()
+__all__ = ["FieldWriter", "ModeWriter"]
 
 
 class _XDMFSeries:
     """An XDMF file holding a mesh and a time series of fields (a context manager)."""
 
-    def __init__(self, path: typing.Union[str, pathlib.Path], msh):
+    def __init__(self, path: str | pathlib.Path, msh):
         pathlib.Path(path).parent.mkdir(parents=True, exist_ok=True)
         self.file = io.XDMFFile(msh.comm, str(path), "w")
         self.file.write_mesh(msh)
@@ -78,7 +40,7 @@ class FieldWriter(_XDMFSeries):
     elsewhere). The "time" of each record is the continuation parameter (μ) or the time.
     """
 
-    def __init__(self, path: typing.Union[str, pathlib.Path], model):
+    def __init__(self, path: str | pathlib.Path, model):
         self.model = model
         msh = model.msh
         self.V1 = _compat.vector_function_space(msh, 1)
@@ -105,7 +67,7 @@ class FieldWriter(_XDMFSeries):
 class ModeWriter(_XDMFSeries):
     """XDMF series of complex mode shapes: real and imaginary parts as two degree-1 fields."""
 
-    def __init__(self, path: typing.Union[str, pathlib.Path], model):
+    def __init__(self, path: str | pathlib.Path, model):
         msh = model.msh
         self.mode = fem.Function(model.V)
         self.V1 = _compat.vector_function_space(msh, 1)

@@ -39,7 +39,7 @@ __all__ = [
     "penetration",
 ]
 
-Scalar = typing.Union[float, np.ndarray, ufl.core.expr.Expr]
+Scalar = float | np.ndarray | ufl.core.expr.Expr
 
 
 def check(name: str, value, ok: bool, allowed: str) -> None:
@@ -223,7 +223,7 @@ class StribeckFriction:
         return np.where(v == 0, 0.0, d * np.sign(v))
 
 
-FrictionCoefficient = typing.Union[ConstantFriction, PiecewiseLinearFriction, StribeckFriction]
+FrictionCoefficient = ConstantFriction | PiecewiseLinearFriction | StribeckFriction
 
 
 # --- the interface law as a validated parameter set ---------------------------------------------
@@ -248,13 +248,13 @@ class InterfaceLaw:
     c_n: float
     m_n: float
     mu: float = 0.0
-    m_T: typing.Optional[float] = None
+    m_T: float | None = None
     b_n: float = 0.0
-    l_n: typing.Optional[float] = None
+    l_n: float | None = None
     g: float = 0.0
     eps: float = 1e-3
     regularisation: str = "c1"
-    friction_coefficient: typing.Optional[FrictionCoefficient] = None
+    friction_coefficient: FrictionCoefficient | None = None
 
     def __post_init__(self):
         if self.m_T is None:

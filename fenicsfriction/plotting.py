@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import typing
 
+from mpi4py import MPI
+
 import numpy as np
 from dolfinx import fem
-
-from mpi4py import MPI
 
 from fenicsfriction import _compat
 
@@ -22,7 +22,7 @@ def _pyplot():
     return plt
 
 
-def cell_outlines(u: fem.Function) -> typing.Optional[tuple[np.ndarray, np.ndarray]]:
+def cell_outlines(u: fem.Function) -> tuple[np.ndarray, np.ndarray] | None:
     """Reference coordinates and displacements of every quadrilateral's corners, on rank 0.
 
     Returns ``(X, U)`` of shape (num_cells, 4, 2) on rank 0 and ``None`` elsewhere.

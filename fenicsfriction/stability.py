@@ -25,22 +25,21 @@ from __future__ import annotations
 import dataclasses
 import typing
 
-import numpy as np
-import scipy.linalg
-import scipy.optimize
-
-import dolfinx.fem.petsc  # noqa: F401
-
 from mpi4py import MPI
 from petsc4py import PETSc
 from slepc4py import SLEPc
 
+import dolfinx.fem.petsc
+import numpy as np
+import scipy.optimize
+
 from fenicsfriction import _compat
-from fenicsfriction.assembly import assemble_jacobian, options_with_defaults
+from fenicsfriction.assembly import assemble_jacobian
 from fenicsfriction.forms import Residual
 from fenicsfriction.laws import check
+from fenicsfriction.petsc_options import options_with_defaults
 
-__all__ = ["EigenSolveError", "Mode", "StabilitySolver", "dense_eigenvalues", "mac", "track"]
+__all__ = ["EigenSolveError", "Mode", "StabilitySolver", "mac", "track"]
 
 DEFAULT_OPTIONS = {
     "pep_type": "toar",
@@ -77,17 +76,6 @@ class Mode:
     ident: int = -1
 
 
-def dense_eigenvalues(K: np.ndarray, C: np.ndarray, M: np.ndarray) -> np.ndarray:
-    """Finite eigenvalues of (λ²M + λC + K) w = 0 from the companion linearisation
-    [[0, I], [-K, -C]] z = λ [[I, 0], [0, M]] z (dense, scipy), sorted by |λ|."""
-    n = K.shape[0]
-    zero, eye = np.zeros((n, n)), np.eye(n)
-    lam = scipy.linalg.eig(np.block([[zero, eye], [-K, -C]]),
-                           np.block([[eye, zero], [zero, M]]), right=False)
-    lam = lam[np.isfinite(lam)]
-    return lam[np.argsort(np.abs(lam))]
-
-
 def mac(a: np.ndarray, b: np.ndarray, comm: MPI.Comm) -> float:
     """Modal assurance criterion |a^H b|² / ((a^H a)(b^H b)) of distributed complex vectors."""
     ab, aa, bb = comm.allreduce(np.array([np.vdot(a, b), np.vdot(a, a), np.vdot(b, b)]))
@@ -109,7 +97,7 @@ class StabilitySolver:
     """
 
     def __init__(self, residual: Residual, prefix: str = "stability_",
-                 options: typing.Optional[dict] = None, residual_tol: float = 1e-8):
+                 options: dict | None = None, residual_tol: float = 1e-8):
         check("residual_tol", residual_tol, residual_tol > 0, "must be > 0")
         self.residual = residual
         self.residual_tol = residual_tol
@@ -171,7 +159,7 @@ class StabilitySolver:
         return float(value)
 
     def solve(self, max_modulus: float, nev: int = 8, max_nev: int = 400,
-              shift: typing.Optional[float] = None) -> list[Mode]:
+              shift: float | None = None) -> list[Mode]:
         """Every eigenvalue with |λ| <= ``max_modulus`` (Im λ >= 0), sorted by |λ|.
 
         Args:
@@ -280,7 +268,7 @@ class Loci:
         return self.stability.solve(self.max_modulus)
 
     def follow(self, values: typing.Iterable[float],
-               on_step: typing.Optional[typing.Callable[[dict, list[Mode]], None]] = None
+               on_step: typing.Callable[[dict, list[Mode]], None] | None = None
                ) -> list[dict]:
         """Steady state and eigenvalues at each value; modes tracked by MAC from step to step.
 
@@ -303,7 +291,7 @@ class Loci:
         return [m for m in modes if is_unstable(m, self.growth_tol)]
 
     def onset(self, stable: float, unstable: float, tol: float = 1e-4,
-              reference: typing.Optional[list[Mode]] = None) -> dict:
+              reference: list[Mode] | None = None) -> dict:
         """Bisect [stable, unstable] for the parameter where a mode starts to grow.
 
         Args:

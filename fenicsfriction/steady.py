@@ -21,18 +21,17 @@ import dataclasses
 import time
 import typing
 
+from petsc4py import PETSc
+
+import dolfinx.fem.petsc
 import numpy as np
 from dolfinx import fem
 
-import dolfinx.fem.petsc  # noqa: F401
-
-from petsc4py import PETSc
-
 from fenicsfriction import _compat
-from fenicsfriction.assembly import (RoundoffConvergence, assemble_jacobian, assemble_residual,
-                                     options_with_defaults)
+from fenicsfriction.assembly import assemble_jacobian, assemble_residual
 from fenicsfriction.forms import Residual
 from fenicsfriction.laws import check
+from fenicsfriction.petsc_options import RoundoffConvergence, options_with_defaults
 
 __all__ = ["ContinuationError", "SolveError", "SolveReport", "SteadySolver", "continuation",
            "epsilon_sequence"]
@@ -53,7 +52,7 @@ DEFAULT_OPTIONS = {
 class SolveError(RuntimeError):
     """A Newton solve did not converge; ``report`` says how, the state was restored."""
 
-    def __init__(self, message: str, report: "SolveReport"):
+    def __init__(self, message: str, report: SolveReport):
         super().__init__(message)
         self.report = report
 
@@ -103,7 +102,7 @@ class SteadySolver:
     """
 
     def __init__(self, residual: Residual, prefix: str = "steady_",
-                 options: typing.Optional[dict] = None, jit_cache_dir: typing.Optional[str] = None,
+                 options: dict | None = None, jit_cache_dir: str | None = None,
                  roundoff_safety: float = 1.0):
         self.residual = residual
         self.u = residual.u
@@ -168,9 +167,9 @@ class SteadySolver:
 
 
 def continuation(solver: SteadySolver, parameter: fem.Constant, targets: typing.Iterable[float],
-                 observe: typing.Optional[typing.Callable[[], dict]] = None,
+                 observe: typing.Callable[[], dict] | None = None,
                  max_halvings: int = 8,
-                 on_step: typing.Optional[typing.Callable[[dict], None]] = None) -> list[dict]:
+                 on_step: typing.Callable[[dict], None] | None = None) -> list[dict]:
     """Step ``parameter`` through ``targets``, solving at each value.
 
     Args:
@@ -227,7 +226,7 @@ def continuation(solver: SteadySolver, parameter: fem.Constant, targets: typing.
 
 
 def epsilon_sequence(solver: SteadySolver, eps: fem.Constant, values: typing.Iterable[float],
-                     observe: typing.Optional[typing.Callable[[], dict]] = None) -> list[dict]:
+                     observe: typing.Callable[[], dict] | None = None) -> list[dict]:
     """Kalker's sequential ε process: solve for each ε in ``values``, warm-starting each solve.
 
     Each record has ``eps``, ``newton_iterations``, ``change`` (the max-norm of the solution

@@ -3,9 +3,9 @@
 import gc
 import pathlib
 
-import pytest
-
 from mpi4py import MPI
+
+import pytest
 
 
 @pytest.fixture(autouse=True)

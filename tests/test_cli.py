@@ -8,10 +8,10 @@ import subprocess
 import sys
 import tempfile
 
+from mpi4py import MPI
+
 import numpy as np
 import pytest
-
-from mpi4py import MPI
 
 from fenicsfriction.cli import main
 
@@ -38,7 +38,7 @@ def test_steady_cli_writes_one_balanced_record_per_step(out_dir):
     records = json.loads((out_dir / "steady.json").read_text())
     assert isinstance(records, list) and len(records) == 7
     for r in records:
-        assert REQUIRED <= set(r)
+        assert set(r) >= REQUIRED
         # statics of the block (Newton tolerance ~1e-7 of the load, see SteadySolver)
         assert r["friction_force"] == pytest.approx(r["mu"] * r["normal_force"], rel=1e-8, abs=1e-8)
         assert r["spring_force"] == pytest.approx(-r["friction_force"], rel=1e-6, abs=1e-6)
@@ -104,7 +104,7 @@ def test_steady_cli_stops_at_discrete_tipping_limit_and_reports_it(out_dir):
     assert len(json.loads((out_dir / "steady.json").read_text())) == 2  # μ = 0 and 0.85
 
 
-@pytest.mark.parametrize("flag,value,name", [("--mu-max", "-1", "--mu-max"),
+@pytest.mark.parametrize(("flag", "value", "name"), [("--mu-max", "-1", "--mu-max"),
                                              ("--refine", "0", "refine"),
                                              ("--belt-direction", "2", "belt_direction"),
                                              ("--eps", "0", "eps")])
@@ -123,7 +123,7 @@ def test_bad_parameter_value_is_reported_by_name(out_dir, capsys, flag, value, n
                                   ["--regularisation", "tanh"]])
 def test_user_error_prints_one_line_without_traceback(tmp_path, args):
     cmd = [sys.executable, "-m", "fenicsfriction", "steady", "block", "--mu-max", "0.5",
-           "--out", str(tmp_path)] + args
+           "--out", str(tmp_path), *args]
     env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_"))}
     result = subprocess.run(cmd, capture_output=True, text=True, timeout=120, env=env)
     assert result.returncode == 2

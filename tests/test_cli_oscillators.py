@@ -5,9 +5,9 @@ import json
 import math
 import pathlib
 
-import pytest
-
 from mpi4py import MPI
+
+import pytest
 
 from fenicsfriction.cli import main
 
@@ -56,13 +56,13 @@ def test_mdof_oscillator_cli_writes_the_time_series(out_dir):
     assert summary["averaged_growth"] < 0 and summary["floquet_growth"] < 0   # 30.16: stable
 
 
-@pytest.mark.parametrize("args, name", [
+@pytest.mark.parametrize(("args", "name"), [
     (["oscillator", "belt", "--m", "0"], "m=0.0"),
     (["oscillator", "belt", "--k", "-1"], "k=-1.0"),
     (["oscillator", "mdof", "--omega", "0"], "--omega=0.0"),
     (["stability-map", "mdof", "--omega-range", "5:1"], "--omega-range='5:1'")])
 def test_bad_oscillator_input_is_named(out_dir, capsys, args, name):
-    assert main(args + ["--out", str(out_dir)] if "--t-end" in args or args[0] != "oscillator"
-                else args + ["--t-end", "1", "--out", str(out_dir)]) == 2
+    assert main([*args, "--out", str(out_dir)] if "--t-end" in args or args[0] != "oscillator"
+                else [*args, "--t-end", "1", "--out", str(out_dir)]) == 2
     if MPI.COMM_WORLD.rank == 0:
         assert name in capsys.readouterr().err

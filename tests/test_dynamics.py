@@ -1,10 +1,10 @@
 """Dynamics (TSALPHA2 on the one residual) against the eigenproblem and energy conservation."""
 
+from mpi4py import MPI
+
 import numpy as np
 import pytest
 import scipy.optimize
-
-from mpi4py import MPI
 
 import fenicsfriction as ff
 from fenicsfriction.dynamics import DynamicsSolver

@@ -3,10 +3,10 @@
 Without ``--with-mpi`` pytest-mpi skips these tests; they run in the MPI pass.
 """
 
+from mpi4py import MPI
+
 import numpy as np
 import pytest
-
-from mpi4py import MPI
 
 import fenicsfriction as ff
 from fenicsfriction._compat import petsc_vec

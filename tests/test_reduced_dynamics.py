@@ -15,16 +15,20 @@ the same integration.
 
 import itertools
 
-import numpy as np
-import pytest
-import scipy.integrate
-import scipy.optimize
-
 from petsc4py import PETSc
 
-from fenicsfriction.dynamics import DynamicsError
-from fenicsfriction.reduced import (BouncingMass, ReducedDynamics, RigidBlock,
-                                    rigid_block_observables)
+import numpy as np
+import pytest
+import scipy.optimize
+from scipy.integrate import trapezoid
+
+from fenicsfriction.reduced import (
+    BouncingMass,
+    ReducedDynamics,
+    RigidBlock,
+    rigid_block_observables,
+)
+from fenicsfriction.timestepping import DynamicsError
 
 _COUNTER = itertools.count()
 
@@ -260,8 +264,8 @@ def test_energy_is_conserved_to_second_order_and_exactly_for_a_linear_foundation
     assert np.abs(energy - energy[0]).max() < 1e-11 * 0.5 * linear.mass * v0**2
 
 
-@pytest.mark.parametrize("y,y_dot,m_n,b_n", [(-1e-4, 0.3, 2.5, 0.0), (-2e-4, -0.7, 2.5, 1e9),
-                                             (-1e-3, 0.5, 1.0, 1e5), (2e-4, 0.3, 2.5, 1e9)])
+@pytest.mark.parametrize(("y", "y_dot", "m_n", "b_n"), [
+    (-1e-4, 0.3, 2.5, 0.0), (-2e-4, -0.7, 2.5, 1e9), (-1e-3, 0.5, 1.0, 1e5), (2e-4, 0.3, 2.5, 1e9)])
 def test_bouncing_mass_linearisation_is_the_derivative_of_its_residual(y, y_dot, m_n, b_n):
     """(M, C, K) against central differences of R, in contact with and without damping and
     in flight (all zero but M). Steps 1e-6 of |y| and of |ẏ|: truncation ≈ (1e-6)²,
@@ -324,7 +328,7 @@ def two_modes(t, a1, w1, c1, s1, a2, w2, c2, s2, c0):
             + np.exp(a2 * t) * (c2 * np.cos(w2 * t) + s2 * np.sin(w2 * t)) + c0)
 
 
-@pytest.mark.parametrize("mu,v_y,t_end", [(1.0, -1e-5, 5e-3), (0.15, -1e-4, 2e-2)])
+@pytest.mark.parametrize(("mu", "v_y", "t_end"), [(1.0, -1e-5, 5e-3), (0.15, -1e-4, 2e-2)])
 def test_small_perturbation_grows_or_decays_with_the_rigid_eigenvalues(mu, v_y, t_end):
     """From the steady state with a u̇_yG perturbation (Newmark step 1e-5 s as in the paper),
     the normal force N(t) carries the normal and rotation pairs only (with the spring through
@@ -397,9 +401,9 @@ def test_rigid_block_probe_tractions_integrate_to_the_resultants():
         pressure = np.array([o["probe_pressure"] for o in probes])
         friction = np.array([o["probe_friction"] for o in probes])
         whole = probes[0]
-        assert rb.B0 * np.trapz(pressure, x) == pytest.approx(whole["normal_force_elastic"],
+        assert rb.B0 * trapezoid(pressure, x) == pytest.approx(whole["normal_force_elastic"],
                                                               rel=1e-6)
-        assert rb.B0 * np.trapz(friction, x) == pytest.approx(whole["friction_force"], rel=1e-6)
+        assert rb.B0 * trapezoid(friction, x) == pytest.approx(whole["friction_force"], rel=1e-6)
         assert friction == pytest.approx(0.5 * pressure, rel=1e-12, abs=0)
         assert whole["probe_v_x"] - whole["probe_slip"] == rb.belt_speed
     assert (pressure == 0).any() and (pressure > 0).any()  # the tilted state is partly open

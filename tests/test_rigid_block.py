@@ -7,12 +7,12 @@ FE comparison is distributed.
 
 import itertools
 
+from mpi4py import MPI
+
 import numpy as np
 import pytest
 import scipy.integrate
 import scipy.optimize
-
-from mpi4py import MPI
 
 import fenicsfriction as ff
 from fenicsfriction.reduced import RigidBlock
@@ -149,7 +149,7 @@ def test_tangential_pair_does_not_move_with_mu_when_the_spring_acts_through_g():
     assert abs(high - low) > 1e-7 * omega
 
 
-@pytest.mark.parametrize("B0,spring_height", [(30.5, None), (30.5, 10.0), (14.0, None),
+@pytest.mark.parametrize(("B0", "spring_height"), [(30.5, None), (30.5, 10.0), (14.0, None),
                                               (14.0, 10.0)])
 def test_stiff_fe_block_has_the_eigenvalues_of_the_rigid_block(B0, spring_height):
     """E × 10³: the FE eigenvalues below 1.5 max|λ_rigid| are the three rigid-body modes

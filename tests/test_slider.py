@@ -8,8 +8,13 @@ import pytest
 
 from fenicsfriction import laws
 from fenicsfriction.reduced.events import HybridError, integrate_hybrid
-from fenicsfriction.reduced.slider import (Contact, Slider, SliderMotion, stroboscopic_growth,
-                                           table2_slider)
+from fenicsfriction.reduced.slider import (
+    Contact,
+    Slider,
+    SliderMotion,
+    stroboscopic_growth,
+    table2_slider,
+)
 
 
 def test_table2_natural_frequencies_are_the_roots_of_the_frequency_equation():
@@ -20,7 +25,7 @@ def test_table2_natural_frequencies_are_the_roots_of_the_frequency_equation():
     assert omega == pytest.approx(roots, rel=1e-13)
     assert np.round(omega, 4) == pytest.approx([0.9950, 31.7807], abs=1e-12)
     M, _, _ = table2_slider(30.78).tangential_matrices()
-    assert R.T @ M @ R == pytest.approx(np.eye(2), abs=1e-13)
+    assert pytest.approx(np.eye(2), abs=1e-13) == R.T @ M @ R
 
 
 def test_two_identical_contacts_have_the_antisymmetric_mode_sqrt_kt_over_m():
@@ -112,7 +117,7 @@ def test_steady_sliding_balances_the_mean_friction():
     assert contact.k_t * (q[1] - q[0]) == pytest.approx(friction, rel=1e-12)
 
 
-@pytest.mark.parametrize("field, value", [("mass", 0.0), ("k_n", -1.0), ("wavelength", 0.0),
+@pytest.mark.parametrize(("field", "value"), [("mass", 0.0), ("k_n", -1.0), ("wavelength", 0.0),
                                           ("wavelength", -2.0), ("k_t", -10.0)])
 def test_bad_contact_parameters_are_named_in_the_error(field, value):
     contact = table2_slider(30.0).contacts[0]
@@ -136,7 +141,7 @@ def test_bad_slider_parameters_are_named_in_the_error():
     assert laws.PiecewiseLinearFriction().derivative(3.0) == pytest.approx(-0.03)
 
 
-@pytest.mark.parametrize("omega, case", [(1.0, "I: Ω1 ≈ ω1"), (31.78, "I: Ω2 ≈ ω1"),
+@pytest.mark.parametrize(("omega", "case"), [(1.0, "I: Ω1 ≈ ω1"), (31.78, "I: Ω2 ≈ ω1"),
                                          (15.9, "III: Ω2 ≈ ω1+ω1"), (10.0, "non-resonant")])
 def test_cases_I_III_and_non_resonant_are_stable_at_the_modal_damping_rate(omega, case):
     # Table 1: away from Case II the averaged growth is -min ξ_ii/2, here < 0 (ξ_ii > 0);

@@ -14,21 +14,21 @@ order), where κ(λ) is its relative condition number (:func:`sensitivity`).
 import dataclasses
 import itertools
 
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import dolfinx.fem.petsc
 import numpy as np
 import pytest
 import scipy.optimize
 from dolfinx import fem
 
-import dolfinx.fem.petsc
-
-from mpi4py import MPI
-from petsc4py import PETSc
-
 import fenicsfriction as ff
 from fenicsfriction import _compat
 from fenicsfriction.forms import friction
+from fenicsfriction.numerics import dense_eigenvalues
 from fenicsfriction.scenes.block import TOP
-from fenicsfriction.stability import Loci, StabilitySolver, dense_eigenvalues, unstable_intervals
+from fenicsfriction.stability import Loci, StabilitySolver, unstable_intervals
 
 COMM = MPI.COMM_WORLD
 MAX_MODULUS = 3e4  # [1/s]; the nearest eigenvalues are 2.49e4 below and > 3.5e4 above

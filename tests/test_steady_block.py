@@ -15,13 +15,12 @@ motions (all linear, so nodally exact):
   (weight and top pressure have no moment about it, friction acts on y = 0 with no lever).
 """
 
+from mpi4py import MPI
+
+import dolfinx.fem.petsc
 import numpy as np
 import pytest
 from dolfinx import fem
-
-import dolfinx.fem.petsc
-
-from mpi4py import MPI
 
 import fenicsfriction as ff
 from fenicsfriction._compat import petsc_vec
@@ -47,7 +46,7 @@ def slack(residual_norm: float, atol: float, n_dofs: int) -> float:
 
 # --- a closed-form solution -----------------------------------------------------------------
 
-@pytest.mark.parametrize("refine,degree", [(1, 2), (2, 2), (2, 1)])
+@pytest.mark.parametrize(("refine", "degree"), [(1, 2), (2, 2), (2, 1)])
 def test_frictionless_block_under_top_pressure_penetrates_uniformly(refine, degree):
     """No weight, pressure p on top, no friction: σ_yy = -p everywhere (a linear displacement
     field, exact in Q1 and Q2), so every contact node penetrates d = (p / c_n)^(1/m_n)."""
@@ -282,7 +281,7 @@ def test_failed_continuation_raises_and_keeps_the_last_converged_step():
     """Beyond tipping (μ = 1.7 > L/H) no steady state exists: the continuation gives up after
     Newton fails, reports the converged targets and leaves the last of them in place."""
     scene = ff.BlockOnBelt()
-    assert 1.7 > scene.tipping_limit
+    assert scene.tipping_limit < 1.7
     model = scene.build(COMM, with_friction=True)
     model.initial_guess()
     solver = ff.SteadySolver(model.residual, prefix="fail_",

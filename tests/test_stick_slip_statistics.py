@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from fenicsfriction.dynamics import stick_slip_statistics
+from fenicsfriction.statistics import stick_slip_statistics
 
 
 def records(n: int = 4001) -> list[dict]:

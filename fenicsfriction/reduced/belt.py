@@ -37,8 +37,12 @@ import numpy as np
 
 from fenicsfriction import laws
 from fenicsfriction.laws import check, check_positive
-from fenicsfriction.reduced.events import (HybridEvent, HybridResult, integrate_hybrid,
-                                           mode_intervals)
+from fenicsfriction.reduced.events import (
+    HybridEvent,
+    HybridResult,
+    integrate_hybrid,
+    mode_intervals,
+)
 
 __all__ = ["BeltOscillator", "BeltResult", "LimitCycle", "belt_summary", "displacement_extrema",
            "limit_cycle"]
@@ -121,7 +125,7 @@ class BeltOscillator:
     N: float
     v_belt: float
     friction: laws.FrictionCoefficient
-    mu_static: typing.Optional[float] = None
+    mu_static: float | None = None
 
     size: typing.ClassVar[int] = 2
 
@@ -270,10 +274,10 @@ class BeltOscillator:
             mu = mu + jump * np.exp(-np.abs(v_r) / math.sqrt(eps * self.v_belt))
         return mu * self.N * laws.abs_smooth_derivative(v_r, eps)
 
-    def simulate(self, t_end: float, x0: typing.Optional[float] = None,
-                 v0: typing.Optional[float] = None, method: str = "events",
-                 eps: typing.Optional[float] = None, rtol: float = 1e-8, atol: float = 1e-10,
-                 sample_dt: typing.Optional[float] = None, max_step: typing.Optional[float] = None,
+    def simulate(self, t_end: float, x0: float | None = None,
+                 v0: float | None = None, method: str = "events",
+                 eps: float | None = None, rtol: float = 1e-8, atol: float = 1e-10,
+                 sample_dt: float | None = None, max_step: float | None = None,
                  prefix: str = "belt_") -> BeltResult:
         """Integrate from (x0, v0) over [0, t_end].
 
@@ -295,8 +299,8 @@ class BeltOscillator:
               "must be 'events' or 'regularised'")
         x0 = self.steady_sliding() if x0 is None else float(x0)
         v0 = 0.0 if v0 is None else float(v0)
-        kwargs = dict(rtol=rtol, atol=atol, sample_dt=sample_dt, max_step=max_step,
-                      prefix=prefix)
+        kwargs = {"rtol": rtol, "atol": atol, "sample_dt": sample_dt, "max_step": max_step,
+                      "prefix": prefix}
         if method == "regularised":
             eps = 1e-3 * self.v_belt if eps is None else eps
             check_positive("eps", eps)

@@ -6,7 +6,7 @@ r"""Time integration of the few-d.o.f. models: PETSc TS (TSALPHA2) without a mes
 * ``linearisation(q, q_dot) -> (M, C, K)`` = (∂R/∂q̈, ∂R/∂q̇, ∂R/∂q), dense n × n,
 
 with the shared set-up, Newton stopping test, cut-back and run loop of
-:class:`~fenicsfriction.dynamics.Alpha2Integrator` (sequential, on ``MPI.COMM_SELF``: every rank
+:class:`~fenicsfriction.timestepping.Alpha2Integrator` (sequential, on ``MPI.COMM_SELF``: every rank
 integrates the same small system). The Jacobian TS asks for is :math:`K + s_v C + s_a M`.
 
 :class:`BouncingMass` is the smallest such model with the interface's normal law: a mass under
@@ -18,17 +18,16 @@ the forces and the contact state of a :class:`~fenicsfriction.reduced.RigidBlock
 from __future__ import annotations
 
 import dataclasses
-import typing
-
-import numpy as np
 
 from mpi4py import MPI
 from petsc4py import PETSc
 
+import numpy as np
+
 from fenicsfriction import laws
-from fenicsfriction.dynamics import Alpha2Integrator
 from fenicsfriction.laws import check
 from fenicsfriction.reduced.rigid_block import _dphi
+from fenicsfriction.timestepping import Alpha2Integrator
 
 __all__ = ["BouncingMass", "ReducedDynamics", "rigid_block_observables"]
 
@@ -40,7 +39,7 @@ class ReducedDynamics(Alpha2Integrator):
         model: offers ``residual(q, q_dot, q_ddot)`` and ``linearisation(q, q_dot)``.
         q0, q_dot0: initial displacement and velocity (n values each).
         prefix: PETSc options prefix of the TS (and its SNES/KSP/PC).
-        options: defaults over :data:`~fenicsfriction.dynamics.DEFAULT_OPTIONS` (LU by PETSc's
+        options: defaults over :data:`~fenicsfriction.timestepping.DEFAULT_OPTIONS` (LU by PETSc's
             own dense factorisation instead of MUMPS); options in the database win.
         atol: absolute Newton tolerance on the residual (force units); None: 1e-10 times the
             model's ``weight`` if it has a positive one, else 1e-10.
@@ -58,7 +57,7 @@ class ReducedDynamics(Alpha2Integrator):
     """
 
     def __init__(self, model, q0, q_dot0, prefix: str = "reduced_",
-                 options: typing.Optional[dict] = None, atol: typing.Optional[float] = None):
+                 options: dict | None = None, atol: float | None = None):
         q0, q_dot0 = (np.array(x, dtype=float).ravel() for x in (q0, q_dot0))
         check("q0", q0, q0.size > 0 and np.all(np.isfinite(q0)), "must be finite numbers")
         check("q_dot0", q_dot0, q_dot0.shape == q0.shape and np.all(np.isfinite(q_dot0)),
@@ -127,7 +126,7 @@ class BouncingMass:
     m_n: float = 2.5
     area: float = 48.8 * 30.5
     b_n: float = 0.0
-    l_n: typing.Optional[float] = None
+    l_n: float | None = None
 
     def __post_init__(self):
         if self.l_n is None:
@@ -180,10 +179,10 @@ class BouncingMass:
             + self.c_n * self.area * d ** (self.m_n + 1) / (self.m_n + 1) + self.weight * y
 
 
-def rigid_block_observables(block, q, q_dot, probe_x: typing.Optional[float] = None) -> dict:
+def rigid_block_observables(block, q, q_dot, probe_x: float | None = None) -> dict:
     r"""Forces, motion and contact state of a :class:`~fenicsfriction.reduced.RigidBlock` at
     (q, q̇), under the names of :meth:`~fenicsfriction.scenes.block.BlockModel.dynamics_observer`
-    so that :func:`~fenicsfriction.dynamics.stick_slip_statistics` and
+    so that :func:`~fenicsfriction.statistics.stick_slip_statistics` and
     :func:`~fenicsfriction.plotting.plot_stick_slip` read FE and rigid runs alike.
 
     Returns:

@@ -42,14 +42,14 @@ from __future__ import annotations
 import dataclasses
 import typing
 
-import numpy as np
-
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from fenicsfriction.assembly import options_with_defaults
-from fenicsfriction.dynamics import DynamicsError
+import numpy as np
+
 from fenicsfriction.laws import check
+from fenicsfriction.petsc_options import options_with_defaults
+from fenicsfriction.timestepping import DynamicsError
 
 __all__ = ["DEFAULT_OPTIONS", "HybridError", "HybridEvent", "HybridResult", "HybridSystem",
            "integrate_hybrid", "mode_intervals"]
@@ -168,7 +168,7 @@ class _Stop(Exception):
 class _History:
     """Recorded times, states, modes and observations, plus the run's counters."""
 
-    def __init__(self, sample_dt: typing.Optional[float], observe):
+    def __init__(self, sample_dt: float | None, observe):
         self.sample_dt, self.observe = sample_dt, observe
         self.t: list[float] = []
         self.y: list[np.ndarray] = []
@@ -208,8 +208,8 @@ class _Segment:
     def __init__(self, system: HybridSystem, mode, history: _History):
         self.system, self.mode, self.history = system, mode, history
         self.fired: list[int] = []
-        self.failure: typing.Optional[str] = None
-        self.left_after: typing.Optional[float] = None  # time to an event starting at zero
+        self.failure: str | None = None
+        self.left_after: float | None = None  # time to an event starting at zero
         # found negative: then the mode was left at once, or left and re-entered in that time
         self.dt_max = 0.0
         self.locating = 0  # right-hand sides evaluated since the last accepted step
@@ -270,7 +270,7 @@ class _Segment:
                 history.next_sample += 1
 
     def run(self, t0: float, y0: np.ndarray, t_end: float, dt: float, options: dict,
-            prefix: str, event_tol: typing.Optional[float] = None) -> None:
+            prefix: str, event_tol: float | None = None) -> None:
         """Integrate from (t0, y0) to the first event or t_end; ``event_tol`` overrides the
         ``ts_event_tol`` option (which sets the base tolerance)."""
         self.t0, self.t, self.y = t0, t0, y0
@@ -326,7 +326,7 @@ class _Segment:
 
 def _smooth_segment(system: HybridSystem, mode, history: _History, t: float, y: np.ndarray,
                     t_end: float, dt: float, options: dict, prefix: str,
-                    event_tol: typing.Optional[float]) -> _Segment:
+                    event_tol: float | None) -> _Segment:
     """Integrate in ``mode`` from (t, y) to its first event or t_end, retrying what can be
     retried: a first step that jumped over a short excursion of an event starting at zero
     (smaller step), and a location stalled below the time resolution (larger tolerance)."""
@@ -354,11 +354,10 @@ def _smooth_segment(system: HybridSystem, mode, history: _History, t: float, y: 
 
 
 def integrate_hybrid(system: HybridSystem, y0, mode0, t_end: float, *, rtol: float = 1e-8,
-                     atol: float = 1e-10, dt0: typing.Optional[float] = None,
-                     max_step: typing.Optional[float] = None, max_events: int = 100000,
-                     sample_dt: typing.Optional[float] = None,
-                     observe: typing.Optional[typing.Callable[[float, np.ndarray, object],
-                                                              dict]] = None,
+                     atol: float = 1e-10, dt0: float | None = None,
+                     max_step: float | None = None, max_events: int = 100000,
+                     sample_dt: float | None = None,
+                     observe: typing.Callable[[float, np.ndarray, object], dict] | None = None,
                      prefix: str = "hybrid_") -> HybridResult:
     """Integrate a piecewise-smooth system from t = 0 to ``t_end``, locating each event.
 

@@ -31,8 +31,8 @@ import typing
 import numpy as np
 
 from fenicsfriction.laws import check
+from fenicsfriction.numerics import dense_eigenvalues
 from fenicsfriction.scenes.block import BlockData
-from fenicsfriction.stability import dense_eigenvalues
 
 __all__ = ["RigidBlock"]
 
@@ -57,7 +57,7 @@ class RigidBlock(BlockData):
         Other parameters: see :class:`~fenicsfriction.scenes.block.BlockData`.
     """
 
-    inertia: typing.Optional[float] = None
+    inertia: float | None = None
     viscous: tuple = (0.0, 0.0, 0.0)
 
     def __post_init__(self):
@@ -76,7 +76,7 @@ class RigidBlock(BlockData):
               "must be three finite coefficients >= 0")
 
     @classmethod
-    def from_scene(cls, scene: BlockData, **changes) -> "RigidBlock":
+    def from_scene(cls, scene: BlockData, **changes) -> RigidBlock:
         """The rigid counterpart of a scene (its :class:`BlockData` fields), with ``changes``.
 
         A uniform top pressure p of the FE scene is a vertical resultant p L B0 through G, so
@@ -91,7 +91,7 @@ class RigidBlock(BlockData):
         return cls(**{**shared, **changes})
 
     @classmethod
-    def with_modal_damping(cls, ratios: tuple, **data) -> "RigidBlock":
+    def with_modal_damping(cls, ratios: tuple, **data) -> RigidBlock:
         """A block with viscous damping c_i = 2 ζ_i sqrt(k_i m_i), ζ = ``ratios`` for
         (u_xG, u_yG, θ), k_i the diagonal of K̄ at the frictionless steady state of the block
         ``data`` describes (where K̄ and the mass matrix are diagonal, so the ζ_i are exactly its
@@ -111,7 +111,7 @@ class RigidBlock(BlockData):
         return np.diag([self.mass, self.mass, self.inertia])
 
     # --- base integrals --------------------------------------------------------------------------
-    def _contact_interval(self, q: np.ndarray) -> typing.Optional[tuple[float, float, bool]]:
+    def _contact_interval(self, q: np.ndarray) -> tuple[float, float, bool] | None:
         """Contact part [lo, hi] of the base and whether d vanishes at ``lo`` (else at ``hi``
         or nowhere: full contact)."""
         a, theta = -q[1] - self.g, q[2]
@@ -176,7 +176,7 @@ class RigidBlock(BlockData):
         return self.mass_matrix @ q_ddot + np.asarray(self.viscous) * q_dot \
             - self.generalised_forces(np.asarray(q, float), np.asarray(q_dot, float))
 
-    def linearisation(self, q: np.ndarray, q_dot: typing.Optional[np.ndarray] = None
+    def linearisation(self, q: np.ndarray, q_dot: np.ndarray | None = None
                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(M, C, K̄) = (∂R/∂q̈, ∂R/∂q̇, ∂R/∂q) at (q, q̇), derived by hand from the laws."""
         q = np.asarray(q, float)
@@ -212,7 +212,7 @@ class RigidBlock(BlockData):
         return np.array([self.belt_direction * self.mu * self.weight / self.K_x, -d0 - self.g,
                          0.0])
 
-    def steady_state(self, q0: typing.Optional[np.ndarray] = None, tol: float = 1e-12,
+    def steady_state(self, q0: np.ndarray | None = None, tol: float = 1e-12,
                      max_it: int = 100) -> np.ndarray:
         """Steady sliding Q(q, 0) = 0 by Newton with backtracking, from ``q0``.
 

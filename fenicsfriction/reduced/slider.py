@@ -50,11 +50,11 @@ import math
 import time
 import typing
 
-import numpy as np
-import scipy.linalg
-
 from mpi4py import MPI
 from petsc4py import PETSc
+
+import numpy as np
+import scipy.linalg
 
 from fenicsfriction import laws
 from fenicsfriction.laws import check, check_positive
@@ -113,7 +113,7 @@ class Contact:
     wavelength: float
     surface_speed: float
     friction: typing.Any = dataclasses.field(default_factory=laws.PiecewiseLinearFriction)
-    mu_static: typing.Optional[float] = None
+    mu_static: float | None = None
     normal_force_factor: float = 1.0
 
     def __post_init__(self):
@@ -179,7 +179,7 @@ class AveragedStability:
     case: str
     modal_damping: np.ndarray
     gamma: np.ndarray
-    gamma_crit: typing.Optional[float]
+    gamma_crit: float | None
 
 
 @dataclasses.dataclass(frozen=True)
@@ -577,7 +577,7 @@ class SliderMotion:
     """
 
     def __init__(self, slider: Slider, normal_force: str = "signed", coupled: bool = False,
-                 eps: typing.Optional[float] = None, linearised: bool = False):
+                 eps: float | None = None, linearised: bool = False):
         check("normal_force", normal_force, normal_force in _NORMAL_FORCE_MODELS,
               f"must be one of {_NORMAL_FORCE_MODELS}")
         check("eps", eps, eps is None or (math.isfinite(eps) and eps > 0),

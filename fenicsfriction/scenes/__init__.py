@@ -1,7 +1,7 @@
 """Scenes: geometry, tags and parameters of the papers' examples (data, not logic)."""
 
-from fenicsfriction.scenes.block import BlockModel, BlockOnBelt
+from fenicsfriction.scenes.block import BlockData, BlockModel, BlockOnBelt
 
-__all__ = ["BlockModel", "BlockOnBelt", "SCENES"]
+__all__ = ["SCENES", "BlockData", "BlockModel", "BlockOnBelt"]
 
 SCENES = {"block": BlockOnBelt}

@@ -38,16 +38,27 @@ from __future__ import annotations
 import dataclasses
 import typing
 
+from mpi4py import MPI
+
 import numpy as np
 import ufl
 from dolfinx import fem, mesh
 
-from mpi4py import MPI
-
 from fenicsfriction import _compat, laws
-from fenicsfriction.forms import (NodalSpring, Residual, body_force, elasticity, friction, inertia,
-                                  is_speed_law, normal_compliance, normal_damping, normal_part,
-                                  surface_traction, tangential_part)
+from fenicsfriction.forms import (
+    NodalSpring,
+    Residual,
+    body_force,
+    elasticity,
+    friction,
+    inertia,
+    is_speed_law,
+    normal_compliance,
+    normal_damping,
+    normal_part,
+    surface_traction,
+    tangential_part,
+)
 from fenicsfriction.laws import check
 
 __all__ = ["BlockData", "BlockModel", "BlockOnBelt"]
@@ -102,16 +113,16 @@ class BlockData:
     c_n: float = 1e10
     m_n: float = 2.5
     mu: float = 0.0
-    m_T: typing.Optional[float] = None
+    m_T: float | None = None
     b_n: float = 0.0
-    l_n: typing.Optional[float] = None
+    l_n: float | None = None
     g: float = 0.0
     eps: float = 1e-3
     regularisation: str = "c1"
     belt_speed: float = 0.287
     belt_direction: int = 1
     K_x: float = 11.1
-    spring_height: typing.Optional[float] = None
+    spring_height: float | None = None
 
     def __post_init__(self):
         if self.spring_height is None:
@@ -165,7 +176,7 @@ class BlockOnBelt(BlockData):
     E: float = 1.4e6
     nu: float = 0.25
     top_pressure: float = 0.0
-    friction_coefficient: typing.Optional[laws.FrictionCoefficient] = None
+    friction_coefficient: laws.FrictionCoefficient | None = None
     refine: int = 1
     degree: int = 2
     contact_quadrature: str = "gauss"
@@ -206,7 +217,7 @@ class BlockOnBelt(BlockData):
         return (self.L / 2 - s_1) / self.spring_height
 
     def build(self, comm: MPI.Comm = MPI.COMM_WORLD,
-              with_friction: typing.Optional[bool] = None) -> "BlockModel":
+              with_friction: bool | None = None) -> BlockModel:
         """Mesh, spaces, the residual and its parameters as ``fem.Constant``.
 
         Args:
@@ -229,7 +240,7 @@ def _vertex_rows(n_rows: int, degree: int, H: float, target: float) -> np.ndarra
     j, fraction = divmod(k, degree)
     if fraction:  # a row inside cell row j: slide that cell row so the node row hits target
         low = target - fraction / degree * spacing
-        if 0 < j < n_rows - 1 and 0 < low and low + spacing < H:
+        if 0 < j < n_rows - 1 and low > 0 and low + spacing < H:
             return np.concatenate([np.linspace(0.0, low, j + 1),
                                    np.linspace(low + spacing, H, n_rows - j)])
     j = min(max(int(round(target / spacing)), 1), n_rows - 1)  # move the nearest vertex row
@@ -251,7 +262,7 @@ class BlockModel:
 
     CONTACT = CONTACT
 
-    def __init__(self, scene: BlockOnBelt, comm: MPI.Comm, with_friction: typing.Optional[bool]):
+    def __init__(self, scene: BlockOnBelt, comm: MPI.Comm, with_friction: bool | None):
         self.scene = s = scene
         law = s.law
         if with_friction is None:
@@ -443,7 +454,7 @@ class BlockModel:
         n_open, n_stick, n_slip = self.msh.comm.allreduce(counts, op=MPI.SUM)
         return {"n_open": int(n_open), "n_stick": int(n_stick), "n_slip": int(n_slip)}
 
-    def band_damping(self) -> typing.Optional[ufl.Form]:
+    def band_damping(self) -> ufl.Form | None:
         """Linear form of the nodal dashpots of sticking nodes, ∫ c_T d^{m_T}/ε v_T ds (per
         tangential dof), for the explicit scheme's stable step; None without friction."""
         if not self.with_friction:
@@ -456,7 +467,7 @@ class BlockModel:
         return self.thickness * laws.friction_bound(self.penetration(), c_T, self.m_T) \
             / self.eps * tangential * self.ds_contact
 
-    def dynamics_observer(self, probe_x: typing.Optional[float] = None) -> typing.Callable:
+    def dynamics_observer(self, probe_x: float | None = None) -> typing.Callable:
         """An ``observe(t)`` for the time integrators: one flat record of the state per step.
 
         Resultants (:meth:`quantities`), centre-of-mass motion (``u_yG``, ``v_yG``, ``theta``),

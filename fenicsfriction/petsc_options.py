@@ -1,0 +1,78 @@
+"""PETSc plumbing without a mesh: option defaults under a prefix and a Newton stopping test.
+
+Used by every PETSc driver of the package, the finite element solvers and the reduced models
+alike, so it imports petsc4py only (no dolfinx).
+"""
+
+from __future__ import annotations
+
+import contextlib
+
+from petsc4py import PETSc
+
+import numpy as np
+
+__all__ = ["RoundoffConvergence", "options_with_defaults"]
+
+
+@contextlib.contextmanager
+def options_with_defaults(prefix: str, defaults: dict):
+    """Put ``defaults`` into the PETSc options database under ``prefix`` for the duration of
+    the block (call ``setFromOptions`` inside it), then take them out again.
+
+    Options already in the database (set by the user: command line, ``PETSC_OPTIONS`` or code)
+    win and are left alone; the defaults never outlive the block, so a later solver with the
+    same prefix gets its own defaults rather than these.
+    """
+    opts = PETSc.Options(prefix)
+    added = [key for key in defaults if not opts.hasName(key)]
+    for key in added:
+        opts[key] = defaults[key]
+    try:
+        yield opts
+    finally:
+        for key in added:
+            opts.delValue(key)
+
+
+class RoundoffConvergence:
+    r"""SNES convergence test: PETSc's atol/rtol tests on the residual norm, with atol raised at
+    each iteration to ``safety`` times the residual's round-off floor
+    :math:`\sqrt{n}\,\varepsilon_{mach}\,\lVert J\rVert_\infty \lVert x\rVert_\infty`
+    (cancellation in :math:`J x`: large when a soft spring carries a large rigid displacement,
+    or, in a time step, when the acceleration is differenced from displacements). ``max_it`` and
+    line-search failures stay PETSc's; the step-length test (``snes_stol``) is not used: it
+    accepts a step small against ‖x‖ (the rigid slide) while the penetration is still wrong.
+
+    Install with ``snes.setConvergenceTest(test)`` after ``setFromOptions`` and call
+    :meth:`jacobian_assembled` from the Jacobian callback. ``atol_used`` is the tolerance of
+    the last test.
+    """
+
+    def __init__(self, snes: PETSc.SNES, safety: float = 1.0):
+        self.safety = safety
+        self.rtol, self.atol = snes.getTolerances()[:2]
+        self.atol_used = self.atol
+        self._jacobian_norm = 0.0
+        self._f0 = np.inf
+
+    def jacobian_assembled(self, A: PETSc.Mat) -> None:
+        self._jacobian_norm = A.norm(PETSc.NormType.INFINITY)
+
+    def floor(self, x: PETSc.Vec) -> float:
+        """sqrt(n) ε_mach ‖J‖_∞ ‖x‖_∞ with the last assembled Jacobian J."""
+        return float(np.sqrt(x.getSize()) * np.finfo(float).eps * self._jacobian_norm
+                     * x.norm(PETSc.NormType.INFINITY))
+
+    def __call__(self, snes, it, norms):
+        fnorm = norms[2]
+        if not np.isfinite(fnorm):
+            return PETSc.SNES.ConvergedReason.DIVERGED_FNORM_NAN
+        if it == 0:
+            self._f0 = fnorm
+        self.atol_used = max(self.atol, self.safety * self.floor(snes.getSolution()))
+        if fnorm <= self.atol_used:
+            return PETSc.SNES.ConvergedReason.CONVERGED_FNORM_ABS
+        if it > 0 and fnorm <= self.rtol * self._f0:
+            return PETSc.SNES.ConvergedReason.CONVERGED_FNORM_RELATIVE
+        return PETSc.SNES.ConvergedReason.ITERATING

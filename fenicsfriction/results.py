@@ -1,0 +1,72 @@
+"""How results leave the program: typed records with ``to_json``, JSON files written on rank 0,
+and the package logger (INFO on rank 0 only).
+
+Imports NumPy and mpi4py only, so the reduced models use it as the finite element ones do.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import logging
+import pathlib
+import typing
+
+from mpi4py import MPI
+
+import numpy as np
+
+__all__ = ["Record", "get_logger", "to_plain", "write_json"]
+
+
+def to_plain(value: typing.Any) -> typing.Any:
+    """``value`` as JSON-ready Python: records and dicts to dicts, arrays and tuples to lists,
+    NumPy scalars to Python numbers, complex numbers to ``[re, im]``, non-finite floats to None."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return {f.name: to_plain(getattr(value, f.name)) for f in dataclasses.fields(value)
+                if f.repr}
+    if isinstance(value, dict):
+        return {str(k): to_plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [to_plain(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return to_plain(value.tolist())
+    if isinstance(value, np.generic):
+        return to_plain(value.item())
+    if isinstance(value, complex):
+        return [to_plain(value.real), to_plain(value.imag)]
+    if isinstance(value, float) and not np.isfinite(value):
+        return None
+    return value
+
+
+class Record:
+    """Mixin for the package's result dataclasses: ``to_json()`` gives plain JSON-ready data.
+
+    Fields declared with ``repr=False`` (large arrays such as eigenvectors) are left out.
+    """
+
+    def to_json(self) -> dict[str, typing.Any]:
+        """The record as a dict of JSON-ready values (see :func:`to_plain`)."""
+        return to_plain(self)
+
+
+def get_logger(comm: MPI.Comm = MPI.COMM_WORLD) -> logging.Logger:
+    """The package logger: INFO on rank 0, warnings only elsewhere."""
+    logger = logging.getLogger("fenicsfriction")
+    if not logger.handlers:
+        handler = logging.StreamHandler()
+        handler.setFormatter(logging.Formatter("%(message)s"))
+        logger.addHandler(handler)
+        logger.propagate = False
+    logger.setLevel(logging.INFO if comm.rank == 0 else logging.WARNING)
+    return logger
+
+
+def write_json(path: str | pathlib.Path, data, comm: MPI.Comm = MPI.COMM_WORLD):
+    """Write ``data`` as JSON on rank 0 (NumPy scalars converted, non-finite floats -> null)."""
+    if comm.rank == 0:
+        path = pathlib.Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(to_plain(data), indent=1) + "\n")
+    comm.Barrier()

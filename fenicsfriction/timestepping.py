@@ -1,0 +1,171 @@
+r"""Second-order time stepping by PETSc TS without a mesh: the driver shared by the finite
+element dynamics (:class:`fenicsfriction.dynamics.DynamicsSolver`) and the few-d.o.f. models
+(:class:`fenicsfriction.reduced.ReducedDynamics`).
+
+The default scheme is PETSc's generalized-α method for second-order systems (``TSALPHA2``),
+Newton (SNES) at each step, with the step cut back to a quarter when Newton fails and grown back
+afterwards (see :class:`Alpha2Integrator`). It imports petsc4py only (no dolfinx).
+"""
+
+from __future__ import annotations
+
+import time
+import typing
+
+from petsc4py import PETSc
+
+import numpy as np
+
+from fenicsfriction.laws import check
+from fenicsfriction.petsc_options import RoundoffConvergence, options_with_defaults
+
+__all__ = ["DEFAULT_OPTIONS", "Alpha2Integrator", "DynamicsError"]
+
+
+DEFAULT_OPTIONS = {
+    "ts_type": "alpha2",
+    "ts_alpha_radius": 1.0,
+    "ts_adapt_type": "none",
+    "ts_max_snes_failures": -1,
+    "ts_max_reject": 20,
+    "ts_exact_final_time": "matchstep",
+    "snes_type": "newtonls",
+    "snes_linesearch_type": "bt",
+    "snes_rtol": 1e-10,
+    "snes_max_it": 10,  # converged steps take 2-4; a cycling Newton is cut back sooner
+    "ksp_type": "preonly",
+    "pc_type": "lu",
+    "pc_factor_mat_solver_type": "mumps",
+}
+
+
+class DynamicsError(RuntimeError):
+    """The time integration stopped before the final time; ``records`` holds the steps done."""
+
+    def __init__(self, message: str, records: list):
+        super().__init__(message)
+        self.records = records
+
+
+class Alpha2Integrator:
+    """PETSc TS (TSALPHA2 by default) on a second-order system R(t, x, ẋ, ẍ) = 0: the set-up,
+    the Newton stopping test, the cut-back and regrowth of the step, and the run loop with its
+    records, shared by the FE solver and the few-d.o.f. models of :mod:`fenicsfriction.reduced`.
+
+    A subclass provides the residual ``_F(ts, t, x, xdot, xddot, F)``, the Jacobian
+    ``_J(ts, t, x, xdot, xddot, shift_v, shift_a, J, P)`` (which must call
+    ``self.convergence.jacobian_assembled(J)``), ``_load(x, xdot, xddot)`` (put an accepted state
+    where ``observe`` reads it) and ``_state()`` (the initial displacement and velocity vectors,
+    which receive the final state).
+
+    Attributes:
+        ts: the PETSc TS, exposed for monitoring or further configuration.
+        fixed_steps: no error control (``ts_adapt_type none``): a cut step grows back.
+        convergence: the Newton stopping test (its ``atol_used``: the last tolerance).
+    """
+
+    def __init__(self, comm, prefix: str, F: PETSc.Vec, J: PETSc.Mat,
+                 options: dict | None, atol: float):
+        check("atol", atol, np.isfinite(atol) and atol > 0, "must be a finite number > 0")
+        self.ts = PETSc.TS().create(comm)
+        self.ts.setOptionsPrefix(prefix)
+        self.ts.setI2Function(self._F, F)
+        self.ts.setI2Jacobian(self._J, J)
+        with options_with_defaults(prefix, {**DEFAULT_OPTIONS, "snes_atol": atol,
+                                            **(options or {})}) as opts:
+            self.ts.setFromOptions()
+            # petsc4py 3.18 does not wrap TSAdapt: read the choice from the options
+            self.fixed_steps = opts.getString("ts_adapt_type") == "none"
+        self.convergence = RoundoffConvergence(self.ts.getSNES())
+        self.ts.getSNES().setConvergenceTest(self.convergence)
+
+    def _F(self, ts, t, x, xdot, xddot, F):
+        raise NotImplementedError
+
+    def _J(self, ts, t, x, xdot, xddot, shift_v, shift_a, J, P):
+        raise NotImplementedError
+
+    def _load(self, x, xdot, xddot) -> None:
+        raise NotImplementedError
+
+    def _state(self) -> tuple[PETSc.Vec, PETSc.Vec]:
+        raise NotImplementedError
+
+    def run(self, t_end: float, dt: float,
+            observe: typing.Callable[[float], dict] | None = None,
+            on_step: typing.Callable[[dict], None] | None = None) -> list[dict]:
+        """Integrate from t = 0 to ``t_end`` with (initial) step ``dt``.
+
+        Args:
+            observe: called after every accepted step (fields hold the state), its dict is
+                merged into the step's record.
+            on_step: called with each record (progress output, field output).
+
+        Returns:
+            One record per accepted step (and one for t = 0): ``time``, ``dt``,
+            ``newton_iterations`` (rejected attempts included), ``rejected_steps`` (cut-backs
+            and error-control rejections before this step), ``wall_time_s`` and what
+            ``observe`` adds.
+
+        Raises:
+            DynamicsError: TS stopped early (e.g. too many step rejections); the fields hold
+                the last accepted state and ``error.records`` the steps done.
+        """
+        check("t_end", t_end, t_end > 0, "must be > 0")
+        check("dt", dt, 0 < dt <= t_end, f"must lie in (0, t_end = {t_end}]")
+        u, v = (vec.copy() for vec in self._state())
+        self.ts.setSolution2(u, v)
+        self.ts.setTime(0.0)
+        self.ts.setStepNumber(0)
+        self.ts.setTimeStep(dt)
+        self.ts.setMaxTime(t_end)
+        self.ts.setMaxSteps(10**9)
+        records: list[dict] = []
+        clock = [time.perf_counter(), 0, 0]
+
+        def regrow(ts):  # after a cut-back, back to the step asked for (not past t_end)
+            remaining = t_end - ts.getTime()
+            if self.fixed_steps and ts.getTimeStep() < min(dt, remaining):
+                ts.setTimeStep(min(2.0 * ts.getTimeStep(), dt, remaining))
+
+        def monitor(ts, step, t, x):
+            snes_its, rejected = ts.getSNESIterations(), ts.getStepRejections()
+            record = {"time": float(t), "dt": 0.0,
+                      "newton_iterations": snes_its - clock[1],
+                      "rejected_steps": rejected - clock[2],
+                      "wall_time_s": time.perf_counter() - clock[0]}
+            clock[:] = time.perf_counter(), snes_its, rejected
+            if step:  # the fields hold the last residual evaluation: load the accepted state
+                self._load(x, ts.getSolution2()[1], None)
+                record["dt"] = float(t - records[-1]["time"])
+            if observe is not None:
+                record.update(observe(float(t)))
+            records.append(record)
+            if on_step is not None:
+                on_step(record)
+
+        self.ts.setMonitor(monitor)
+        self.ts.setPostStep(regrow)
+        error = None
+        try:
+            self.ts.solve(u)
+        except PETSc.Error as err:  # e.g. a NaN in the error estimate: report, keep the state
+            error = err
+        self.ts.cancelMonitor()
+        self.ts.setPostStep(None)
+        reason = self.ts.getConvergedReason()
+        x, x_dot = self.ts.getSolution2()
+        self._load(x, x_dot, None)  # also after a failure: the last accepted state
+        for target, vec in zip(self._state(), (x, x_dot), strict=True):
+            vec.copy(target)
+        u.destroy()
+        v.destroy()
+        if error is not None:
+            raise DynamicsError(f"TS failed at t = {self.ts.getTime():.6g} after "
+                                f"{self.ts.getStepNumber()} steps with PETSc error {error.ierr} "
+                                f"(see the PETSc trace above); the fields hold the last "
+                                f"accepted state", records) from error
+        if reason < 0:
+            raise DynamicsError(f"TS stopped at t = {self.ts.getTime():.6g} with reason "
+                                f"{reason} after {self.ts.getStepNumber()} steps", records)
+        return records
