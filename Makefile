@@ -3,6 +3,8 @@
 SHELL := /bin/bash
 PY := .venv/bin/python
 NP ?= 2
+# the linters `make test` runs, pinned as in pyproject.toml's `lint` extra
+LINTERS := ruff==0.17.6 mypy==2.4.1
 OUT ?= results
 APT_PACKAGES := python3-dolfinx python3-petsc4py python3-slepc4py python3-mpi4py python3-ufl \
     python3-basix python3-ffcx python3-numpy python3-scipy python3-matplotlib python3-pytest \
@@ -13,7 +15,7 @@ MPIRUN := mpirun -n $(NP) $(shell [ "$$(id -u)" = 0 ] && echo --allow-run-as-roo
 export OMPI_MCA_rmaps_base_oversubscribe := 1
 export PYTHONDONTWRITEBYTECODE := 1
 
-.PHONY: setup demo test test-serial test-mpi benchmark clean
+.PHONY: setup demo lint test test-serial test-mpi benchmark clean
 
 .venv/.installed: pyproject.toml
 	@missing=$$(for p in $(APT_PACKAGES); do dpkg-query -W -f='$${Status}' $$p 2>/dev/null \
@@ -24,6 +26,7 @@ export PYTHONDONTWRITEBYTECODE := 1
 	        --no-install-recommends $$missing; fi
 	/usr/bin/python3 -m venv --system-site-packages .venv
 	$(PY) -m pip install --quiet --no-build-isolation --no-deps -e .
+	$(PY) -m pip install --quiet $(LINTERS)
 	@touch $@
 
 setup: .venv/.installed
@@ -34,13 +37,17 @@ demo: setup
 	FENICSFRICTION_DEMO_OUT=$(OUT)/stick-slip-block $(MPIRUN) $(PY) demos/demo_block_stick_slip.py
 	FENICSFRICTION_DEMO_OUT=$(OUT)/slider $(MPIRUN) $(PY) demos/demo_slider_table2.py
 
+lint: setup
+	$(PY) -m ruff check .
+	$(PY) -m mypy
+
 test-serial: setup
 	$(PY) -m pytest -q tests
 
 test-mpi: setup
 	$(MPIRUN) $(PY) -m mpi4py -m pytest -q --with-mpi tests
 
-test: test-serial test-mpi
+test: lint test-serial test-mpi
 
 benchmark: setup
 	$(PY) benchmarks/bench_steady.py --out $(OUT)/benchmarks
