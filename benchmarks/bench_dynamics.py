@@ -89,7 +89,7 @@ class Scene:
             last[0] = t
             q = self.model.quantities()
             observe.seconds += time.perf_counter() - t0
-            return {"N": q["normal_force"], "F": q["friction_force"]}
+            return {"N": q.normal_force, "F": q.friction_force}
 
         observe.seconds = 0.0
         return observe

@@ -1,11 +1,12 @@
-r"""Cost against accuracy of the reduced friction oscillators (seed 004 and the belt).
+r"""Cost against accuracy of the reduced friction oscillators (the m.d.o.f. slider and the belt).
 
-**Stability map** of seed 004's Table 2 slider (paper reading) over the forcing frequency:
-first-order averaging (closed-form averaged eigenvalues, Cases I-III) against Floquet
-multipliers (monodromy matrix over one period by PETSc TS, Dormand–Prince, rtol 1e-10). For
-each method: wall time per forcing frequency, and the unstable band edges (bisected to 1e-4)
-against those of Floquet at rtol 1e-12 (the reference). The ratio Floquet ÷ averaging per ω_o
-is the cost figure.
+**Stability map** of the Table 2 slider of "Friction-induced sliding instability in a
+multi-degree-of-freedom system with oscillatory normal forces" (2003) (paper reading) over
+the forcing frequency: first-order averaging (closed-form averaged eigenvalues, Cases I-III)
+against Floquet multipliers (monodromy matrix over one period by PETSc TS, Dormand–Prince,
+rtol 1e-10). For each method: wall time per forcing frequency, and the unstable band edges
+(bisected to 1e-4) against those of Floquet at rtol 1e-12 (the reference). The ratio
+Floquet ÷ averaging per ω_o is the cost figure.
 
 **Stick-slip integration** of the 1-d.o.f. oscillator on a belt whose limit cycle is known
 in closed form (m = k = N = 1, c = 0, μ_s = 0.6, μ_k = 0.3, v_b = 0.5: period
@@ -28,8 +29,9 @@ import time
 import numpy as np
 
 from fenicsfriction import laws
-from fenicsfriction.reduced import BeltOscillator, limit_cycle
+from fenicsfriction.reduced import BeltOscillator
 from fenicsfriction.reduced.slider import stability_map, table2_slider
+from fenicsfriction.statistics import limit_cycle
 
 BANDS = [(29.0, 34.0), (60.0, 67.0)]
 SAMPLES = 41

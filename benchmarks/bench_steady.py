@@ -122,7 +122,7 @@ def run_mesh(refine: int, comm: MPI.Comm) -> dict:
     samples: dict[float, dict] = {}
 
     def observe() -> dict:
-        q = model.quantities()
+        q = model.quantities().to_json()
         uy = probe(model.residual.u)  # collective: every rank calls it at the same μ
         for mu in MU_SAMPLES:
             if np.isclose(q["mu"], mu):

@@ -12,7 +12,8 @@ at each step. TS asks for
 
 Steps: fixed (``-dynamics_ts_adapt_type none``, the default) or adaptive
 (``-dynamics_ts_adapt_type basic``, error-controlled). A step whose Newton solve fails is
-retried with a quarter of the step (``ts_max_snes_failures = -1``): the cut-back of seed 001,
+retried with a quarter of the step (``ts_max_snes_failures = -1``): the cut-back of Pop's
+"A finite element method for frictional contact problems",
 whose Newton iterations cycle across the steep part of φ_ε at slide-to-stick transitions when ε
 is small and the step large. With fixed steps the step then grows back (doubling after each
 accepted step) to the one asked for, so a transition costs a few small steps, not the rest of
@@ -75,7 +76,7 @@ class DynamicsSolver(Alpha2Integrator):
     def _state(self) -> tuple[PETSc.Vec, PETSc.Vec]:
         return _compat.petsc_vec(self.residual.u), _compat.petsc_vec(self.residual.u_dot)
 
-    def _load(self, x, xdot, xddot) -> None:
+    def _load(self, x: typing.Any, xdot: typing.Any, xddot: typing.Any) -> None:
         """Copy a state into the fields (``xddot=None`` leaves the acceleration alone)."""
         for vec, field in ((x, self.residual.u), (xdot, self.residual.u_dot),
                            (xddot, self.residual.u_ddot)):
@@ -95,7 +96,8 @@ class DynamicsSolver(Alpha2Integrator):
 
 
 class CentralDifference:
-    """Explicit central differences with a row-sum lumped mass (seed 000's FE dynamics).
+    """Explicit central differences with a row-sum lumped mass (the FE dynamics of Martins & Oden
+    1986).
 
     .. math::
         a_n = M_L^{-1}\\,(-R(u_n, \\tilde v_n, 0)),\\quad

@@ -1,4 +1,4 @@
-r"""The regularised virtual-power residual of Problem 1ε as a sum of UFL terms (SPEC §2).
+r"""The regularised virtual-power residual of Problem 1ε as a sum of UFL terms.
 
 .. math::
     R(u, \dot u, \ddot u; v) = \rho\langle\ddot u, v\rangle + a(u, v) + \langle P(u), v\rangle
@@ -28,6 +28,7 @@ import ufl
 from dolfinx import fem
 
 from fenicsfriction import laws
+from fenicsfriction.laws import is_speed_law
 
 __all__ = [
     "NodalSpring",
@@ -45,29 +46,30 @@ __all__ = [
     "tangential_part",
 ]
 
-Value = float | ufl.core.expr.Expr
+Value: typing.TypeAlias = typing.Any  # a float or a UFL expression (e.g. a fem.Constant)
+Field = typing.Any  # a UFL vector expression: a Function, an Argument, a FacetNormal, ...
 
 
 # --- kinematics on Γ_C ---------------------------------------------------------------------------
 
-def normal_part(w, n) -> ufl.core.expr.Expr:
+def normal_part(w: Field, n: Field) -> Field:
     """:math:`w_n = w \\cdot n`."""
     return ufl.dot(w, n)
 
 
-def tangential_part(w, n) -> ufl.core.expr.Expr:
+def tangential_part(w: Field, n: Field) -> Field:
     """:math:`w_T = w - (w\\cdot n) n`."""
     return w - ufl.dot(w, n) * n
 
 
 # --- bulk terms ----------------------------------------------------------------------------------
 
-def inertia(rho: Value, u_ddot, v, dx: ufl.Measure) -> ufl.Form:
+def inertia(rho: Value, u_ddot: Field, v: Field, dx: ufl.Measure) -> ufl.Form:
     """:math:`\\rho \\langle \\ddot u, v\\rangle`."""
     return rho * ufl.inner(u_ddot, v) * dx
 
 
-def _lame(E: Value, nu: Value, plane_stress: bool):
+def _lame(E: Value, nu: Value, plane_stress: bool) -> tuple[Value, Value]:
     mu = E / (2 * (1 + nu))
     lmbda = E * nu / ((1 + nu) * (1 - 2 * nu))
     if plane_stress:
@@ -75,10 +77,12 @@ def _lame(E: Value, nu: Value, plane_stress: bool):
     return lmbda, mu
 
 
-def elasticity(u, v, E: Value, nu: Value, dx: ufl.Measure, plane_stress: bool = False) -> ufl.Form:
+def elasticity(u: Field, v: Field, E: Value, nu: Value, dx: ufl.Measure,
+               plane_stress: bool = False) -> ufl.Form:
     """:math:`a_0(u, v) = \\int_\\Omega \\sigma(u):\\varepsilon(v)`, isotropic Hooke's law.
 
-    In 2D the default is plane strain (the block of seed 000); ``plane_stress=True`` switches.
+    In 2D the default is plane strain (the block of Martins & Oden 1986);
+    ``plane_stress=True`` switches.
     """
     lmbda, mu = _lame(E, nu, plane_stress)
     eps_u, eps_v = ufl.sym(ufl.grad(u)), ufl.sym(ufl.grad(v))
@@ -86,58 +90,55 @@ def elasticity(u, v, E: Value, nu: Value, dx: ufl.Measure, plane_stress: bool = 
     return ufl.inner(sigma, eps_v) * dx
 
 
-def elastic_support(u, v, K: Value, U_E, ds: ufl.Measure) -> ufl.Form:
+def elastic_support(u: Field, v: Field, K: Value, U_E: Field, ds: ufl.Measure) -> ufl.Form:
     """Distributed linear springs on :math:`\\Gamma_E`: :math:`\\int K (u - U^E)\\cdot v`."""
     return ufl.inner(K * (u - U_E), v) * ds
 
 
-def body_force(b, v, dx: ufl.Measure) -> ufl.Form:
+def body_force(b: Field, v: Field, dx: ufl.Measure) -> ufl.Form:
     """Load term :math:`-\\int_\\Omega b\\cdot v` (residual sign convention: R = internal - f)."""
     return -ufl.inner(b, v) * dx
 
 
-def surface_traction(t, v, ds: ufl.Measure) -> ufl.Form:
+def surface_traction(t: Field, v: Field, ds: ufl.Measure) -> ufl.Form:
     """Load term :math:`-\\int_{\\Gamma_F} t\\cdot v`."""
     return -ufl.inner(t, v) * ds
 
 
-# --- interface terms on Γ_C (seed 000 eqs. 14-16) -------------------------------------------------
+# --- interface terms on Γ_C (Martins & Oden 1986, eqs. 14-16) ----------------------------------
 
-def normal_compliance(u, v, n, c_n: Value, m_n: Value, g: Value, ds: ufl.Measure) -> ufl.Form:
+def normal_compliance(u: Field, v: Field, n: Field, c_n: Value, m_n: Value, g: Value,
+                      ds: ufl.Measure) -> ufl.Form:
     """:math:`\\langle P(u), v\\rangle = \\int_{\\Gamma_C} c_n (u_n - g)_+^{m_n} v_n`."""
     d = laws.penetration(normal_part(u, n), g)
     return laws.normal_pressure(d, c_n, m_n) * normal_part(v, n) * ds
 
 
-def normal_damping(u, u_dot, v, n, b_n: Value, l_n: Value, g: Value,
-                   ds: ufl.Measure) -> ufl.Form:
+def normal_damping(u: Field, u_dot: Field, v: Field, n: Field, b_n: Value, l_n: Value,
+                   g: Value, ds: ufl.Measure) -> ufl.Form:
     """:math:`\\langle D(u,\\dot u), v\\rangle = \\int_{\\Gamma_C} b_n d^{l_n} \\dot u_n v_n`."""
     d = laws.penetration(normal_part(u, n), g)
     return laws.normal_damping_pressure(d, normal_part(u_dot, n), b_n, l_n) \
         * normal_part(v, n) * ds
 
 
-def friction(u, u_dot, v, n, c_T: Value | typing.Callable, m_T: Value, g: Value,
-             U_T, eps: Value, ds: ufl.Measure, regularisation: str = "c1") -> ufl.Form:
+def friction(u: Field, u_dot: Field, v: Field, n: Field, c_T: Value | typing.Callable,
+             m_T: Value, g: Value, U_T: Field, eps: Value, ds: ufl.Measure,
+             regularisation: str = "c1") -> ufl.Form:
     """Regularised friction power :math:`\\langle J_\\varepsilon(u,\\dot u), v\\rangle`.
 
     .. math:: \\int_{\\Gamma_C} c_T\\, d^{m_T}\\, \\phi_\\varepsilon'(\\dot u_T - U_T)\\cdot v_T
 
+    that is :math:`-\\int t_T \\cdot v_T` with the traction
+    :func:`fenicsfriction.laws.friction_traction`.
     ``c_T`` is a number/UFL value (Coulomb: :math:`\\mu c_n`), or a callable of the relative
     slip speed :math:`|\\dot u_T - U_T|` for a velocity-dependent law, e.g.
     ``lambda s: c_n * PiecewiseLinearFriction()(s)``; its slope then enters every derivative.
     """
     d = laws.penetration(normal_part(u, n), g)
     w = tangential_part(u_dot, n) - U_T
-    if is_speed_law(c_T):
-        c_T = c_T(ufl.sqrt(ufl.inner(w, w)))
-    direction = laws.REGULARISATIONS[regularisation][1](w, eps)
-    return laws.friction_bound(d, c_T, m_T) * ufl.inner(direction, tangential_part(v, n)) * ds
-
-
-def is_speed_law(c_T) -> bool:
-    """True when ``c_T`` is a function of the slip speed (UFL expressions are callable too)."""
-    return callable(c_T) and not isinstance(c_T, ufl.core.expr.Expr)
+    traction = laws.friction_traction(d, w, c_T, m_T, eps, regularisation)
+    return -ufl.inner(traction, tangential_part(v, n)) * ds
 
 
 # --- nodal springs (point loads are not UFL integrals in dolfinx 0.5) ----------------------------
@@ -164,15 +165,15 @@ class NodalSpring:
         """Attach to the node of ``V`` at ``point`` (it must be a node of the mesh)."""
         laws.check("stiffness", stiffness, stiffness > 0, "the spring stiffness must be > 0")
         Vc, to_parent = V.sub(component).collapse()
-        point = np.asarray(point, dtype=float)
+        position = np.asarray(point, dtype=float)
         dofs = fem.locate_dofs_geometrical(
             (V.sub(component), Vc),
-            lambda x: np.linalg.norm(x[:len(point)] - point[:, None], axis=0) < tol)[0]
+            lambda x: np.linalg.norm(x[:len(position)] - position[:, None], axis=0) < tol)[0]
         bs, index_map = V.dofmap.index_map_bs, V.dofmap.index_map
         owned = dofs[dofs < index_map.size_local * bs]
         comm = V.mesh.comm
         count = comm.allreduce(len(owned))
-        laws.check("point", point.tolist(), count == 1,
+        laws.check("point", position.tolist(), count == 1,
                    f"the spring must sit on exactly one node of the mesh (found {count})")
         local = int(owned[0]) if len(owned) else -1
         g = -1
@@ -181,14 +182,14 @@ class NodalSpring:
                     + local % bs)
         g = comm.allreduce(g, op=__import__("mpi4py").MPI.MAX)
         return cls(stiffness=float(stiffness), anchor=float(anchor), local_dof=local,
-                   global_dof=g, position=point)
+                   global_dof=g, position=position)
 
     def add_to_residual(self, b_local: np.ndarray, x_local: np.ndarray) -> None:
         """``b += K (x_i - U)`` on the owning rank (arrays are local, owned part first)."""
         if self.local_dof >= 0:
             b_local[self.local_dof] += self.stiffness * (x_local[self.local_dof] - self.anchor)
 
-    def add_to_matrix(self, A) -> None:
+    def add_to_matrix(self, A: typing.Any) -> None:
         """``A[i, i] += K`` (call between assembly and ``A.assemble()``)."""
         if self.local_dof >= 0:
             from petsc4py import PETSc

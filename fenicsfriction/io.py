@@ -5,6 +5,7 @@ Numbers (JSON, CSV) are written by :mod:`fenicsfriction.results`."""
 from __future__ import annotations
 
 import pathlib
+import typing
 
 import numpy as np
 from dolfinx import fem, io
@@ -17,7 +18,7 @@ __all__ = ["FieldWriter", "ModeWriter"]
 class _XDMFSeries:
     """An XDMF file holding a mesh and a time series of fields (a context manager)."""
 
-    def __init__(self, path: str | pathlib.Path, msh):
+    def __init__(self, path: str | pathlib.Path, msh: typing.Any):
         pathlib.Path(path).parent.mkdir(parents=True, exist_ok=True)
         self.file = io.XDMFFile(msh.comm, str(path), "w")
         self.file.write_mesh(msh)
@@ -40,7 +41,7 @@ class FieldWriter(_XDMFSeries):
     elsewhere). The "time" of each record is the continuation parameter (μ) or the time.
     """
 
-    def __init__(self, path: str | pathlib.Path, model):
+    def __init__(self, path: str | pathlib.Path, model: typing.Any):
         self.model = model
         msh = model.msh
         self.V1 = _compat.vector_function_space(msh, 1)
@@ -67,7 +68,7 @@ class FieldWriter(_XDMFSeries):
 class ModeWriter(_XDMFSeries):
     """XDMF series of complex mode shapes: real and imaginary parts as two degree-1 fields."""
 
-    def __init__(self, path: str | pathlib.Path, model):
+    def __init__(self, path: str | pathlib.Path, model: typing.Any):
         msh = model.msh
         self.mode = fem.Function(model.V)
         self.V1 = _compat.vector_function_space(msh, 1)
@@ -75,7 +76,7 @@ class ModeWriter(_XDMFSeries):
                       fem.Function(self.V1, name="mode_imag"))
         super().__init__(path, msh)
 
-    def write(self, mode, t: float) -> None:
+    def write(self, mode: typing.Any, t: float) -> None:
         """Write ``mode`` (a :class:`~fenicsfriction.stability.Mode`) at "time" ``t``."""
         owned = len(mode.vector)
         for part, values in zip(self.parts, (mode.vector.real, mode.vector.imag), strict=True):

@@ -1,12 +1,16 @@
-r"""Pointwise interface laws of Martins & Oden (seed 000, eqs. 1-2) and their regularisations.
+r"""Pointwise interface laws of Martins & Oden (1986, eqs. 1-2) and their regularisations.
 
 Every builder takes UFL expressions (to be used in forms) or NumPy arrays/floats (to be used in
-reduced models and post-processing) and returns the same kind. Notation (SPEC §1):
+reduced models and post-processing) and returns the same kind. Notation (see docs/theory.md):
 
 * :math:`d = (u_n - g)_+` penetration (approach) of the interface, :math:`g \ge 0` initial gap;
 * normal compliance :math:`c_n d^{m_n}`, normal damping :math:`b_n d^{l_n} \dot u_n`;
 * friction bound :math:`c_T d^{m_T}`; Coulomb is :math:`m_T = m_n`, :math:`c_T = \mu c_n`;
 * regularised friction direction :math:`\phi_\varepsilon'(w)` with :math:`w = \dot u_T - U_T`.
+
+The two tractions of the interface on the body are defined here once, :func:`normal_traction`
+and :func:`friction_traction`; the residual's terms (:mod:`fenicsfriction.forms`), the scenes'
+observables and the reduced models all call them.
 
 Parameters are validated in one place, :class:`InterfaceLaw`; a bad value raises ``ValueError``
 naming the parameter, its value and what is allowed.
@@ -30,32 +34,37 @@ __all__ = [
     "StribeckFriction",
     "abs_c1",
     "abs_c1_derivative",
+    "abs_c1_second_derivative",
     "abs_smooth",
     "abs_smooth_derivative",
+    "abs_smooth_second_derivative",
     "check",
     "friction_bound",
+    "friction_traction",
+    "is_speed_law",
     "normal_damping_pressure",
     "normal_pressure",
+    "normal_traction",
     "penetration",
 ]
 
-Scalar = float | np.ndarray | ufl.core.expr.Expr
+Scalar: typing.TypeAlias = typing.Any  # a float, a NumPy array or a UFL expression
 
 
-def check(name: str, value, ok: bool, allowed: str) -> None:
+def check(name: str, value: typing.Any, ok: bool, allowed: str) -> None:
     """Raise ``ValueError("name=value is invalid: allowed")`` unless ``ok``."""
     if not ok:
         raise ValueError(f"{name}={value!r} is invalid: {allowed}")
 
 
-def check_positive(name: str, value, strict: bool = True) -> None:
+def check_positive(name: str, value: typing.Any, strict: bool = True) -> None:
     """:func:`check` that ``value`` is a finite real number, > 0 (``strict``) or >= 0."""
     ok = isinstance(value, numbers.Real) and math.isfinite(value) \
-        and (value > 0 if strict else value >= 0)
+        and (float(value) > 0 if strict else float(value) >= 0)
     check(name, value, ok, f"must be a finite number {'>' if strict else '>='} 0")
 
 
-def _is_ufl(*xs) -> bool:
+def _is_ufl(*xs: typing.Any) -> bool:
     return any(isinstance(x, ufl.core.expr.Expr) for x in xs)
 
 
@@ -67,7 +76,7 @@ def _min(a: Scalar, b: Scalar) -> Scalar:
     return ufl.min_value(a, b) if _is_ufl(a, b) else np.minimum(a, b)
 
 
-def _norm(w) -> Scalar:
+def _norm(w: typing.Any) -> Scalar:
     """Euclidean norm of a UFL vector; element-wise |w| of NumPy input.
 
     NumPy input is read as scalar tangential velocities (reduced models, one tangent direction).
@@ -85,31 +94,32 @@ def _exp(x: Scalar) -> Scalar:
     return ufl.exp(x) if _is_ufl(x) else np.exp(x)
 
 
-# --- normal response (seed 000 eq. 1) -----------------------------------------------------------
+# --- normal response (Martins & Oden 1986, eq. 1) ----------------------------------------------
 
 def penetration(u_n: Scalar, g: Scalar = 0.0) -> Scalar:
-    """Approach of the interface :math:`d = (u_n - g)_+` (seed 000, Fig. 3)."""
+    """Approach of the interface :math:`d = (u_n - g)_+` (Martins & Oden 1986, Fig. 3)."""
     return _max(u_n - g, 0.0)
 
 
 def normal_pressure(d: Scalar, c_n: Scalar, m_n: Scalar) -> Scalar:
-    """Elastic normal compliance :math:`-\\sigma_n^e = c_n d^{m_n}` (seed 000 eq. 1)."""
+    """Elastic normal compliance :math:`-\\sigma_n^e = c_n d^{m_n}` (Martins & Oden 1986, eq. 1)."""
     return c_n * d**m_n
 
 
 def normal_damping_pressure(d: Scalar, u_n_dot: Scalar, b_n: Scalar, l_n: Scalar) -> Scalar:
-    """Dissipative normal stress :math:`-\\sigma_n^d = b_n d^{l_n} \\dot u_n` (seed 000 eq. 1)."""
+    """Dissipative normal stress :math:`-\\sigma_n^d = b_n d^{l_n} \\dot u_n` (Martins & Oden
+    1986, eq. 1)."""
     return b_n * d**l_n * u_n_dot
 
 
 def friction_bound(d: Scalar, c_T: Scalar, m_T: Scalar) -> Scalar:
-    """Maximum friction stress :math:`c_T d^{m_T}` (seed 000 eq. 2)."""
+    """Maximum friction stress :math:`c_T d^{m_T}` (Martins & Oden 1986, eq. 2)."""
     return c_T * d**m_T
 
 
-# --- regularisations of |w| (seed 001 eq. 15, seed 002 eq. 40) ----------------------------------
+# --- regularisations of |w| (Pop, eq. 15; Kalker 1986, eq. 40) -----------------------------------
 
-def abs_c1(w, eps: Scalar) -> Scalar:
+def abs_c1(w: typing.Any, eps: Scalar) -> Scalar:
     """C1 regularisation :math:`\\phi_\\varepsilon(w) = |w|^2/(2\\varepsilon)` for
     :math:`|w|<\\varepsilon`, :math:`|w| - \\varepsilon/2` otherwise."""
     r = _norm(w)
@@ -118,25 +128,92 @@ def abs_c1(w, eps: Scalar) -> Scalar:
     return np.where(r < eps, r**2 / (2 * eps), r - eps / 2)
 
 
-def abs_c1_derivative(w, eps: Scalar):
+def abs_c1_derivative(w: typing.Any, eps: Scalar) -> typing.Any:
     """:math:`\\phi_\\varepsilon'(w) = w / \\max(|w|, \\varepsilon)` (a vector like ``w``)."""
     return w / _max(_norm(w), eps)
 
 
-def abs_smooth(w, eps: Scalar) -> Scalar:
+def abs_c1_second_derivative(w: Scalar, eps: Scalar) -> Scalar:
+    """:math:`\\phi_\\varepsilon''(w)` of a scalar slip (one tangent direction): 1/ε inside
+    the band |w| < ε, 0 outside. At w = 0 it is also the coefficient of the isotropic
+    tangential stiffness :math:`\\partial\\phi_\\varepsilon'/\\partial w = I/\\varepsilon` of a
+    vector slip."""
+    r = _norm(w)
+    if _is_ufl(r, eps):
+        return ufl.conditional(ufl.lt(r, eps), 1 / eps, 0.0)
+    return np.where(r < eps, 1.0 / eps, 0.0)
+
+
+def abs_smooth(w: typing.Any, eps: Scalar) -> Scalar:
     """Smooth regularisation :math:`\\psi_\\varepsilon(w) = \\sqrt{|w|^2 + \\varepsilon^2}`."""
     return _sqrt(_norm(w) ** 2 + eps**2)
 
 
-def abs_smooth_derivative(w, eps: Scalar):
+def abs_smooth_derivative(w: typing.Any, eps: Scalar) -> typing.Any:
     """:math:`\\psi_\\varepsilon'(w) = w / \\sqrt{|w|^2 + \\varepsilon^2}`."""
     return w / abs_smooth(w, eps)
 
 
-REGULARISATIONS: dict[str, tuple[typing.Callable, typing.Callable]] = {
-    "c1": (abs_c1, abs_c1_derivative),
-    "smooth": (abs_smooth, abs_smooth_derivative),
+def abs_smooth_second_derivative(w: Scalar, eps: Scalar) -> Scalar:
+    """:math:`\\psi_\\varepsilon''(w) = \\varepsilon^2 / (w^2 + \\varepsilon^2)^{3/2}` of a scalar
+    slip; at w = 0, 1/ε, the coefficient of the isotropic tangential stiffness."""
+    return eps**2 / abs_smooth(w, eps) ** 3
+
+
+REGULARISATIONS: dict[str, tuple[typing.Callable[..., typing.Any], ...]] = {
+    "c1": (abs_c1, abs_c1_derivative, abs_c1_second_derivative),
+    "smooth": (abs_smooth, abs_smooth_derivative, abs_smooth_second_derivative),
 }
+"""φ_ε, φ'_ε and φ''_ε (scalar slip) of each regularisation, by name."""
+
+
+# --- the interface tractions (Martins & Oden 1986, eqs. 1-2) --------------------------------------
+
+def normal_traction(d: Scalar, c_n: Scalar, m_n: Scalar, approach_rate: Scalar = 0.0,
+                    b_n: Scalar = 0.0, l_n: Scalar | None = None) -> Scalar:
+    """Normal contact pressure on the body :math:`c_n d^{m_n} + b_n d^{l_n} \\dot d`.
+
+    Args:
+        d: penetration :math:`d \\ge 0` (see :func:`penetration`).
+        c_n, m_n: normal compliance coefficient and exponent.
+        approach_rate: :math:`\\dot u_n`, the normal velocity into the foundation.
+        b_n, l_n: normal damping coefficient and exponent (``None``: ``m_n``).
+
+    Returns:
+        The elastic part (:func:`normal_pressure`) plus the damping part
+        (:func:`normal_damping_pressure`), pushing the body out of the foundation when > 0.
+    """
+    return normal_pressure(d, c_n, m_n) \
+        + normal_damping_pressure(d, approach_rate, b_n, m_n if l_n is None else l_n)
+
+
+def is_speed_law(c_T: typing.Any) -> bool:
+    """True when ``c_T`` is a function of the slip speed (UFL expressions are callable too)."""
+    return callable(c_T) and not isinstance(c_T, ufl.core.expr.Expr)
+
+
+def friction_traction(d: Scalar, w: typing.Any, c_T: typing.Any, m_T: Scalar, eps: Scalar,
+                      regularisation: str = "c1") -> typing.Any:
+    """Regularised friction traction on the body :math:`-c_T d^{m_T} \\phi_\\varepsilon'(w)`.
+
+    Args:
+        d: penetration.
+        w: slip velocity :math:`\\dot u_T - U_T` (UFL vector, or NumPy scalars/arrays: one tangent
+            direction).
+        c_T: the friction coefficient of the bound, a number/UFL value (Coulomb: :math:`\\mu c_n`)
+            or a callable of the slip speed :math:`|w|` (velocity-dependent μ, e.g.
+            ``lambda s: c_n * StribeckFriction(...)(s)``).
+        m_T: friction exponent.
+        eps: regularisation parameter ε.
+        regularisation: ``"c1"`` or ``"smooth"`` (:data:`REGULARISATIONS`).
+
+    Returns:
+        The traction, a vector like ``w`` opposing the slip (Martins & Oden 1986, eq. 2).
+    """
+    if is_speed_law(c_T):
+        c_T = c_T(_norm(w))
+    direction = REGULARISATIONS[regularisation][1](w, eps)
+    return -friction_bound(d, c_T, m_T) * direction
 
 
 # --- velocity-dependent friction coefficients ---------------------------------------------------
@@ -147,20 +224,23 @@ class ConstantFriction:
 
     mu: float
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         check("mu", self.mu, self.mu >= 0, "the friction coefficient must be >= 0")
 
     def __call__(self, speed: Scalar) -> Scalar:
+        """μ at relative velocity ``speed``: the constant."""
         return self.mu + 0 * abs(speed)
 
-    def derivative(self, speed):
+    def derivative(self, speed: Scalar) -> np.ndarray:
         """dμ/dv at the signed relative velocity ``speed`` (NumPy): zero."""
         return 0.0 * np.asarray(speed, dtype=float)
 
 
 @dataclasses.dataclass(frozen=True)
 class PiecewiseLinearFriction:
-    """Seed 004 eq. 59: :math:`\\mu = \\mu_s - s |v|` for :math:`|v| < v_c`, then constant.
+    """:math:`\\mu = \\mu_s - s |v|` for :math:`|v| < v_c`, then constant: eq. 59 of
+    "Friction-induced sliding instability in a multi-degree-of-freedom system with oscillatory
+    normal forces" (2003).
 
     Defaults are the paper's: ``mu_s=0.75, slope=0.03, v_c=15`` (so :math:`\\mu_k = 0.3`).
     """
@@ -169,7 +249,7 @@ class PiecewiseLinearFriction:
     slope: float = 0.03
     v_c: float = 15.0
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         check("mu_s", self.mu_s, self.mu_s >= 0, "the static coefficient must be >= 0")
         check("v_c", self.v_c, self.v_c > 0, "the transition speed must be > 0")
         mu_k = self.mu_s - self.slope * self.v_c
@@ -180,7 +260,7 @@ class PiecewiseLinearFriction:
         """μ at relative velocity ``speed`` (its magnitude is used: signed input is fine)."""
         return self.mu_s - self.slope * _min(abs(speed), self.v_c)
 
-    def derivative(self, speed):
+    def derivative(self, speed: Scalar) -> np.ndarray:
         """dμ/dv at the signed relative velocity ``speed`` (NumPy).
 
         μ is even in v, so the derivative is odd: -slope sgn(v) below v_c, 0 above. At v = 0 and
@@ -202,7 +282,7 @@ class StribeckFriction:
     v_s: float
     exponent: float = 1.0
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         check("mu_k", self.mu_k, self.mu_k >= 0, "the kinetic coefficient must be >= 0")
         check("mu_s", self.mu_s, self.mu_s >= 0, "the static coefficient must be >= 0")
         check("v_s", self.v_s, self.v_s > 0, "the Stribeck speed must be > 0")
@@ -213,7 +293,7 @@ class StribeckFriction:
         ratio = abs(speed) / self.v_s
         return self.mu_k + (self.mu_s - self.mu_k) * _exp(-(ratio**self.exponent))
 
-    def derivative(self, speed):
+    def derivative(self, speed: Scalar) -> np.ndarray:
         """dμ/dv at the signed relative velocity ``speed`` (NumPy); 0 at v = 0."""
         v = np.asarray(speed, dtype=float)
         ratio = np.abs(v) / self.v_s
@@ -241,22 +321,22 @@ class InterfaceLaw:
         l_n: normal damping exponent [-]; ``None`` means l_n = m_n.
         g: initial gap [length], >= 0.
         eps: regularisation parameter of |u̇_T - U_T| [length / time], > 0.
-        regularisation: ``"c1"`` (φ_ε, seed 001 eq. 15) or ``"smooth"`` (ψ_ε, seed 002 eq. 40).
+        regularisation: ``"c1"`` (φ_ε, Pop, eq. 15) or ``"smooth"`` (ψ_ε, Kalker 1986, eq. 40).
         friction_coefficient: optional velocity-dependent μ(|v|); when given it replaces ``mu``.
     """
 
     c_n: float
     m_n: float
     mu: float = 0.0
-    m_T: float | None = None
+    m_T: float = None  # type: ignore[assignment]  # None: set by __post_init__
     b_n: float = 0.0
-    l_n: float | None = None
+    l_n: float = None  # type: ignore[assignment]  # None: set by __post_init__
     g: float = 0.0
     eps: float = 1e-3
     regularisation: str = "c1"
     friction_coefficient: FrictionCoefficient | None = None
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if self.m_T is None:
             self.m_T = self.m_n
         if self.l_n is None:

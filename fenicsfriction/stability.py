@@ -2,7 +2,7 @@ r"""Problem 3, stability of steady sliding: :math:`(\lambda^2 M + \lambda C + \b
 
 The operators are the Gateaux derivatives of the one residual at the steady state
 :math:`(u_0, 0, 0)` (:meth:`Residual.linearisation`); :math:`\bar K` is not symmetric: friction
-couples normal displacement into tangential force (seed 000, eq. 31). Re λ > 0 means the
+couples normal displacement into tangential force (Martins & Oden 1986, eq. 31). Re λ > 0 means the
 steady sliding is dynamically unstable.
 
 SLEPc PEP (TOAR) with shift-and-invert about a real shift σ > 0 (MUMPS LU) computes the
@@ -37,9 +37,12 @@ from fenicsfriction import _compat
 from fenicsfriction.assembly import assemble_jacobian
 from fenicsfriction.forms import Residual
 from fenicsfriction.laws import check
+from fenicsfriction.numerics import bisect
 from fenicsfriction.petsc_options import options_with_defaults
+from fenicsfriction.results import Record
 
-__all__ = ["EigenSolveError", "Mode", "StabilitySolver", "mac", "track"]
+__all__ = ["EigenSolveError", "Loci", "Mode", "Onset", "StabilitySolver", "mac", "track",
+           "unstable_intervals"]
 
 DEFAULT_OPTIONS = {
     "pep_type": "toar",
@@ -230,6 +233,24 @@ def track(previous: list[Mode], current: list[Mode], comm: MPI.Comm,
     return next_ident
 
 
+@dataclasses.dataclass
+class Onset(Record):
+    """Where a mode starts to grow along a continuation (see :meth:`Loci.onset`).
+
+    Attributes:
+        mu_crit: midpoint of the final bisection interval.
+        interval: the final interval [stable, unstable].
+        value: the growing eigenvalue [re, im] just past the onset.
+        colliding: the two modes nearest to it in frequency at the stable end, each with its
+            ``mode`` id and eigenvalue ``re``, ``im``.
+    """
+
+    mu_crit: float
+    interval: list[float]
+    value: list[float]
+    colliding: list[dict[str, typing.Any]]
+
+
 def is_unstable(mode: Mode, growth_tol: float) -> bool:
     """Re λ > growth_tol |λ|: a growing mode (undamped stable modes have Re λ ~ round-off)."""
     return mode.value.real > growth_tol * abs(mode.value)
@@ -253,7 +274,8 @@ class Loci:
         growth_tol: a mode is unstable when Re λ > growth_tol |λ|.
     """
 
-    def __init__(self, steady, stability: StabilitySolver, parameter, max_modulus: float,
+    def __init__(self, steady: typing.Any, stability: StabilitySolver, parameter: typing.Any,
+                 max_modulus: float,
                  growth_tol: float = 1e-6):
         check("growth_tol", growth_tol, growth_tol > 0, "must be > 0")
         self.steady, self.stability, self.parameter = steady, stability, parameter
@@ -291,7 +313,7 @@ class Loci:
         return [m for m in modes if is_unstable(m, self.growth_tol)]
 
     def onset(self, stable: float, unstable: float, tol: float = 1e-4,
-              reference: list[Mode] | None = None) -> dict:
+              reference: list[Mode] | None = None) -> Onset:
         """Bisect [stable, unstable] for the parameter where a mode starts to grow.
 
         Args:
@@ -311,19 +333,15 @@ class Loci:
             reference = self._solve_at(stable)
         if self.unstable(reference) or not self.unstable(self._solve_at(unstable)):
             raise ValueError(f"onset: need no growing mode at {stable} and one at {unstable}")
-        while unstable - stable > tol:
-            mid = 0.5 * (stable + unstable)
-            if self.unstable(self._solve_at(mid)):
-                unstable = mid
-            else:
-                stable = mid
+        stable, unstable = bisect(lambda value: bool(self.unstable(self._solve_at(value))),
+                                  stable, unstable, tol)
         grow = max(self.unstable(self._solve_at(unstable)), key=lambda m: m.value.real)
         self._solve_at(stable)
         nearest = sorted(reference, key=lambda m: abs(m.value.imag - grow.value.imag))[:2]
-        return {"mu_crit": 0.5 * (stable + unstable), "interval": [stable, unstable],
-                "value": [grow.value.real, grow.value.imag],
-                "colliding": [{"mode": m.ident, "re": m.value.real, "im": m.value.imag}
-                              for m in nearest]}
+        return Onset(mu_crit=0.5 * (stable + unstable), interval=[stable, unstable],
+                     value=[grow.value.real, grow.value.imag],
+                     colliding=[{"mode": m.ident, "re": m.value.real, "im": m.value.imag}
+                                for m in nearest])
 
 
 def unstable_intervals(records: list[dict], growth_tol: float = 1e-6) -> dict[int, list]:

@@ -5,14 +5,14 @@ can be changed through the PETSc options database under the solver's prefix (def
 ``steady_``), e.g. ``-steady_snes_rtol 1e-12`` or ``-steady_pc_factor_mat_solver_type
 superlu_dist``.
 
-Drivers on top of one solve (seed 000, "NINCT increments"):
+Drivers on top of one solve (Martins & Oden 1986, "NINCT increments"):
 
 * :func:`continuation` — a parameter (μ) stepped from its current value through a list of
   targets, each Newton solve warm-started from the last; a failed step is halved until it
   converges or ``max_halvings`` is exhausted, which raises :class:`ContinuationError` with the
   last converged state kept in ``u``.
-* :func:`epsilon_sequence` — Kalker's *sequential process* (seed 002 §6): ε_k → 0, each solve
-  starting from the previous one, recording how much the solution still changes.
+* :func:`epsilon_sequence` — Kalker's *sequential process* (Kalker 1986, section 6): ε_k → 0,
+  each solve starting from the previous one, recording how much the solution still changes.
 """
 
 from __future__ import annotations
@@ -167,7 +167,7 @@ class SteadySolver:
 
 
 def continuation(solver: SteadySolver, parameter: fem.Constant, targets: typing.Iterable[float],
-                 observe: typing.Callable[[], dict] | None = None,
+                 observe: typing.Callable[[], typing.Any] | None = None,
                  max_halvings: int = 8,
                  on_step: typing.Callable[[dict], None] | None = None) -> list[dict]:
     """Step ``parameter`` through ``targets``, solving at each value.
@@ -176,7 +176,8 @@ def continuation(solver: SteadySolver, parameter: fem.Constant, targets: typing.
         solver: the steady solver (its ``u`` is the warm start and holds the result).
         parameter: the ``fem.Constant`` being continued (e.g. the friction coefficient).
         targets: the values to reach, in order; each one reached produces one record.
-        observe: returns extra quantities recorded at each converged target.
+        observe: returns extra quantities recorded at each converged target, a dict or a
+            record (e.g. ``model.quantities``) whose fields become columns of the row.
         max_halvings: how many times a failing increment may be halved.
         on_step: called with each record as soon as it exists (progress output).
 
@@ -218,15 +219,23 @@ def continuation(solver: SteadySolver, parameter: fem.Constant, targets: typing.
                   "halvings": halvings,
                   "wall_time_s": time.perf_counter() - t0}
         if observe is not None:
-            record.update(observe())
+            record.update(_row(observe()))
         records.append(record)
         if on_step is not None:
             on_step(record)
     return records
 
 
+def _row(values: typing.Any) -> dict[str, typing.Any]:
+    """The fields of a record (a dataclass such as ``BlockModel.quantities()``), or a dict, as
+    the flat columns of a table row (values as they are, so rows do not depend on which)."""
+    if dataclasses.is_dataclass(values) and not isinstance(values, type):
+        return {f.name: getattr(values, f.name) for f in dataclasses.fields(values)}
+    return dict(values)
+
+
 def epsilon_sequence(solver: SteadySolver, eps: fem.Constant, values: typing.Iterable[float],
-                     observe: typing.Callable[[], dict] | None = None) -> list[dict]:
+                     observe: typing.Callable[[], typing.Any] | None = None) -> list[dict]:
     """Kalker's sequential ε process: solve for each ε in ``values``, warm-starting each solve.
 
     Each record has ``eps``, ``newton_iterations``, ``change`` (the max-norm of the solution
@@ -255,7 +264,7 @@ def epsilon_sequence(solver: SteadySolver, eps: fem.Constant, values: typing.Ite
         record = {"eps": float(value), "newton_iterations": report.iterations, "change": change,
                   "residual_norm": report.residual_norm, "atol": report.atol}
         if observe is not None:
-            record.update(observe())
+            record.update(_row(observe()))
         records.append(record)
     if previous is not None:
         previous.destroy()

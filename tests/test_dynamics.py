@@ -1,5 +1,7 @@
 """Dynamics (TSALPHA2 on the one residual) against the eigenproblem and energy conservation."""
 
+import dataclasses
+
 from mpi4py import MPI
 
 import numpy as np
@@ -26,7 +28,8 @@ def perturbed_run(model, dt: float, t_end: float, v_y: float, prefix: str):
     dynamics = DynamicsSolver(model.residual, prefix=prefix, atol=1e-12 * model.force_scale,
                               options={"snes_rtol": 1e-14})
     return dynamics.run(t_end, dt, observe=lambda t: {
-        "normal_force": model.quantities()["normal_force"], **model.energies()})
+        "normal_force": model.quantities().normal_force,
+        **dataclasses.asdict(model.energies())})
 
 
 def test_energy_without_friction_is_conserved_to_second_order_in_the_step():
@@ -87,7 +90,7 @@ def test_central_differences_agree_with_generalized_alpha_and_respect_the_stable
     for scheme in ("central", "alpha2"):
         model = steady_block(0.6, prefix=f"cd_{scheme}")
         model.residual.u_dot.x.array[1::2] = -1e-4
-        observe = lambda t, m=model: {"normal_force": m.quantities()["normal_force"]}  # noqa: E731
+        observe = lambda t, m=model: {"normal_force": m.quantities().normal_force}  # noqa: E731
         if scheme == "central":
             explicit = CentralDifference(model.residual)
             records = explicit.run(2e-3, 2e-3, observe=observe)
@@ -118,7 +121,7 @@ def test_central_differences_need_the_stick_band_bound_inside_the_band():
         explicit = CentralDifference(model.residual,
                                      band_damping=model.band_damping() if band else None)
         records = explicit.run(1e-3, 1e-3, observe=lambda t, m=model: {
-            "friction": m.quantities()["friction_force"]})
+            "friction": m.quantities().friction_force})
         friction = np.array([r["friction"] for r in records])
         assert friction[0] == pytest.approx(0.6 * weight * 0.005 / 1e-2, rel=1e-6)
         peaks[band] = np.abs(friction - friction[0]).max() / weight
@@ -156,7 +159,8 @@ def test_stable_mu_decays_at_the_rate_of_its_eigenvalue():
 
 
 def test_small_eps_and_a_large_step_are_recovered_by_the_cut_back():
-    """The hard case of seed 001: ε = 1e-3 cm/s and dt = 1e-5 s, past the onset at the slow
+    """The hard case of Pop, "A finite element method for frictional contact problems":
+    ε = 1e-3 cm/s and dt = 1e-5 s, past the onset at the slow
     belt speed. Contact points reach the belt speed within 5 ms; Newton then cycles across the
     regularisation band and fails. The run must finish without user action (failed steps
     retried at a quarter of the step, which then grows back), and agree with a run at a
@@ -169,7 +173,8 @@ def test_small_eps_and_a_large_step_are_recovered_by_the_cut_back():
         solver = DynamicsSolver(model.residual, prefix=f"hard{dt}_ts_",
                                 atol=1e-10 * model.force_scale)
         records = solver.run(7e-3, dt, observe=lambda t, m=model: {
-            "normal_force": m.quantities()["normal_force"], **m.contact_states()})
+            "normal_force": m.quantities().normal_force,
+            **dataclasses.asdict(m.contact_states())})
         assert records[-1]["time"] == pytest.approx(7e-3, rel=1e-12)
         if dt == 1e-5:
             assert sum(r["rejected_steps"] for r in records) > 0  # the cut-back did act

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from fenicsfriction.reduced.events import HybridError, integrate_hybrid
+from fenicsfriction.statistics import mode_intervals
 
 OMEGA = 2.0
 
@@ -181,3 +182,21 @@ def test_bad_arguments_name_the_parameter():
     with pytest.raises(ValueError, match="t_end="):
         integrate_hybrid(HalfSwings(), [1.0, 0.0], "down", 0.0)
 
+
+
+def test_mode_intervals_are_the_half_swings_between_the_turning_points():
+    # "up" holds from the k-th turning point (k odd: x = -1) to the next, kπ/ω to (k+1)π/ω,
+    # and to t_end if the run ends in it
+    result = integrate_hybrid(HalfSwings(), [1.0, 0.0], "down", 10.0)
+    up = mode_intervals(result, lambda mode: mode == "up")
+    down = mode_intervals(result, lambda mode: mode == "down")
+    n = int(10.0 * OMEGA / np.pi)  # turning points before t_end
+    assert len(up) == (n + 1) // 2 and len(down) == n // 2 + 1
+    for a, b in up:
+        k = round(a * OMEGA / np.pi)
+        assert k % 2 == 1 and abs(a - k * np.pi / OMEGA) < 1e-8
+        assert abs(b - min((k + 1) * np.pi / OMEGA, 10.0)) < 1e-8
+    assert down[0][0] == 0.0
+    # together they tile [0, t_end]
+    total = sum(b - a for a, b in up + down)
+    assert total == pytest.approx(10.0, rel=1e-14)

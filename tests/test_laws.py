@@ -1,4 +1,4 @@
-"""Pointwise interface laws (SPEC §1) against closed forms, finite differences and the papers."""
+"""Pointwise interface laws against closed forms, finite differences and the papers."""
 
 import math
 
@@ -14,7 +14,7 @@ from fenicsfriction import laws
 
 EPS = 0.3  # any ε > 0; the closed forms below are written for this value
 
-# (w, φ_ε(w), φ_ε'(w), ψ_ε(w), ψ_ε'(w)) worked by hand from SPEC §1 with ε = 0.3
+# (w, φ_ε(w), φ_ε'(w), ψ_ε(w), ψ_ε'(w)) worked by hand from the definitions with ε = 0.3
 HAND_VALUES = [
     (0.0, 0.0, 0.0, 0.3, 0.0),
     (0.15, 0.0375, 0.5, math.sqrt(0.1125), 0.15 / math.sqrt(0.1125)),  # |w| < ε: w²/(2ε), w/ε
@@ -44,7 +44,7 @@ def test_regularisations_work_elementwise_on_arrays():
 
 @pytest.mark.parametrize("name", sorted(laws.REGULARISATIONS))
 def test_derivatives_are_central_differences_of_the_regularisations(name):
-    f, df = laws.REGULARISATIONS[name]
+    f, df, ddf = laws.REGULARISATIONS[name]
     # points on both sides of the kinks |w| = ε, kept 1e-3 away from them
     w = np.concatenate([np.linspace(-3, -0.301, 40), np.linspace(-0.299, 0.299, 41),
                         np.linspace(0.301, 3, 40)])
@@ -53,6 +53,11 @@ def test_derivatives_are_central_differences_of_the_regularisations(name):
     # truncation: 0 for the piecewise quadratic/linear φ_ε, h²|ψ'''|/6 ≤ h²/ε² ~ 1e-11 for ψ_ε;
     # round-off: ε_mach |f| / h ≤ 1e-16 * 3 / 1e-6 = 3e-10
     np.testing.assert_allclose(fd, df(w, EPS), rtol=0, atol=1e-8)
+    # the second derivative (scalar slip) likewise from φ'_ε: truncation 0 (c1) or
+    # h² |ψ''''| / 6 ≲ h² / ε³ ~ 4e-11 (ψ_ε); round-off ε_mach / h = 1e-10
+    fd2 = (df(w + h, EPS) - df(w - h, EPS)) / (2 * h)
+    np.testing.assert_allclose(fd2, ddf(w, EPS), rtol=0, atol=1e-8)
+    assert ddf(0.0, EPS) == pytest.approx(1 / EPS, rel=1e-14)  # both: 1/ε at zero slip
 
 
 def test_c1_regularisation_is_c1_but_not_c2_at_eps():
@@ -125,8 +130,9 @@ def test_uniform_penetration_solves_the_compliance_law():
     assert laws.normal_pressure(d, law.c_n, law.m_n) == pytest.approx(0.3, rel=1e-14)
 
 
-def test_piecewise_linear_friction_defaults_are_seed_004_eq_59():
-    """μ = 0.75 - 0.03|V_rel| for |V_rel| < 15, 0.3 above (seed 004, eq. 59)."""
+def test_piecewise_linear_friction_defaults_are_those_of_the_slider_paper_eq_59():
+    """μ = 0.75 - 0.03|V_rel| for |V_rel| < 15, 0.3 above (the m.d.o.f. slider paper (2003),
+    eq. 59)."""
     mu = laws.PiecewiseLinearFriction()
     speeds = np.array([0.0, 1.0, 5.0, 10.0, 14.999, 15.0, 15.001, 20.0, 1e3])
     expected = [0.75, 0.72, 0.60, 0.45, 0.75 - 0.03 * 14.999, 0.3, 0.3, 0.3, 0.3]

@@ -289,7 +289,8 @@ def test_bouncing_mass_linearisation_is_the_derivative_of_its_residual(y, y_dot,
 # --- the rigid block: growth and decay of a small perturbation against its eigenvalues --------
 
 def rigid_block(mu: float) -> RigidBlock:
-    """SPEC §4 rigid-model data of Figs. 10-12 (B0 = 14, I = 70, K_x = 2388, belt 0.127 cm/s)
+    """The rigid-model data of Martins & Oden 1986, Figs. 10-12 (B0 = 14, I = 70, K_x = 2388,
+    belt 0.127 cm/s)
     with viscous damping c_i = 2 ζ_i sqrt(k_i m_i), ζ = (0.005, 0.04, 0.04): k_i the diagonal
     of K̄ at the frictionless steady state, where K̄ and the mass matrix are diagonal, so the
     ζ_i are exactly the modal damping ratios at μ = 0; the c_i are then kept for every μ."""

@@ -1,4 +1,4 @@
-r"""The rigid 3-d.o.f. block (seed 000, Fig. 9; SPEC §4) against its own derivatives, statics,
+r"""The rigid 3-d.o.f. block (Martins & Oden 1986, Fig. 9) against its own derivatives, statics,
 its closed-form tangential mode, and the FE block in the stiff limit.
 
 The rigid model is serial NumPy: under MPI every rank computes the same numbers, and only the
@@ -16,6 +16,7 @@ import scipy.optimize
 
 import fenicsfriction as ff
 from fenicsfriction.reduced import RigidBlock
+from fenicsfriction.reduced.rigid_block import rigid_loci
 from fenicsfriction.stability import StabilitySolver
 
 _COUNTER = itertools.count()
@@ -207,3 +208,45 @@ def test_rigid_counterpart_carries_the_top_pressure_and_refuses_a_speed_law():
     with pytest.raises(ValueError, match="friction_coefficient"):
         RigidBlock.from_scene(ff.BlockOnBelt(
             friction_coefficient=ff.laws.StribeckFriction(mu_s=0.8, mu_k=0.5, v_s=0.1)))
+
+
+def test_rigid_loci_bracket_each_onset_between_a_stable_and_a_growing_block():
+    """The onsets are re-checked on blocks solved from scratch: no growing mode onset_tol below
+    μ_crit, one onset_tol above; the unstable intervals cover the grid points that grow."""
+    scene = ff.BlockOnBelt()
+    targets, max_frequency, growth_tol, tol = np.linspace(0.0, 1.4, 8), 6000.0, 1e-6, 1e-3
+    loci = rigid_loci(scene, targets, max_frequency, growth_tol, tol)
+
+    def grows(mu):
+        block = RigidBlock.from_scene(scene, mu=mu)
+        lam = block.eigenvalues(block.steady_state())
+        lam = lam[(lam.imag >= 0) & (np.abs(lam) <= max_frequency)]
+        return bool(np.any(lam.real > growth_tol * np.abs(lam)))
+
+    assert loci.onsets and loci.mu_crit == loci.onsets[0]
+    for onset in loci.onsets:
+        assert not grows(onset - tol) and grows(onset + tol)
+    growing = [float(mu) for mu in targets if grows(mu)]
+    first, last = loci.unstable_intervals[0]
+    assert growing[0] == pytest.approx(first, rel=1e-14)
+    assert first - (targets[1] - targets[0]) < loci.mu_crit < first <= last
+    assert [s["mu"] for s in loci.steps] == pytest.approx(list(targets), rel=1e-15)
+    assert loci.to_json()["mu_crit"] == loci.mu_crit
+
+
+def test_rigid_generalised_forces_integrate_the_pointwise_tractions():
+    """The rigid block's generalised forces integrate laws.normal_traction and
+    laws.friction_traction: at full contact with θ = 0 and a uniform slip they are B0 L times
+    the pointwise tractions (closed form, smooth regularisation, normal damping on)."""
+    block = RigidBlock(mu=0.6, b_n=1e6, regularisation="smooth", eps=1e-2)
+    d, rate, w = 2e-4, 0.03, 0.1
+    q = np.array([0.0, -d, 0.0])
+    q_dot = np.array([w + block.belt_speed, -rate, 0.0])
+    forces = block.generalised_forces(q, q_dot)
+    area = block.L * block.B0
+    p = block.c_n * d**block.m_n + block.b_n * d**block.l_n * rate
+    t = -0.6 * block.c_n * d**block.m_n * w / np.sqrt(w**2 + 1e-4)
+    F_s = block._spring(q)
+    arm = block.spring_height - block.H / 2
+    assert forces == pytest.approx([area * t + F_s, area * p - block.weight,
+                                    area * t * block.H / 2 - F_s * arm], rel=1e-10)

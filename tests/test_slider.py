@@ -1,10 +1,13 @@
-"""The 2m+1 d.o.f. slider of seed 004: natural frequencies, averaging against Floquet."""
+"""The 2m+1 d.o.f. slider of the m.d.o.f. slider paper (2003): natural frequencies, averaging
+against Floquet, the nonlinear motion."""
 
 import dataclasses
+import json
 import math
 
 import numpy as np
 import pytest
+import scipy.linalg
 
 from fenicsfriction import laws
 from fenicsfriction.reduced.events import HybridError, integrate_hybrid
@@ -19,7 +22,7 @@ from fenicsfriction.reduced.slider import (
 
 def test_table2_natural_frequencies_are_the_roots_of_the_frequency_equation():
     # det(K - Ω² M) = 0 for M = diag(1, 0.01), K = [[11, -10], [-10, 10]]:
-    # Ω⁴ - 1011 Ω² + 1000 = 0 (seed 004 eq. 60: Ω1 = 0.9950, Ω2 = 31.7807)
+    # Ω⁴ - 1011 Ω² + 1000 = 0 (the paper's eq. 60: Ω1 = 0.9950, Ω2 = 31.7807)
     roots = np.sqrt(np.sort(np.roots([1.0, -1011.0, 1000.0])))
     omega, R = table2_slider(30.78).natural_frequencies()
     assert omega == pytest.approx(roots, rel=1e-13)
@@ -71,7 +74,7 @@ def test_averaging_and_floquet_agree_at_the_principal_resonance_and_its_band_edg
     upper_avg = edge(lambda w: -table2_slider(w).averaged().growth, 63.6, 66.0)
     upper_floquet = edge(lambda w: -table2_slider(w).floquet().growth, 63.6, 66.0)
     assert abs(upper_avg - upper_floquet) < 0.05
-    assert upper_floquet == pytest.approx(64.45, abs=0.05)     # seed 004: 62.70 < ω_o < 64.45
+    assert upper_floquet == pytest.approx(64.45, abs=0.05)     # the paper: 62.70 < ω_o < 64.45
 
 
 def test_the_linearised_motion_integrated_in_time_grows_at_the_floquet_rate():
@@ -109,12 +112,13 @@ def test_forced_response_is_the_periodic_motion_of_the_linear_system():
 
 
 def test_steady_sliding_balances_the_mean_friction():
+    # eq. 59 in the paper's reading: μ(V) = 0.75 − 0.03 V/10 on its slope, V = ω_o λ/2π
     slider = table2_slider(30.78)
     q = slider.steady_sliding()
-    contact = slider.contacts[0]
-    friction = contact.friction(contact.surface_speed) * contact.normal_load
+    speed = 30.78 * 16.67 / (2 * math.pi)
+    friction = (0.75 - 0.03 * speed / 10) * 0.05
     assert slider.stiffness * q[0] == pytest.approx(friction, rel=1e-12)   # slider spring
-    assert contact.k_t * (q[1] - q[0]) == pytest.approx(friction, rel=1e-12)
+    assert 10.0 * (q[1] - q[0]) == pytest.approx(friction, rel=1e-12)  # k_t of Table 2
 
 
 @pytest.mark.parametrize(("field", "value"), [("mass", 0.0), ("k_n", -1.0), ("wavelength", 0.0),
@@ -150,9 +154,29 @@ def test_cases_I_III_and_non_resonant_are_stable_at_the_modal_damping_rate(omega
     slider = table2_slider(omega, reading="slider-mass")
     averaged = slider.averaged()
     assert averaged.case == case
-    assert averaged.growth == pytest.approx(-averaged.modal_damping.min() / 2, rel=1e-12)
+    # ξ_ii = r_iᵀ C r_i on the mass-normalised modes of Table 2's matrices, C with the
+    # friction damping S N_o = −0.003 × 0.05 of eq. 59 (slope 0.03 per 10 speed units)
+    M, K = np.diag([1.0, 0.01]), np.array([[11.0, -10.0], [-10.0, 10.0]])
+    C = np.array([[0.03, -0.015], [-0.015, 0.015 - 0.003 * 0.05]])
+    _, R = scipy.linalg.eigh(K, M)
+    xi = np.einsum("ik,ij,jk->k", R, C, R)
+    assert averaged.modal_damping == pytest.approx(xi, rel=1e-12)
+    assert averaged.growth == pytest.approx(-xi.min() / 2, rel=1e-12)
     assert averaged.growth < 0
     assert slider.floquet().growth == pytest.approx(averaged.growth, rel=1e-3)
+
+
+def test_stability_results_are_json_records():
+    averaged, floquet = table2_slider(63.5).averaged(), table2_slider(63.5).floquet()
+    a, f = (json.loads(json.dumps(r.to_json())) for r in (averaged, floquet))
+    assert a["growth"] == averaged.growth and a["case"] == averaged.case
+    assert f["growth"] == floquet.growth and len(f["multipliers"]) == 4
+    # the multipliers' product is det Φ(T) = exp(∫ tr A dt) (Liouville): tr A = −tr M̂⁻¹Ĉ(t),
+    # whose mean over a period is that of the mean damping Ĉ + diag(0, S N_o)
+    C = table2_slider(63.5).friction_damping([0.05])
+    trace = -(C[0, 0] / 1.0 + C[1, 1] / 0.01)
+    product = np.prod([complex(re, im) for re, im in f["multipliers"]])
+    assert product.real == pytest.approx(math.exp(trace * floquet.period), rel=1e-8)
 
 
 def _run(slider, t_end, eps=None, sample_dt=1e-3, **kwargs):

@@ -1,4 +1,5 @@
-r"""Stability of steady sliding (SPEC §2 Problem 3, §4): the linearisation, the PEP and the loci.
+r"""Stability of steady sliding (Problem 3, the block of Martins & Oden 1986): the
+linearisation, the PEP and the loci.
 
 The block is the paper's (4 × 3 nine-node quadrilaterals, ``refine=1``); every eigenvalue with
 |λ| ≤ ``MAX_MODULUS`` is 6 modes: the spring mode ±i sqrt(K_x/M) ≈ 4.97 rad/s, the
@@ -27,7 +28,7 @@ import fenicsfriction as ff
 from fenicsfriction import _compat
 from fenicsfriction.forms import friction
 from fenicsfriction.numerics import dense_eigenvalues
-from fenicsfriction.scenes.block import TOP
+from fenicsfriction.scenes.block.data import TOP
 from fenicsfriction.stability import Loci, StabilitySolver, unstable_intervals
 
 COMM = MPI.COMM_WORLD
@@ -171,7 +172,7 @@ def test_stiffness_and_damping_are_the_derivatives_of_the_residual():
     residual = model.residual
     solver = StabilitySolver(residual, prefix=prefix("fd_pep"))
     solver.assemble()
-    d_min = model.quantities()["min_penetration"]
+    d_min = model.quantities().min_penetration
     assert d_min > 0, "the whole base must be in contact for the law to be smooth"
 
     probe = ResidualProbe(residual)
@@ -228,7 +229,8 @@ def frobenius(A: PETSc.Mat) -> float:
 
 
 def test_stiffness_is_symmetric_but_for_the_friction_coupling():
-    """K̄ = K + K_nn + K_Tn (SPEC §2): elasticity, the spring and the normal compliance are
+    """K̄ = K + K_nn + K_Tn (Martins & Oden 1986, eq. 31): elasticity, the spring and the normal
+    compliance are
     symmetric, so K̄ - K̄ᵀ vanishes at μ = 0 and, at μ > 0, equals F - Fᵀ with F the derivative
     of the friction term alone.
 
@@ -371,15 +373,15 @@ def test_loci_keep_each_mode_and_bisection_finds_the_flutter_onset():
     assert unstable_intervals(records, loci.growth_tol) == {}
 
     onset = loci.onset(0.3, 0.45, tol=1e-3, reference=last["modes"])
-    stable, unstable = onset["interval"]
-    assert 0.3 <= stable < onset["mu_crit"] < unstable <= 0.45
+    stable, unstable = onset.interval
+    assert 0.3 <= stable < onset.mu_crit < unstable <= 0.45
     assert unstable - stable <= 1e-3
     for value, growing in ((stable, False), (unstable, True)):  # re-solved independently
         ff.continuation(steady, model.mu, [value])
         assert bool(loci.unstable(stability.solve(MAX_MODULUS))) == growing, value
-    low, high = onset["colliding"]
+    low, high = onset.colliding
     assert {low["mode"], high["mode"]} == {1, 2}
-    growth, frequency = onset["value"]
+    growth, frequency = onset.value
     assert min(low["im"], high["im"]) < frequency < max(low["im"], high["im"])
     assert 0 < growth < 1e-2 * frequency
 

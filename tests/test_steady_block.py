@@ -1,4 +1,5 @@
-r"""Steady sliding of the block on the belt (SPEC §2 Problem 2, §4): statics and closed forms.
+r"""Steady sliding of the block on the belt (Problem 2, the block of Martins & Oden 1986):
+statics and closed forms.
 
 Tolerances come from one fact. At a converged state the assembled residual R (nodal forces)
 satisfies ‖R‖₂ ≤ ``residual_norm`` and the exact residual of that state differs from the
@@ -14,6 +15,8 @@ motions (all linear, so nodally exact):
 * the rigid rotation r = (-y, x - L/2) about the base midpoint, R(r) = spring·h_s - N·x_cp
   (weight and top pressure have no moment about it, friction acts on y = 0 with no lever).
 """
+
+import dataclasses
 
 from mpi4py import MPI
 
@@ -64,12 +67,12 @@ def test_frictionless_block_under_top_pressure_penetrates_uniformly(refine, degr
     assert report.iterations >= 2
     load = p * scene.L * scene.B0
     force_error = slack(report.residual_norm, report.atol, petsc_vec(model.residual.u).getSize())
-    assert q["normal_force"] == pytest.approx(load, abs=force_error)
+    assert q.normal_force == pytest.approx(load, abs=force_error)
     # d ∝ N^(1/m_n): a force error δN moves the penetration by δd/d = δN / (m_n N); the
     # factor 10 allows for the error not being spread uniformly over the contact nodes
     tolerance = 10 * force_error / (scene.m_n * load)
-    assert q["min_penetration"] == pytest.approx(d, rel=tolerance)
-    assert q["max_penetration"] == pytest.approx(d, rel=tolerance)
+    assert q.min_penetration == pytest.approx(d, rel=tolerance)
+    assert q.max_penetration == pytest.approx(d, rel=tolerance)
 
 
 # --- global equilibrium along the continuation in μ -----------------------------------------
@@ -92,14 +95,16 @@ def test_continuation_reaches_every_mu_to_a_small_fraction_of_the_load(mu_path):
         assert r["residual_norm"] + r["atol"] <= 1e-6 * scene.weight, r
 
 
-def test_friction_is_mu_times_normal_force_at_every_mu(mu_path):
-    # C1 law with ε < |U_T|: φ'_ε(-U_T) = -τ exactly, so the friction integrand is μ times the
-    # pressure integrand at every quadrature point; only summation round-off differs
-    scene, records, _ = mu_path
+def test_spring_holds_mu_times_the_weight_at_every_mu(mu_path):
+    """C1 law with ε < |U_T|: φ'_ε(-U_T) = -τ exactly, so Coulomb's F = dir μ N holds with
+    N = W; the spring, read off its node's displacement, balances it. Its error is the
+    horizontal balance's slack plus μ times the vertical one's."""
+    scene, records, n = mu_path
     assert scene.eps < scene.belt_speed
     for r in records:
-        expected = scene.belt_direction * r["mu"] * r["normal_force"]
-        assert r["friction_force"] == pytest.approx(expected, rel=1e-12, abs=1e-12)
+        expected = scene.belt_direction * r["mu"] * scene.weight
+        assert abs(-r["spring_force"] - expected) <= (1 + r["mu"]) * slack(
+            r["residual_norm"], r["atol"], n), r
 
 
 def test_friction_balances_spring_at_every_mu(mu_path):
@@ -301,7 +306,8 @@ def test_failed_continuation_raises_and_keeps_the_last_converged_step():
     assert [r["value"] for r in records] == [0.4, 0.8]
     assert float(model.mu.value) == 0.8
     assert unchanged
-    assert q == {key: records[-1][key] for key in q}
+    fields = dataclasses.asdict(q)
+    assert fields == {key: records[-1][key] for key in fields}
 
 
 @pytest.mark.timeout(120)
@@ -325,9 +331,11 @@ def test_halved_continuation_stops_at_an_equilibrium_after_failure():
     # a diverged iterate leaves nodal forces of order the load (~60 here); a converged state
     # is held to ≤ 1e-6 W (see test_continuation_reaches_every_mu...)
     assert residual.norm() <= 1e-6 * scene.weight
-    assert q["friction_force"] == pytest.approx(float(model.mu.value) * q["normal_force"],
-                                                rel=1e-12)
-    assert q["normal_force"] == pytest.approx(scene.weight, rel=1e-6)
+    # equilibrium along x with the spring force read off the nodal displacement, and
+    # Coulomb's law in closed form: the spring holds μ W
+    assert q.friction_force == pytest.approx(-q.spring_force, rel=1e-6)
+    assert -q.spring_force == pytest.approx(float(model.mu.value) * scene.weight, rel=1e-6)
+    assert q.normal_force == pytest.approx(scene.weight, rel=1e-6)
 
 
 def test_solvers_sharing_a_prefix_each_get_their_own_defaults():

@@ -30,19 +30,19 @@ def test_statistics_of_a_synthetic_run_match_their_closed_forms():
     int_n = 1.0 + (np.cos(5 * np.pi) - np.cos(10 * np.pi)) / (10 * np.pi)
     int_n_stick = 0.2 + (np.cos(6 * np.pi) - np.cos(7 * np.pi)) / (10 * np.pi)
     int_f = 0.5 * (int_n - int_n_stick) - 0.1 * 0.4
-    assert stats["mean_normal_force"] == pytest.approx(int_n / 0.5, rel=1e-3)
-    assert stats["apparent_coefficient"] == pytest.approx(int_f / int_n, rel=2e-3)
-    assert stats["ratio_to_mu"] == pytest.approx(int_f / int_n / 0.5, rel=2e-3)
-    assert stats["probe_stick_fraction"] == pytest.approx(0.2, abs=1e-3)
-    assert stats["any_stick_fraction"] == pytest.approx(0.2, abs=1e-3)
-    assert stats["probe_open_fraction"] == pytest.approx(0.1, abs=1e-3)
-    assert stats["probe_longest_stick"] == pytest.approx(0.1, abs=5e-4)
-    assert stats["spring_elongation"]["start"] == pytest.approx(2.5, abs=1e-3)
-    assert stats["spring_elongation"]["end"] == 2.0
-    assert stats["spring_elongation"]["mean"] == pytest.approx(2.25, rel=1e-9)
-    assert stats["normal_force_range"] == pytest.approx([1.0, 3.0], abs=1e-6)
-    assert stats["max_energy_error"] is None  # no energy_error in the records
-    assert stats["steps"] == 4000 and stats["newton_iterations"] == 8002
+    assert stats.mean_normal_force == pytest.approx(int_n / 0.5, rel=1e-3)
+    assert stats.apparent_coefficient == pytest.approx(int_f / int_n, rel=2e-3)
+    assert stats.ratio_to_mu == pytest.approx(int_f / int_n / 0.5, rel=2e-3)
+    assert stats.probe_stick_fraction == pytest.approx(0.2, abs=1e-3)
+    assert stats.any_stick_fraction == pytest.approx(0.2, abs=1e-3)
+    assert stats.probe_open_fraction == pytest.approx(0.1, abs=1e-3)
+    assert stats.probe_longest_stick == pytest.approx(0.1, abs=5e-4)
+    assert stats.spring_elongation["start"] == pytest.approx(2.5, abs=1e-3)
+    assert stats.spring_elongation["end"] == 2.0
+    assert stats.spring_elongation["mean"] == pytest.approx(2.25, rel=1e-9)
+    assert stats.normal_force_range == pytest.approx([1.0, 3.0], abs=1e-6)
+    assert stats.max_energy_error is None  # no energy_error in the records
+    assert stats.steps == 4000 and stats.newton_iterations == 8002
 
 
 def test_statistics_refuse_a_window_past_the_end():

@@ -37,22 +37,19 @@ import numpy as np
 
 from fenicsfriction import laws
 from fenicsfriction.laws import check, check_positive
-from fenicsfriction.reduced.events import (
-    HybridEvent,
-    HybridResult,
-    integrate_hybrid,
-    mode_intervals,
-)
+from fenicsfriction.reduced.events import HybridEvent, HybridResult, integrate_hybrid
+from fenicsfriction.results import Record
+from fenicsfriction.statistics import LimitCycle, mode_intervals
 
-__all__ = ["BeltOscillator", "BeltResult", "LimitCycle", "belt_summary", "displacement_extrema",
-           "limit_cycle"]
+# LimitCycle (the closed-form cycle's type) lives with the statistics that measure one
+__all__ = ["BeltOscillator", "BeltResult", "LimitCycle"]
 
 STICK, SLIP_FORWARD, SLIP_BACKWARD = "stick", "slip+", "slip-"
 _SLIP_SIGN = {SLIP_FORWARD: 1.0, SLIP_BACKWARD: -1.0}
 
 
 @dataclasses.dataclass
-class BeltResult:
+class BeltResult(Record):
     """A run of :meth:`BeltOscillator.simulate`.
 
     Attributes:
@@ -77,26 +74,9 @@ class BeltResult:
     hybrid: HybridResult
     method: str
 
-
-@dataclasses.dataclass(frozen=True)
-class LimitCycle:
-    """Period, amplitude and stick fraction of a (stick-slip) cycle.
-
-    Attributes:
-        period: T.
-        amplitude: max - min of x over a cycle (peak to peak).
-        x_min, x_max: the extremes of x.
-        stick_fraction: time spent sticking over T.
-        period_change: |T - T_previous| of the cycle before (0 for a closed form); a measure of
-            how far the transient has died out.
-    """
-
-    period: float
-    amplitude: float
-    x_min: float
-    x_max: float
-    stick_fraction: float
-    period_change: float = 0.0
+    def stick_onsets(self) -> np.ndarray:
+        """Times of the located events that enter stick (empty for the regularised law)."""
+        return np.array([e.t for e in self.events if e.mode_after == STICK])
 
 
 @dataclasses.dataclass
@@ -129,7 +109,7 @@ class BeltOscillator:
 
     size: typing.ClassVar[int] = 2
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         check_positive("m", self.m)
         check_positive("k", self.k)
         check_positive("c", self.c, strict=False)
@@ -145,41 +125,47 @@ class BeltOscillator:
         check("mu_static", self.mu_static, self.mu_static >= mu_0,
               f"must be >= mu(0) = {mu_0:g}: sticking may not hold less than sliding starts with")
 
+    @property
+    def static_coefficient(self) -> float:
+        """μ_s: ``mu_static`` (μ(0) when not given)."""
+        return float(self.friction(0.0)) if self.mu_static is None else self.mu_static
+
     # --- the hybrid system ----------------------------------------------------------------------
 
-    def required_force(self, x):
+    def required_force(self, x: typing.Any) -> typing.Any:
         """Friction force that keeps the mass stuck to the belt: F_req = k x + c v_b."""
         return self.k * np.asarray(x, dtype=float) + self.c * self.v_belt
 
-    def friction_force(self, y, mode) -> float:
+    def friction_force(self, y: np.ndarray, mode: str) -> float:
         """F in ``mode`` at the state y = (x, ẋ)."""
         if mode == STICK:
             return float(self.required_force(y[0]))
         return _SLIP_SIGN[mode] * float(self.friction(self.v_belt - y[1])) * self.N
 
-    def rhs(self, t: float, y: np.ndarray, mode) -> np.ndarray:
+    def rhs(self, t: float, y: np.ndarray, mode: str) -> np.ndarray:
         """(ẋ, ẍ): (v_b, 0) in stick, (ẋ, (F - c ẋ - k x)/m) in slip."""
         if mode == STICK:
             return np.array([self.v_belt, 0.0])
         force = self.friction_force(y, mode) - self.c * y[1] - self.k * y[0]
         return np.array([y[1], force / self.m])
 
-    def events(self, t: float, y: np.ndarray, mode) -> np.ndarray:
+    def events(self, t: float, y: np.ndarray, mode: str) -> np.ndarray:
         """Stick: (μ_s N - F_req, μ_s N + F_req); slip±: ±v_r."""
         if mode == STICK:
-            bound, force = self.mu_static * self.N, float(self.required_force(y[0]))
+            bound, force = self.static_coefficient * self.N, float(self.required_force(y[0]))
             return np.array([bound - force, bound + force])
         return np.array([_SLIP_SIGN[mode] * (self.v_belt - y[1])])
 
     def mode_at_belt_speed(self, x: float) -> str:
         """The consistent mode at ẋ = v_b: stick if -μ_s N <= F_req < μ_s N, else slip in the
         direction of F_req."""
-        bound, force = self.mu_static * self.N, float(self.required_force(x))
+        bound, force = self.static_coefficient * self.N, float(self.required_force(x))
         if force >= bound:
             return SLIP_FORWARD
         return STICK if force >= -bound else SLIP_BACKWARD
 
-    def switch(self, t: float, y: np.ndarray, mode, fired: list[int]):
+    def switch(self, t: float, y: np.ndarray, mode: str,
+               fired: list[int]) -> tuple[np.ndarray, str]:
         """Every event of this model happens at ẋ = v_b: the velocity is set to v_b exactly
         (the located state is off by the event tolerance); a stick ends in the slip the bound
         reached points to, a slip at the mode :meth:`mode_at_belt_speed` picks."""
@@ -241,12 +227,12 @@ class BeltOscillator:
         check("c", self.c, self.c == 0, "the closed form needs c = 0")
         check("friction", self.friction, isinstance(self.friction, laws.ConstantFriction),
               "the closed form needs a ConstantFriction kinetic coefficient")
-        mu_k = self.friction.mu
-        check("mu_static", self.mu_static, self.mu_static > mu_k,
+        mu_k = typing.cast(laws.ConstantFriction, self.friction).mu
+        check("mu_static", self.mu_static, self.static_coefficient > mu_k,
               f"the closed form needs mu_static > mu_k = {mu_k:g} (else no stick-slip)")
         omega = math.sqrt(self.k / self.m)
         x_k = mu_k * self.N / self.k
-        delta = (self.mu_static - mu_k) * self.N / self.k
+        delta = (self.static_coefficient - mu_k) * self.N / self.k
         radius = math.hypot(delta, self.v_belt / omega)
         phi = math.atan2(self.v_belt / omega, delta)
         stick = 2 * delta / self.v_belt
@@ -256,7 +242,7 @@ class BeltOscillator:
 
     # --- time integration ---------------------------------------------------------------------
 
-    def regularised_force(self, v_r, eps: float):
+    def regularised_force(self, v_r: typing.Any, eps: float) -> typing.Any:
         r"""The smooth friction law :math:`F_\varepsilon = \mu_\varepsilon(v_r) N
         v_r/\sqrt{v_r^2 + \varepsilon^2}` (:func:`~fenicsfriction.laws.abs_smooth_derivative`).
 
@@ -269,7 +255,7 @@ class BeltOscillator:
         ε → 0 and the breakaway force :math:`\max F_\varepsilon` tends to μ_s N.
         """
         mu = self.friction(v_r)
-        jump = self.mu_static - float(self.friction(0.0))
+        jump = self.static_coefficient - float(self.friction(0.0))
         if jump > 0:
             mu = mu + jump * np.exp(-np.abs(v_r) / math.sqrt(eps * self.v_belt))
         return mu * self.N * laws.abs_smooth_derivative(v_r, eps)
@@ -299,8 +285,8 @@ class BeltOscillator:
               "must be 'events' or 'regularised'")
         x0 = self.steady_sliding() if x0 is None else float(x0)
         v0 = 0.0 if v0 is None else float(v0)
-        kwargs = {"rtol": rtol, "atol": atol, "sample_dt": sample_dt, "max_step": max_step,
-                      "prefix": prefix}
+        kwargs: dict[str, typing.Any] = {"rtol": rtol, "atol": atol, "sample_dt": sample_dt,
+                                         "max_step": max_step, "prefix": prefix}
         if method == "regularised":
             eps = 1e-3 * self.v_belt if eps is None else eps
             check_positive("eps", eps)
@@ -328,84 +314,20 @@ class _Regularised:
 
     size = 2
 
-    def __init__(self, oscillator: BeltOscillator, eps: float):
+    def __init__(self, oscillator: BeltOscillator, eps: float) -> None:
         self.oscillator, self.eps = oscillator, eps
 
-    def rhs(self, t: float, y: np.ndarray, mode) -> np.ndarray:
+    def rhs(self, t: float, y: np.ndarray, mode: str) -> np.ndarray:
+        """(ẋ, ẍ) with the regularised friction force."""
         o = self.oscillator
         force = o.regularised_force(o.v_belt - y[1], self.eps) - o.c * y[1] - o.k * y[0]
         return np.array([y[1], force / o.m])
 
-    def events(self, t: float, y: np.ndarray, mode) -> np.ndarray:
+    def events(self, t: float, y: np.ndarray, mode: str) -> np.ndarray:
+        """None: the smooth law has one mode."""
         return np.empty(0)
 
-    def switch(self, t, y, mode, fired):
+    def switch(self, t: float, y: np.ndarray, mode: str,
+               fired: list[int]) -> tuple[np.ndarray, str]:
+        """Never called (no events)."""
         raise AssertionError("the regularised law has no events")
-
-
-def displacement_extrema(result: BeltResult) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Times, values and kinds (+1 maximum, -1 minimum) of the extremes of x: where ẋ changes
-    sign between two records, the cubic Hermite interpolant of (x, ẋ) is extremal (error
-    O(h⁴) in the value)."""
-    t, x, v = result.t, result.x, result.v
-    times, values, kinds = [], [], []
-    for i in np.flatnonzero((np.sign(v[:-1]) != np.sign(v[1:])) & (t[1:] > t[:-1])):
-        h = t[i + 1] - t[i]
-        # p(s) = x0 + h v0 s + a s² + b s³ on s in [0, 1]
-        a = 3 * (x[i + 1] - x[i]) - h * (2 * v[i] + v[i + 1])
-        b = -2 * (x[i + 1] - x[i]) + h * (v[i] + v[i + 1])
-        roots = np.roots([3 * b, 2 * a, h * v[i]])
-        roots = [r.real for r in roots if abs(r.imag) < 1e-12 and 0 <= r.real <= 1]
-        s = roots[0] if roots else 0.5
-        times.append(t[i] + h * s)
-        values.append(x[i] + h * v[i] * s + a * s**2 + b * s**3)
-        kinds.append(1 if v[i] > 0 else -1)
-    return np.array(times), np.array(values), np.array(kinds)
-
-
-def limit_cycle(result: BeltResult) -> LimitCycle:
-    """Measure the last full cycle of a run (make the run long enough for transients to die).
-
-    The cycle is delimited by the last two stick onsets (located events) if the run has them,
-    else by the last two maxima of x (interpolated, :func:`displacement_extrema`); the amplitude is
-    max - min of x over it, the extremes interpolated alike.
-
-    Raises:
-        ValueError: fewer than two (three, for ``period_change``) cycle markers.
-    """
-    onsets = np.array([e.t for e in result.events if e.mode_after == STICK])
-    times, values, kinds = displacement_extrema(result)
-    markers = onsets if onsets.size >= 2 else times[kinds > 0]
-    check("result", f"<{markers.size} cycle markers>", markers.size >= 2,
-          "needs at least two stick onsets or maxima of x: run longer")
-    start, end = markers[-2], markers[-1]
-    inside = (times >= start) & (times <= end)
-    in_cycle = (result.t >= start) & (result.t <= end)
-    x_max = max(values[inside & (kinds > 0)], default=result.x[in_cycle].max())
-    x_min = min(values[inside & (kinds < 0)], default=result.x[in_cycle].min())
-    stick = sum(max(0.0, min(b, end) - max(a, start)) for a, b in result.stick_intervals)
-    period = end - start
-    change = abs(period - (markers[-2] - markers[-3])) if markers.size >= 3 else math.nan
-    return LimitCycle(period=float(period), amplitude=float(x_max - x_min), x_min=float(x_min),
-                      x_max=float(x_max), stick_fraction=float(stick / period),
-                      period_change=float(change))
-
-
-def belt_summary(result: BeltResult) -> dict:
-    """JSON-able numbers of a run: ``period``, ``amplitude``, ``stick_fraction`` (of the last
-    cycle; None without two cycle markers), ``period_change``, ``events``,
-    ``stick_fraction_run`` (over the whole run), ``steps``, ``rejected_steps``,
-    ``rhs_evaluations``, ``t_end`` and ``method``."""
-    try:
-        cycle = dataclasses.asdict(limit_cycle(result))
-    except ValueError:
-        cycle = dict.fromkeys(("period", "amplitude", "x_min", "x_max", "stick_fraction",
-                               "period_change"))
-    duration = float(result.t[-1] - result.t[0])
-    stuck = sum(b - a for a, b in result.stick_intervals)
-    return {**{key: (None if value is None or math.isnan(value) else value)
-               for key, value in cycle.items()},
-            "events": len(result.events), "stick_fraction_run": stuck / duration,
-            "steps": result.hybrid.steps, "rejected_steps": result.hybrid.rejected_steps,
-            "rhs_evaluations": result.hybrid.rhs_evaluations, "t_end": float(result.t[-1]),
-            "method": result.method}

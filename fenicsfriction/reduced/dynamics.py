@@ -18,6 +18,7 @@ the forces and the contact state of a :class:`~fenicsfriction.reduced.RigidBlock
 from __future__ import annotations
 
 import dataclasses
+import typing
 
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -26,8 +27,12 @@ import numpy as np
 
 from fenicsfriction import laws
 from fenicsfriction.laws import check
-from fenicsfriction.reduced.rigid_block import _dphi
 from fenicsfriction.timestepping import Alpha2Integrator
+
+if typing.TYPE_CHECKING:
+    from fenicsfriction.reduced.rigid_block import RigidBlock
+
+ArrayLike: typing.TypeAlias = typing.Any  # an array of floats, or a float for one d.o.f.
 
 __all__ = ["BouncingMass", "ReducedDynamics", "rigid_block_observables"]
 
@@ -56,11 +61,12 @@ class ReducedDynamics(Alpha2Integrator):
     velocity error g h/6 after the first step.
     """
 
-    def __init__(self, model, q0, q_dot0, prefix: str = "reduced_",
-                 options: dict | None = None, atol: float | None = None):
+    def __init__(self, model: typing.Any, q0: ArrayLike, q_dot0: ArrayLike,
+                 prefix: str = "reduced_", options: dict | None = None,
+                 atol: float | None = None):
         q0, q_dot0 = (np.array(x, dtype=float).ravel() for x in (q0, q_dot0))
-        check("q0", q0, q0.size > 0 and np.all(np.isfinite(q0)), "must be finite numbers")
-        check("q_dot0", q_dot0, q_dot0.shape == q0.shape and np.all(np.isfinite(q_dot0)),
+        check("q0", q0, q0.size > 0 and bool(np.all(np.isfinite(q0))), "must be finite numbers")
+        check("q_dot0", q_dot0, q_dot0.shape == q0.shape and bool(np.all(np.isfinite(q_dot0))),
               f"must be {q0.size} finite numbers, like q0")
         self.model = model
         self.q, self.q_dot = q0, q_dot0
@@ -81,7 +87,7 @@ class ReducedDynamics(Alpha2Integrator):
         self._v.setArray(self.q_dot)
         return self._u, self._v
 
-    def _load(self, x, xdot, xddot) -> None:
+    def _load(self, x: typing.Any, xdot: typing.Any, xddot: typing.Any) -> None:
         """Copy an accepted state into ``q`` and ``q_dot`` (the acceleration is not kept)."""
         self.q = x.getArray(readonly=True).copy()
         self.q_dot = xdot.getArray(readonly=True).copy()
@@ -117,7 +123,7 @@ class BouncingMass:
         area: contact area A [cm^2], > 0.
         b_n, l_n: normal damping b_n d^{l_n} (-ẏ), >= 0, exponent >= 1 (None: m_n).
 
-    Defaults: the block of SPEC §4 (M = 0.45, W = 450, c_n = 1e10, m_n = 2.5, A = L B0).
+    Defaults: the block of Martins & Oden 1986 (M = 0.45, W = 450, c_n = 1e10, m_n = 2.5, A = L B0).
     """
 
     mass: float = 0.45
@@ -126,7 +132,7 @@ class BouncingMass:
     m_n: float = 2.5
     area: float = 48.8 * 30.5
     b_n: float = 0.0
-    l_n: float | None = None
+    l_n: float = None  # type: ignore[assignment]  # None: set by __post_init__
 
     def __post_init__(self):
         if self.l_n is None:
@@ -146,19 +152,20 @@ class BouncingMass:
         """Rest position y0 = -d0 with d0 = (W / (c_n A))^(1/m_n)."""
         return -(self.weight / (self.c_n * self.area)) ** (1.0 / self.m_n)
 
-    def foundation_force(self, q, q_dot) -> np.ndarray:
+    def foundation_force(self, q: ArrayLike, q_dot: ArrayLike) -> np.ndarray:
         """Upward force of the foundation A (c_n d^{m_n} + b_n d^{l_n} (-ẏ))."""
         y, y_dot = np.asarray(q, float), np.asarray(q_dot, float)
         d = laws.penetration(-y)
         return self.area * (laws.normal_pressure(d, self.c_n, self.m_n)
                             + laws.normal_damping_pressure(d, -y_dot, self.b_n, self.l_n))
 
-    def residual(self, q, q_dot, q_ddot) -> np.ndarray:
+    def residual(self, q: ArrayLike, q_dot: ArrayLike, q_ddot: ArrayLike) -> np.ndarray:
         """R = m ÿ + W - foundation force."""
         return self.mass * np.asarray(q_ddot, float) + self.weight \
             - self.foundation_force(q, q_dot)
 
-    def linearisation(self, q, q_dot=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def linearisation(self, q: ArrayLike, q_dot: ArrayLike | None = None
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(M, C, K) = (∂R/∂ÿ, ∂R/∂ẏ, ∂R/∂y) as 1 × 1 arrays; out of contact (y >= 0)
         C = K = 0 (d^0 would read 1 at d = 0 for a linear law)."""
         y = float(np.asarray(q, float).ravel()[0])
@@ -171,7 +178,7 @@ class BouncingMass:
         return (np.array([[self.mass]]), np.array([[self.area * self.b_n * d**self.l_n]]),
                 np.array([[self.area * stiffness]]))
 
-    def energy(self, q, q_dot) -> np.ndarray:
+    def energy(self, q: ArrayLike, q_dot: ArrayLike) -> np.ndarray:
         """Kinetic + foundation c_n A d^{m_n+1}/(m_n+1) + gravity W y (conserved if b_n = 0)."""
         y, y_dot = np.asarray(q, float), np.asarray(q_dot, float)
         d = laws.penetration(-y)
@@ -179,7 +186,8 @@ class BouncingMass:
             + self.c_n * self.area * d ** (self.m_n + 1) / (self.m_n + 1) + self.weight * y
 
 
-def rigid_block_observables(block, q, q_dot, probe_x: float | None = None) -> dict:
+def rigid_block_observables(block: RigidBlock, q: ArrayLike, q_dot: ArrayLike,
+                            probe_x: float | None = None) -> dict[str, typing.Any]:
     r"""Forces, motion and contact state of a :class:`~fenicsfriction.reduced.RigidBlock` at
     (q, q̇), under the names of :meth:`~fenicsfriction.scenes.block.BlockModel.dynamics_observer`
     so that :func:`~fenicsfriction.statistics.stick_slip_statistics` and
@@ -209,7 +217,8 @@ def rigid_block_observables(block, q, q_dot, probe_x: float | None = None) -> di
     x = 0.5 * block.L if probe_x is None else float(probe_x)
     s = x - 0.5 * block.L  # from G's vertical
     d = max(-q[1] - block.g - q[2] * s, 0.0)
-    direction = _dphi(block.regularisation, w, block.eps)[0]
+    friction = laws.friction_traction(d, w, block.mu * block.c_n, block.m_T, block.eps,
+                                      block.regularisation)
     return {"normal_force": float(Q[1] + block.weight), "normal_force_elastic": float(elastic),
             "friction_force": float(Q[0] - spring), "spring_force": float(spring),
             "spring_elongation": float(-spring / block.K_x),
@@ -218,6 +227,6 @@ def rigid_block_observables(block, q, q_dot, probe_x: float | None = None) -> di
             "probe_x": x, "probe_u_y": float(q[1] + q[2] * s),
             "probe_v_x": float(q_dot[0] + q_dot[2] * block.H / 2),
             "probe_v_y": float(q_dot[1] + q_dot[2] * s), "probe_slip": float(w),
-            "probe_pressure": float(block.c_n * d**block.m_n),
-            "probe_friction": float(-block.mu * block.c_n * d**block.m_T * direction)}
+            "probe_pressure": float(laws.normal_pressure(d, block.c_n, block.m_n)),
+            "probe_friction": float(friction)}
 

@@ -49,10 +49,11 @@ import numpy as np
 
 from fenicsfriction.laws import check
 from fenicsfriction.petsc_options import options_with_defaults
+from fenicsfriction.results import Record
 from fenicsfriction.timestepping import DynamicsError
 
 __all__ = ["DEFAULT_OPTIONS", "HybridError", "HybridEvent", "HybridResult", "HybridSystem",
-           "integrate_hybrid", "mode_intervals"]
+           "Observer", "integrate_hybrid"]
 
 DEFAULT_OPTIONS = {
     "ts_type": "rk",
@@ -89,22 +90,28 @@ class HybridSystem(typing.Protocol):
         size: the size of the state y.
     """
 
-    size: int
+    @property
+    def size(self) -> int:
+        """The size of the state y."""
 
-    def rhs(self, t: float, y: np.ndarray, mode) -> np.ndarray:
+    def rhs(self, t: float, y: np.ndarray, mode: typing.Any) -> np.ndarray:
         """dy/dt in ``mode``."""
 
-    def events(self, t: float, y: np.ndarray, mode) -> np.ndarray:
+    def events(self, t: float, y: np.ndarray, mode: typing.Any) -> np.ndarray:
         """Event functions g_k (floats; their number may depend on the mode): all >= 0 while
         ``mode`` holds; a sign change of any g_k ends the smooth segment."""
 
-    def switch(self, t: float, y: np.ndarray, mode,
-               fired: list[int]) -> tuple[np.ndarray, object]:
+    def switch(self, t: float, y: np.ndarray, mode: typing.Any,
+               fired: list[int]) -> tuple[np.ndarray, typing.Any]:
         """The state and the mode after the events ``fired`` (indices into ``events``) at t."""
 
 
+#: ``observe(t, y, mode) -> dict``: what to record beside the state at each recorded time
+Observer = typing.Callable[[float, np.ndarray, typing.Any], dict]
+
+
 @dataclasses.dataclass(frozen=True)
-class HybridEvent:
+class HybridEvent(Record):
     """One located event: at time ``t`` the events ``fired`` of ``mode_before`` crossed zero;
     the switch mapped the state ``y_before`` to ``y_after`` in ``mode_after``."""
 
@@ -117,7 +124,7 @@ class HybridEvent:
 
 
 @dataclasses.dataclass
-class HybridResult:
+class HybridResult(Record):
     """History of a run of :func:`integrate_hybrid`.
 
     Attributes:
@@ -156,7 +163,8 @@ class HybridError(DynamicsError):
         result: the history up to there (``records`` holds its events).
     """
 
-    def __init__(self, message: str, t: float, y: np.ndarray, mode, result: HybridResult):
+    def __init__(self, message: str, t: float, y: np.ndarray, mode: typing.Any,
+                 result: HybridResult) -> None:
         super().__init__(message, result.events)
         self.t, self.y, self.mode, self.result = t, y, mode, result
 
@@ -168,7 +176,7 @@ class _Stop(Exception):
 class _History:
     """Recorded times, states, modes and observations, plus the run's counters."""
 
-    def __init__(self, sample_dt: float | None, observe):
+    def __init__(self, sample_dt: float | None, observe: Observer | None) -> None:
         self.sample_dt, self.observe = sample_dt, observe
         self.t: list[float] = []
         self.y: list[np.ndarray] = []
@@ -179,7 +187,7 @@ class _History:
         self.steps = self.rejected_steps = self.rhs_evaluations = self.segments = 0
         self.relaxed_locations = 0
 
-    def record(self, t: float, y: np.ndarray, mode) -> None:
+    def record(self, t: float, y: np.ndarray, mode: typing.Any) -> None:
         self.t.append(float(t))
         self.y.append(np.array(y, dtype=float))
         self.modes.append(mode)
@@ -205,7 +213,18 @@ class _Segment:
     the mode holds, resumable from ``t``, ``y``).
     """
 
-    def __init__(self, system: HybridSystem, mode, history: _History):
+    # set by run()
+    t0: float
+    t: float
+    y: np.ndarray
+    g: np.ndarray
+    g_accepted: np.ndarray
+    pending: np.ndarray
+    event_tol: float
+    base_event_tol: float
+    _sample: PETSc.Vec
+
+    def __init__(self, system: HybridSystem, mode: typing.Any, history: _History) -> None:
         self.system, self.mode, self.history = system, mode, history
         self.fired: list[int] = []
         self.failure: str | None = None
@@ -215,7 +234,7 @@ class _Segment:
         self.locating = 0  # right-hand sides evaluated since the last accepted step
         self.stalled = self.spurious = False
 
-    def _rhs(self, ts, t, x, f):
+    def _rhs(self, ts: PETSc.TS, t: float, x: PETSc.Vec, f: PETSc.Vec) -> None:
         self.history.rhs_evaluations += 1
         self.locating += 1  # reset by each accepted step
         if self.locating > _MAX_LOCATION_TRIES and self.failure is None:
@@ -229,10 +248,11 @@ class _Segment:
             raise _Stop  # ends TSSolve: converged reasons do not end the location loop
         f.setArray(self.system.rhs(t, x.getArray(readonly=True), self.mode))
 
-    def _events(self, ts, t, x, fvalue):
+    def _events(self, ts: PETSc.TS, t: float, x: PETSc.Vec, fvalue: np.ndarray) -> None:
         fvalue[:] = self.g = self.system.events(t, x.getArray(readonly=True), self.mode)
 
-    def _post_event(self, ts, fired, t, x, forward):
+    def _post_event(self, ts: PETSc.TS, fired: typing.Sequence[int], t: float, x: PETSc.Vec,
+                    forward: bool) -> None:
         # PETSc counts |g| < tol as an event even for a g that started at zero and has not
         # left that band yet. If it is still moving away from zero (up since the last
         # accepted step) nothing crossed: the mode holds and the driver resumes it; if it is
@@ -242,7 +262,7 @@ class _Segment:
                             if not (self.pending[int(k)] and g[int(k)] > self.g_accepted[int(k)]))
         self.spurious = not self.fired
 
-    def _post_step(self, ts):
+    def _post_step(self, ts: PETSc.TS) -> None:
         self.locating = 0
         if self.pending.any():  # PETSc skips events that start at zero: watch them here
             g = np.asarray(self.g, dtype=float)
@@ -324,7 +344,8 @@ class _Segment:
                 obj.destroy()
 
 
-def _smooth_segment(system: HybridSystem, mode, history: _History, t: float, y: np.ndarray,
+def _smooth_segment(system: HybridSystem, mode: typing.Any, history: _History, t: float,
+                    y: np.ndarray,
                     t_end: float, dt: float, options: dict, prefix: str,
                     event_tol: float | None) -> _Segment:
     """Integrate in ``mode`` from (t, y) to its first event or t_end, retrying what can be
@@ -353,11 +374,12 @@ def _smooth_segment(system: HybridSystem, mode, history: _History, t: float, y: 
     return segment
 
 
-def integrate_hybrid(system: HybridSystem, y0, mode0, t_end: float, *, rtol: float = 1e-8,
+def integrate_hybrid(system: HybridSystem, y0: typing.Sequence[float] | np.ndarray,
+                     mode0: typing.Any, t_end: float, *, rtol: float = 1e-8,
                      atol: float = 1e-10, dt0: float | None = None,
                      max_step: float | None = None, max_events: int = 100000,
                      sample_dt: float | None = None,
-                     observe: typing.Callable[[float, np.ndarray, object], dict] | None = None,
+                     observe: Observer | None = None,
                      prefix: str = "hybrid_") -> HybridResult:
     """Integrate a piecewise-smooth system from t = 0 to ``t_end``, locating each event.
 
@@ -402,7 +424,8 @@ def integrate_hybrid(system: HybridSystem, y0, mode0, t_end: float, *, rtol: flo
     history = _History(sample_dt, observe)
     history.record(0.0, y, mode0)
     t, mode = 0.0, mode0
-    instant_start, instant_modes = t, set()  # modes entered since the time last advanced
+    # modes entered since the time last advanced
+    instant_start, instant_modes = t, set[typing.Any]()
 
     def fail(message: str) -> typing.NoReturn:
         raise HybridError(message, t, y, mode, history.result())
@@ -451,18 +474,3 @@ def integrate_hybrid(system: HybridSystem, y0, mode0, t_end: float, *, rtol: flo
         if t >= t_end:
             return history.result()
 
-
-def mode_intervals(result: HybridResult, holds: typing.Callable[[object], bool]
-                   ) -> list[tuple[float, float]]:
-    """The (start, end) time intervals of a run during which ``holds(mode)`` is true, from the
-    located events (exact to the event tolerance), e.g. a contact's stick phases."""
-    intervals, start = [], float(result.t[0]) if holds(result.modes[0]) else None
-    for event in result.events:
-        before, after = holds(event.mode_before), holds(event.mode_after)
-        if before and not after:
-            intervals.append((start, event.t))
-        elif after and not before:
-            start = event.t
-    if holds(result.modes[-1]):
-        intervals.append((start, float(result.t[-1])))
-    return intervals

@@ -1,4 +1,4 @@
-r"""The block on a moving belt as a rigid body in plane motion (seed 000, Fig. 6 and Fig. 9).
+r"""The block on a moving belt as a rigid body in plane motion (Martins & Oden 1986, Figs. 6, 9).
 
 Three degrees of freedom :math:`q = (u_{xG}, u_{yG}, \theta)`: the displacement of the centre
 of mass G and the (small) rotation, counter-clockwise. A rigid motion moves a point X by
@@ -16,7 +16,9 @@ paper's exponents. Generalised forces by virtual power:
     Q_x = B_0\!\int t_x\,ds + F_s,\quad Q_y = B_0\!\int p\,ds - W,\quad
     Q_\theta = B_0\!\int (p\,s + t_x H/2)\,ds - F_s (h_s - H/2),
 
-with :math:`p = c_n d^{m_n} + b_n d^{l_n}\dot u_n`, :math:`t_x = -c_T d^{m_T}\phi_\varepsilon'(w)`
+with the tractions of :mod:`fenicsfriction.laws`, :math:`p = c_n d^{m_n} + b_n d^{l_n}\dot u_n`
+(:func:`~fenicsfriction.laws.normal_traction`) and :math:`t_x = -c_T d^{m_T}\phi_\varepsilon'(w)`
+(:func:`~fenicsfriction.laws.friction_traction`),
 and the spring force :math:`F_s = -K_x (u_{xG} - \theta (h_s - H/2))` at height :math:`h_s`.
 The equations of motion are :math:`M\ddot q + C_v \dot q - Q(q, \dot q) = 0` with
 :math:`M = \mathrm{diag}(M, M, I)`; the linearisation (M, C, K̄) is derived analytically and
@@ -30,21 +32,15 @@ import typing
 
 import numpy as np
 
+from fenicsfriction import laws
 from fenicsfriction.laws import check
-from fenicsfriction.numerics import dense_eigenvalues
-from fenicsfriction.scenes.block import BlockData
+from fenicsfriction.numerics import bisect, dense_eigenvalues
+from fenicsfriction.results import Record
+from fenicsfriction.scenes.block.data import BlockData
 
-__all__ = ["RigidBlock"]
+__all__ = ["RigidBlock", "RigidLoci", "rigid_loci"]
 
 _GAUSS = tuple((np.polynomial.legendre.leggauss(64)[i] + (1, 0)[i]) / 2 for i in range(2))
-
-
-def _dphi(regularisation: str, w: float, eps: float) -> tuple[float, float]:
-    """φ'(w) and φ''(w) of the scalar regularisation."""
-    if regularisation == "c1":
-        return (w / max(abs(w), eps), 1.0 / eps if abs(w) < eps else 0.0)
-    root = np.sqrt(w * w + eps * eps)
-    return w / root, eps * eps / root**3
 
 
 @dataclasses.dataclass
@@ -57,7 +53,7 @@ class RigidBlock(BlockData):
         Other parameters: see :class:`~fenicsfriction.scenes.block.BlockData`.
     """
 
-    inertia: float | None = None
+    inertia: float = None  # type: ignore[assignment]  # None: set by __post_init__
     viscous: tuple = (0.0, 0.0, 0.0)
 
     def __post_init__(self):
@@ -76,7 +72,7 @@ class RigidBlock(BlockData):
               "must be three finite coefficients >= 0")
 
     @classmethod
-    def from_scene(cls, scene: BlockData, **changes) -> RigidBlock:
+    def from_scene(cls, scene: BlockData, **changes: typing.Any) -> RigidBlock:
         """The rigid counterpart of a scene (its :class:`BlockData` fields), with ``changes``.
 
         A uniform top pressure p of the FE scene is a vertical resultant p L B0 through G, so
@@ -84,19 +80,21 @@ class RigidBlock(BlockData):
         and is refused rather than silently replaced by ``mu``.
         """
         shared = {f.name: getattr(scene, f.name) for f in dataclasses.fields(BlockData)}
-        if getattr(scene, "friction_coefficient", None) is not None:
-            raise ValueError(f"friction_coefficient={scene.friction_coefficient!r} is invalid: "
+        law = getattr(scene, "friction_coefficient", None)
+        if law is not None:
+            raise ValueError(f"friction_coefficient={law!r} is invalid: "
                              "the rigid block supports a constant mu only")
         shared["weight"] += getattr(scene, "top_pressure", 0.0) * scene.L * scene.B0
         return cls(**{**shared, **changes})
 
     @classmethod
-    def with_modal_damping(cls, ratios: tuple, **data) -> RigidBlock:
+    def with_modal_damping(cls, ratios: tuple[float, float, float], **data: typing.Any
+                           ) -> RigidBlock:
         """A block with viscous damping c_i = 2 ζ_i sqrt(k_i m_i), ζ = ``ratios`` for
         (u_xG, u_yG, θ), k_i the diagonal of K̄ at the frictionless steady state of the block
         ``data`` describes (where K̄ and the mass matrix are diagonal, so the ζ_i are exactly its
-        modal damping ratios at μ = 0); the c_i are then kept at every μ (seed 000 Figs. 10-12:
-        ζ = 0.005, 0.04, 0.04)."""
+        modal damping ratios at μ = 0); the c_i are then kept at every μ (Martins & Oden 1986,
+        Figs. 10-12: ζ = 0.005, 0.04, 0.04)."""
         check("ratios", ratios, len(ratios) == 3 and all(np.isfinite(z) and z >= 0
                                                          for z in ratios),
               "must be three finite ratios >= 0")
@@ -159,19 +157,19 @@ class RigidBlock(BlockData):
         """Q(q, q̇): interface, spring and weight forces on (u_xG, u_yG, θ)."""
         U = self.belt_direction * self.belt_speed
         w = q_dot[0] + q_dot[2] * self.H / 2 - U
-        direction = _dphi(self.regularisation, w, self.eps)[0]
         c_T = self.mu * self.c_n
 
-        def integrand(s, d):
-            p = self.c_n * d**self.m_n + self.b_n * d**self.l_n * (-(q_dot[1] + q_dot[2] * s))
-            t = -c_T * d**self.m_T * direction
+        def integrand(s: np.ndarray, d: np.ndarray) -> np.ndarray:
+            p = laws.normal_traction(d, self.c_n, self.m_n, -(q_dot[1] + q_dot[2] * s),
+                                     self.b_n, self.l_n)
+            t = laws.friction_traction(d, w, c_T, self.m_T, self.eps, self.regularisation)
             return np.array([t, p, p * s + t * self.H / 2])  # arrays over s
 
         Q = self._integrate(q, integrand, 3)
         F_s = self._spring(q)
         return Q + np.array([F_s, -self.weight, -F_s * (self.spring_height - self.H / 2)])
 
-    def residual(self, q, q_dot, q_ddot) -> np.ndarray:
+    def residual(self, q: np.ndarray, q_dot: np.ndarray, q_ddot: np.ndarray) -> np.ndarray:
         """R(q, q̇, q̈) = M q̈ + C_v q̇ - Q(q, q̇)."""
         return self.mass_matrix @ q_ddot + np.asarray(self.viscous) * q_dot \
             - self.generalised_forces(np.asarray(q, float), np.asarray(q_dot, float))
@@ -183,7 +181,8 @@ class RigidBlock(BlockData):
         q_dot = np.zeros(3) if q_dot is None else np.asarray(q_dot, float)
         U = self.belt_direction * self.belt_speed
         w = q_dot[0] + q_dot[2] * self.H / 2 - U
-        dphi, ddphi = _dphi(self.regularisation, w, self.eps)
+        _, first, second = laws.REGULARISATIONS[self.regularisation]
+        dphi, ddphi = first(w, self.eps), second(w, self.eps)
         c_T, h2 = self.mu * self.c_n, self.H / 2
         mn, mT, ln = self.m_n, self.m_T, self.l_n
 
@@ -242,3 +241,68 @@ class RigidBlock(BlockData):
         """Eigenvalues of (λ² M + λ C + K̄) at q (companion form), sorted by |λ|."""
         M, C, K = self.linearisation(q)
         return dense_eigenvalues(K, C, M)
+
+
+@dataclasses.dataclass
+class RigidLoci(Record):
+    """Eigenvalues of the rigid block along a μ grid and the flutter onsets between grid points.
+
+    Attributes:
+        steps: one row per μ: ``mu``, ``eigenvalues`` ([re, im] with Im λ >= 0 and
+            |λ| <= max_frequency) and ``max_re``.
+        onsets: μ of each onset (midpoint of the bisection's final interval).
+        mu_crit: the first onset, or None.
+        unstable_intervals: grid intervals [first, last] of μ where a mode grows.
+    """
+
+    steps: list[dict[str, typing.Any]]
+    onsets: list[float]
+    mu_crit: float | None
+    unstable_intervals: list[list[float]]
+
+
+def rigid_loci(scene: BlockData, targets: typing.Sequence[float] | np.ndarray,
+               max_frequency: float, growth_tol: float, onset_tol: float) -> RigidLoci:
+    """Eigenvalues of the rigid counterpart of ``scene`` along the μ grid ``targets``, and the
+    onsets of growth between grid points located by bisection.
+
+    Args:
+        scene: the block (its :class:`BlockData` fields, see :meth:`RigidBlock.from_scene`).
+        targets: the μ grid, increasing.
+        max_frequency: eigenvalues with |λ| above it are left out [1/s].
+        growth_tol: a mode grows when Re λ > growth_tol |λ|.
+        onset_tol: width of the bisection's final interval in μ.
+
+    Returns:
+        The :class:`RigidLoci`. Each steady state starts Newton from the previous one.
+    """
+    q: np.ndarray | None = None
+    steps: list[dict[str, typing.Any]] = []
+
+    def values(mu: float) -> np.ndarray:
+        nonlocal q
+        block = RigidBlock.from_scene(scene, mu=mu)
+        q = block.steady_state(q)
+        lam = block.eigenvalues(q)
+        return lam[(lam.imag >= 0) & (np.abs(lam) <= max_frequency)]
+
+    def grows(lam: np.ndarray) -> bool:
+        return bool(np.any(lam.real > growth_tol * np.abs(lam)))
+
+    for mu in targets:
+        lam = values(mu)
+        steps.append({"mu": float(mu), "eigenvalues": [[v.real, v.imag] for v in lam],
+                      "max_re": float(lam.real.max())})
+    flags = [grows(np.array([complex(*v) for v in st["eigenvalues"]])) for st in steps]
+    onsets: list[float] = []
+    intervals: list[list[float]] = []
+    for k in range(1, len(steps)):
+        if flags[k] and not flags[k - 1]:
+            values(targets[k - 1])  # Newton's warm start for the bisection
+            lo, hi = bisect(lambda mu: grows(values(mu)), targets[k - 1], targets[k], onset_tol)
+            onsets.append(0.5 * (lo + hi))
+            intervals.append([float(targets[k]), float(targets[k])])
+        if flags[k] and intervals:
+            intervals[-1][1] = float(targets[k])
+    return RigidLoci(steps=steps, onsets=onsets, mu_crit=onsets[0] if onsets else None,
+                     unstable_intervals=intervals)

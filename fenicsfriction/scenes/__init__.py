@@ -1,7 +1,21 @@
-"""Scenes: geometry, tags and parameters of the papers' examples (data, not logic)."""
+"""Scenes: geometry, tags and parameters of the papers' examples (data, not logic).
 
-from fenicsfriction.scenes.block import BlockData, BlockModel, BlockOnBelt
+Importing this package does not import dolfinx; ``BlockModel`` loads it on first use.
+"""
+
+from __future__ import annotations
+
+import typing
+
+from fenicsfriction.scenes.block import BlockData, BlockOnBelt
 
 __all__ = ["SCENES", "BlockData", "BlockModel", "BlockOnBelt"]
 
 SCENES = {"block": BlockOnBelt}
+
+
+def __getattr__(name: str) -> typing.Any:
+    if name == "BlockModel":
+        from fenicsfriction.scenes.block.model import BlockModel
+        return BlockModel
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

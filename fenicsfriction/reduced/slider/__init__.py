@@ -1,0 +1,32 @@
+r"""The 2m+1 d.o.f. slider on a rough moving surface ("Friction-induced sliding instability in a
+multi-degree-of-freedom system with oscillatory normal forces" (2003)).
+
+One module per question:
+
+* :mod:`~fenicsfriction.reduced.slider.model` — what is the slider? :class:`Contact`,
+  :class:`Slider` (its matrices, natural frequencies, steady sliding, forced response),
+  :class:`ScaledFriction`;
+* :mod:`~fenicsfriction.reduced.slider.stability` — is steady sliding stable? First-order
+  averaging (:meth:`Slider.averaged`) and Floquet multipliers (:meth:`Slider.floquet`),
+  :func:`stability_map` over the forcing frequency, :func:`stroboscopic_growth` of a time
+  response;
+* :mod:`~fenicsfriction.reduced.slider.table2` — the paper's numerical example
+  (:func:`table2_slider`, ``TABLE2_READINGS``, ``TABLE2_PAPER_BANDS``);
+* :mod:`~fenicsfriction.reduced.slider.motion` — how does it move? :class:`SliderMotion`, the
+  nonlinear equations with true stick (events) or a regularised law.
+"""
+
+from fenicsfriction.reduced.slider.model import Contact, ScaledFriction, Slider
+from fenicsfriction.reduced.slider.motion import SliderMotion
+from fenicsfriction.reduced.slider.stability import (
+    AveragedStability,
+    FloquetStability,
+    StabilityMap,
+    stability_map,
+    stroboscopic_growth,
+)
+from fenicsfriction.reduced.slider.table2 import TABLE2_PAPER_BANDS, TABLE2_READINGS, table2_slider
+
+__all__ = ["TABLE2_PAPER_BANDS", "TABLE2_READINGS", "AveragedStability", "Contact",
+           "FloquetStability", "ScaledFriction", "Slider", "SliderMotion", "StabilityMap",
+           "stability_map", "stroboscopic_growth", "table2_slider"]
