@@ -7,6 +7,7 @@ alike, so it imports petsc4py only (no dolfinx).
 from __future__ import annotations
 
 import contextlib
+import typing
 
 from petsc4py import PETSc
 
@@ -16,7 +17,7 @@ __all__ = ["RoundoffConvergence", "options_with_defaults"]
 
 
 @contextlib.contextmanager
-def options_with_defaults(prefix: str, defaults: dict):
+def options_with_defaults(prefix: str, defaults: dict) -> typing.Iterator[PETSc.Options]:
     """Put ``defaults`` into the PETSc options database under ``prefix`` for the duration of
     the block (call ``setFromOptions`` inside it), then take them out again.
 
@@ -64,7 +65,7 @@ class RoundoffConvergence:
         return float(np.sqrt(x.getSize()) * np.finfo(float).eps * self._jacobian_norm
                      * x.norm(PETSc.NormType.INFINITY))
 
-    def __call__(self, snes, it, norms):
+    def __call__(self, snes: PETSc.SNES, it: int, norms: tuple) -> int:
         fnorm = norms[2]
         if not np.isfinite(fnorm):
             return PETSc.SNES.ConvergedReason.DIVERGED_FNORM_NAN

@@ -63,7 +63,8 @@ def get_logger(comm: MPI.Comm = MPI.COMM_WORLD) -> logging.Logger:
     return logger
 
 
-def write_json(path: str | pathlib.Path, data, comm: MPI.Comm = MPI.COMM_WORLD):
+def write_json(path: str | pathlib.Path, data: typing.Any,
+               comm: MPI.Comm = MPI.COMM_WORLD) -> None:
     """Write ``data`` as JSON on rank 0 (NumPy scalars converted, non-finite floats -> null)."""
     if comm.rank == 0:
         path = pathlib.Path(path)

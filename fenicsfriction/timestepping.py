@@ -64,7 +64,7 @@ class Alpha2Integrator:
         convergence: the Newton stopping test (its ``atol_used``: the last tolerance).
     """
 
-    def __init__(self, comm, prefix: str, F: PETSc.Vec, J: PETSc.Mat,
+    def __init__(self, comm: typing.Any, prefix: str, F: PETSc.Vec, J: PETSc.Mat,
                  options: dict | None, atol: float):
         check("atol", atol, np.isfinite(atol) and atol > 0, "must be a finite number > 0")
         self.ts = PETSc.TS().create(comm)
@@ -85,7 +85,7 @@ class Alpha2Integrator:
     def _J(self, ts, t, x, xdot, xddot, shift_v, shift_a, J, P):
         raise NotImplementedError
 
-    def _load(self, x, xdot, xddot) -> None:
+    def _load(self, x: PETSc.Vec, xdot: PETSc.Vec, xddot: PETSc.Vec | None) -> None:
         raise NotImplementedError
 
     def _state(self) -> tuple[PETSc.Vec, PETSc.Vec]:

@@ -1,4 +1,5 @@
-"""The command line of the reduced friction oscillators (seed 004 and the belt oscillator)."""
+"""The command line of the reduced friction oscillators (the m.d.o.f. slider, the belt
+oscillator)."""
 
 import csv
 import json

@@ -37,7 +37,7 @@ import numpy as np
 
 from fenicsfriction import laws
 from fenicsfriction.laws import check, check_positive
-from fenicsfriction.reduced.events import HybridEvent, HybridResult, integrate_hybrid
+from fenicsfriction.reduced.events import HybridEvent, HybridResult, Observer, integrate_hybrid
 from fenicsfriction.results import Record
 from fenicsfriction.statistics import LimitCycle, mode_intervals
 
@@ -264,7 +264,7 @@ class BeltOscillator:
                  v0: float | None = None, method: str = "events",
                  eps: float | None = None, rtol: float = 1e-8, atol: float = 1e-10,
                  sample_dt: float | None = None, max_step: float | None = None,
-                 prefix: str = "belt_") -> BeltResult:
+                 observe: Observer | None = None, prefix: str = "belt_") -> BeltResult:
         """Integrate from (x0, v0) over [0, t_end].
 
         Args:
@@ -275,7 +275,7 @@ class BeltOscillator:
                 :func:`~fenicsfriction.reduced.events.integrate_hybrid`) or ``"regularised"``
                 (the smooth law :meth:`regularised_force` by the same TS, no events).
             eps: regularisation speed of ``"regularised"``; None: 1e-3 v_b.
-            rtol, atol, sample_dt, max_step, prefix: see
+            rtol, atol, sample_dt, max_step, observe, prefix: see
                 :func:`~fenicsfriction.reduced.events.integrate_hybrid`.
 
         Returns:
@@ -286,7 +286,8 @@ class BeltOscillator:
         x0 = self.steady_sliding() if x0 is None else float(x0)
         v0 = 0.0 if v0 is None else float(v0)
         kwargs: dict[str, typing.Any] = {"rtol": rtol, "atol": atol, "sample_dt": sample_dt,
-                                         "max_step": max_step, "prefix": prefix}
+                                         "max_step": max_step, "observe": observe,
+                                         "prefix": prefix}
         if method == "regularised":
             eps = 1e-3 * self.v_belt if eps is None else eps
             check_positive("eps", eps)

@@ -1,0 +1,61 @@
+"""Command line: ``fenicsfriction steady block --mu-max 1.5 --steps 30 --out DIR``.
+
+One module per family of commands: :mod:`~fenicsfriction.cli.block` (the finite element block:
+``steady``, ``stability``, ``dynamics``) and :mod:`~fenicsfriction.cli.oscillators` (the reduced
+oscillators: ``stability-map``, ``oscillator``); :mod:`~fenicsfriction.cli.common` holds what they
+share. User errors (a bad flag or parameter value, an unwritable ``--out``) print one line and
+exit with status 2; a solver failure writes what converged, prints one line and exits with
+status 1; SIGINT/SIGTERM stop the run at the next step with everything computed so far written,
+one line, and status 130/143.
+"""
+
+from __future__ import annotations
+
+import logging
+import sys
+
+from mpi4py import MPI
+
+from fenicsfriction.cli import block, oscillators
+from fenicsfriction.cli.common import Parser
+
+__all__ = ["main"]
+
+COMMANDS = {"steady": block.run_steady, "stability": block.run_stability,
+            "dynamics": block.run_dynamics, "stability-map": oscillators.run_stability_map,
+            "oscillator": oscillators.run_oscillator}
+
+
+def _parser() -> Parser:
+    parser = Parser(prog="fenicsfriction", description=__doc__.splitlines()[0])
+    commands = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
+    block.add_parsers(commands)
+    oscillators.add_parsers(commands)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``fenicsfriction`` console script and ``python -m fenicsfriction``."""
+    argv = sys.argv[1:] if argv is None else list(argv)
+    # everything after the first PETSc-style option (-prefix_name) goes to PETSc
+    split = next((i for i, a in enumerate(argv) if a.startswith("-") and not a.startswith("--")
+                  and len(a) > 2 and not a[1].isdigit()), len(argv))
+    args = _parser().parse_args(argv[:split])
+    if split < len(argv):
+        from petsc4py import PETSc
+        PETSc.Options().insertString(" ".join(argv[split:]))
+    logging.getLogger("ffcx").setLevel(logging.WARNING)
+    logging.getLogger("UFL").setLevel(logging.WARNING)
+    logging.getLogger().setLevel(logging.WARNING)
+    from fenicsfriction.results import get_logger
+    log = get_logger(MPI.COMM_WORLD)
+    try:
+        return COMMANDS[args.command](args, log)
+    except ValueError as err:
+        if MPI.COMM_WORLD.rank == 0:
+            print(f"fenicsfriction: error: {err}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:  # a second signal inside a step: no summary, but no traceback
+        print("fenicsfriction: interrupted inside a step; the rows written so far are kept",
+              file=sys.stderr)
+        return 130

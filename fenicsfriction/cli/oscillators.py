@@ -1,0 +1,237 @@
+"""``fenicsfriction stability-map mdof`` and ``fenicsfriction oscillator mdof|belt``: the reduced
+friction oscillators (the m.d.o.f. slider with oscillatory normal forces, "Friction-induced
+sliding instability in a multi-degree-of-freedom system with oscillatory normal forces" (2003),
+and the 1-d.o.f. oscillator on a belt).
+
+The slider's time series is written row by row as the integration samples it; a signal stops the
+run at the next sample with what was computed kept (see :mod:`fenicsfriction.cli.common`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import functools
+import logging
+import pathlib
+import time
+import typing
+
+from mpi4py import MPI
+
+import numpy as np
+
+from fenicsfriction import laws, plotting, results
+from fenicsfriction.cli.common import CsvRows, Interrupted, StopSignals, omega_range, output_folder
+from fenicsfriction.laws import check
+
+__all__ = ["add_parsers", "run_oscillator", "run_stability_map"]
+
+
+def add_parsers(commands: typing.Any) -> None:
+    """``stability-map mdof`` and ``oscillator mdof|belt``."""
+    from fenicsfriction.reduced.slider import TABLE2_READINGS
+
+    readings = {"choices": sorted(TABLE2_READINGS), "default": "paper",
+                "help": "reading of the paper's dimensionless Table 2 model (paper)"}
+    smap = commands.add_parser(
+        "stability-map", help="stability of steady sliding vs forcing frequency (m.d.o.f. slider)",
+        description="Growth rate of perturbations of steady sliding of the Table 2 slider by "
+                    "first-order averaging and by Floquet multipliers (PETSc TS), with the "
+                    "unstable bands.")
+    smap.add_argument("scene", choices=["mdof"], help="scene to run")
+    smap.add_argument("--omega-range", type=omega_range, required=True, metavar="LO:HI")
+    smap.add_argument("--samples", type=int, default=101, help="forcing frequencies sampled")
+    smap.add_argument("--methods", default="averaging,floquet",
+                      help="comma-separated: averaging, floquet")
+    smap.add_argument("--reading", **readings)
+    smap.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    osc = commands.add_parser(
+        "oscillator", help="stick-slip time response of a friction oscillator",
+        description="Integrates the m.d.o.f. slider (mdof) or the 1-d.o.f. oscillator on a "
+                    "belt (belt) with stick and slip switched at events located by PETSc TS "
+                    "(or a regularised law with --eps); TS options as -hybrid_<option>.")
+    osc.add_argument("scene", choices=["mdof", "belt"], help="scene to run")
+    osc.add_argument("--t-end", type=float, default=100.0, help="final (dimensionless) time")
+    osc.add_argument("--eps", type=float, help="regularised law of this width (no events)")
+    osc.add_argument("--rtol", type=float, default=1e-8, help="relative tolerance of the steps")
+    osc.add_argument("--sample-dt", type=float, default=0.01, help="output sampling step")
+    osc.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    mdof = osc.add_argument_group("mdof (the m.d.o.f. slider, Table 2)")
+    mdof.add_argument("--omega", type=float, default=30.78, help="forcing frequency ω_o")
+    mdof.add_argument("--reading", **readings)
+    mdof.add_argument("--normal-force", choices=["signed", "absolute", "clipped"],
+                      default="signed", help="how N enters friction (signed, as eq. 21)")
+    mdof.add_argument("--coupled", action="store_true",
+                      help="the roughness under a contact follows its tangential motion")
+    mdof.add_argument("--perturbation", type=float, default=0.01,
+                      help="initial slider velocity added to steady sliding")
+    belt = osc.add_argument_group("belt (m ẍ + c ẋ + k x = μ(v_b − ẋ) N)")
+    for flag, default, text in (("--m", 1.0, "mass"), ("--k", 1.0, "stiffness"),
+                                ("--c", 0.0, "damping"), ("--N", 1.0, "normal force"),
+                                ("--v-belt", 0.5, "belt speed"),
+                                ("--mu-s", 0.6, "static coefficient"),
+                                ("--mu-k", 0.3, "kinetic coefficient (constant, stribeck)"),
+                                ("--slope", 0.03, "dμ/d|v| (piecewise)"),
+                                ("--v-c", 15.0, "end of the slope (piecewise)"),
+                                ("--v-s", 0.5, "Stribeck speed (stribeck)")):
+        belt.add_argument(flag, type=float, default=default, help=f"{text} ({default})")
+    belt.add_argument("--law", choices=["constant", "piecewise", "stribeck"],
+                      default="constant", help="μ(v) while slipping (constant: μ_k, with μ_s "
+                                               "for stick)")
+    belt.add_argument("--x0", type=float, default=0.0, help="initial displacement (0)")
+    belt.add_argument("--v0", type=float,
+                      help="initial velocity (the belt's: the mass starts stuck to the belt)")
+
+
+def run_stability_map(args: argparse.Namespace, log: logging.Logger) -> int:
+    """Averaging and Floquet growth rates over a range of forcing frequencies, with bands."""
+    from fenicsfriction.reduced.slider import TABLE2_PAPER_BANDS, stability_map, table2_slider
+
+    lo, hi = args.omega_range
+    check("--omega-range", f"{lo:g}:{hi:g}", 0 < lo < hi, "needs 0 < LO < HI")
+    check("--samples", args.samples, args.samples >= 2, "must be >= 2")
+    out = output_folder(args.out)
+    methods = [m.strip() for m in args.methods.split(",") if m.strip()]
+    result = stability_map(functools.partial(table2_slider, reading=args.reading),
+                           np.linspace(lo, hi, args.samples), methods=methods)
+    for method in methods:
+        bands = [(round(a, 3), round(b, 3)) for a, b in result.bands[method]]
+        per_omega = result.seconds[method] / args.samples * 1e3
+        log.info(f"{method}: unstable bands {bands} ({per_omega:.2f} ms per ω_o)")
+    paper = [list(band) for band in TABLE2_PAPER_BANDS]
+    slider = table2_slider(lo, reading=args.reading)
+    results.write_json(out / "stability_map.json", {
+        "reading": args.reading, "natural_frequencies": slider.natural_frequencies()[0],
+        "omega": result.omega, "growth": result.growth, "bands": result.bands,
+        "seconds_per_omega": {k: v / args.samples for k, v in result.seconds.items()},
+        "paper_bands": paper})
+    if MPI.COMM_WORLD.rank == 0:
+        plotting.plot_stability_map(result.omega, result.growth, result.bands,
+                                    out / "stability_map.png", reference_bands=TABLE2_PAPER_BANDS)
+    MPI.COMM_WORLD.Barrier()
+    return 0
+
+
+def _belt(args: argparse.Namespace, observe: typing.Callable) -> tuple[dict, dict, tuple]:
+    """The belt oscillator's run: (summary, columns, what to plot)."""
+    from fenicsfriction.reduced import BeltOscillator
+    from fenicsfriction.statistics import belt_summary
+
+    law: dict[str, typing.Callable[[], laws.FrictionCoefficient]] = {
+           "constant": lambda: laws.ConstantFriction(args.mu_k),
+           "piecewise": lambda: laws.PiecewiseLinearFriction(args.mu_s, args.slope, args.v_c),
+           "stribeck": lambda: laws.StribeckFriction(args.mu_s, args.mu_k, args.v_s)}
+    oscillator = BeltOscillator(args.m, args.k, args.c, args.N, args.v_belt,
+                                law[args.law](), mu_static=args.mu_s)
+    method = "events" if args.eps is None else "regularised"
+    run = oscillator.simulate(args.t_end, x0=args.x0,
+                              v0=args.v_belt if args.v0 is None else args.v0, method=method,
+                              eps=args.eps, rtol=args.rtol, atol=1e-2 * args.rtol,
+                              sample_dt=args.sample_dt, observe=observe)
+    summary = belt_summary(run).to_json()
+    summary = {**summary, "stick_fraction": summary["stick_fraction_run"],
+               "effective_damping": oscillator.effective_damping(),
+               "steady_sliding_stable": oscillator.is_steady_sliding_stable(),
+               "linear_eigenvalues": [[s.real, s.imag]
+                                      for s in oscillator.linear_eigenvalues()]}
+    if args.law == "constant" and args.c == 0 and args.mu_s > args.mu_k:
+        summary["classic_cycle"] = oscillator.classic_limit_cycle().to_json()
+    columns = {"t": run.t, "x": run.x, "v": run.v, "friction_force": run.friction_force,
+               "stick": [int(m == "stick") for m in run.modes]}
+    plot = (run.t, run.x, run.v, args.v_belt, run.stick_intervals, ("x", "ẋ"))
+    return summary, columns, plot
+
+
+def run_oscillator(args: argparse.Namespace, log: logging.Logger) -> int:
+    """Stick-slip time response of the slider or the belt oscillator: CSV, JSON and a figure."""
+    from fenicsfriction.reduced.events import HybridError, integrate_hybrid
+    from fenicsfriction.reduced.slider import SliderMotion, table2_slider
+    from fenicsfriction.statistics import mode_intervals
+
+    check("--t-end", args.t_end, args.t_end > 0, "must be > 0")
+    check("--sample-dt", args.sample_dt, 0 < args.sample_dt <= args.t_end,
+          "must lie in (0, t-end]")
+    check("--omega", args.omega, args.omega > 0, "must be > 0")
+    out = output_folder(args.out)
+    comm = MPI.COMM_WORLD
+    next_report = [0.0]
+    samples = [0.0, 0]  # last sampled time, count
+    start = time.perf_counter()
+
+    with StopSignals(comm) as stop, CsvRows(out / "timeseries.csv", comm) as table:
+        def progress(t: float, mode: typing.Any) -> None:
+            samples[:] = t, samples[1] + 1
+            if t >= next_report[0]:
+                log.info(f"t = {t:10.4f} / {args.t_end:g}  mode {mode}")
+                next_report[0] += args.t_end / 10
+            stop.check(f"t = {t:.6g} ({samples[1]} samples)")
+
+        try:
+            if args.scene == "belt":
+                def observe_belt(t: float, y: np.ndarray, mode: typing.Any) -> dict:
+                    progress(t, mode)
+                    return {}
+
+                summary, columns, plot = _belt(args, observe_belt)
+            else:
+                slider = table2_slider(args.omega, reading=args.reading)
+                motion = SliderMotion(slider, normal_force=args.normal_force,
+                                      coupled=args.coupled, eps=args.eps)
+                n = motion.size // 2
+
+                def observe(t: float, y: np.ndarray, mode: typing.Any) -> dict:
+                    normal, force = motion.contact_forces(t, y, mode)
+                    table.write({"t": t, "y_s": y[0], "y_1": y[1], "x_1": y[2], "v_s": y[n],
+                                 "v_1": y[n + 1], "normal_force": normal[0],
+                                 "friction_force": force[0], "stick": int(mode[0] == 0)})
+                    progress(t, mode)
+                    return {}
+
+                try:
+                    run = integrate_hybrid(motion, motion.initial_state([args.perturbation]),
+                                           motion.slip_mode(), args.t_end, rtol=args.rtol,
+                                           atol=1e-2 * args.rtol, sample_dt=args.sample_dt,
+                                           observe=observe)
+                except HybridError as error:
+                    log.info(f"stopped: {error}")
+                    run = error.result
+                t, y = run.t, run.y
+                stick = mode_intervals(run, lambda mode: mode[0] == 0)
+                omega, _ = slider.natural_frequencies()
+                late = t >= t[-1] / 2
+                summary = {"omega": args.omega, "reading": args.reading,
+                           "natural_frequencies": omega,
+                           "surface_speed": slider.contacts[0].surface_speed,
+                           "averaged_growth": slider.averaged().growth,
+                           "floquet_growth": slider.floquet().growth,
+                           "events": len(run.events),
+                           "stick_fraction": sum(b - a for a, b in stick) / t[-1],
+                           "slider_amplitude_first_half": float(np.ptp(y[~late, 0])) / 2,
+                           "slider_amplitude_second_half": float(np.ptp(y[late, 0])) / 2,
+                           "steps": run.steps, "t_end": float(t[-1])}
+                columns = {}
+                plot = (t, y[:, 0], y[:, n + 1], slider.contacts[0].surface_speed, stick,
+                        ("slider y_s", "velocity of mass 1, ẏ_1"))
+        except Interrupted as err:
+            summary = {"interrupted": str(err), "t_end": samples[0], "samples": samples[1],
+                       "wall_seconds": time.perf_counter() - start}
+            results.write_json(out / "summary.json", summary)
+            log.error(f"fenicsfriction: {err}; the results so far are written")
+            return err.exit_code
+        if columns and comm.rank == 0:  # the belt's table, from the finished run
+            with open(out / "timeseries.csv", "w", newline="") as f:
+                writer = csv.writer(f)
+                writer.writerow(columns)
+                writer.writerows(zip(*columns.values(), strict=True))
+    summary["wall_seconds"] = time.perf_counter() - start
+    log.info(f"{summary['events']} events, stick fraction {summary['stick_fraction']:.3f}, "
+             f"{summary['wall_seconds']:.1f} s")
+    results.write_json(out / "summary.json", summary)
+    if comm.rank == 0:
+        t, x, v, surface, stick, names = plot
+        plotting.plot_oscillator(t, x, v, surface, stick, out / "oscillator.png",
+                                 title=f"{args.scene}: {summary['events']} stick/slip events",
+                                 names=names)
+    comm.Barrier()
+    return 0
