@@ -31,19 +31,28 @@ _EXPORTS: dict[str, str] = {
     "SteadySolver": "steady", "SolveError": "steady", "SolveReport": "steady",
     "ContinuationError": "steady", "continuation": "steady", "epsilon_sequence": "steady",
     "StabilitySolver": "stability", "Loci": "stability", "Mode": "stability",
-    "EigenSolveError": "stability", "unstable_intervals": "stability",
+    "EigenSolveError": "stability", "unstable_intervals": "stability", "Onset": "stability",
     "DynamicsSolver": "dynamics", "CentralDifference": "dynamics",
     "DynamicsError": "timestepping",
     # post-processing and output
-    "stick_slip_statistics": "statistics", "dense_eigenvalues": "numerics",
+    "stick_slip_statistics": "statistics", "StickSlipStatistics": "statistics",
+    "mode_intervals": "statistics", "limit_cycle": "statistics", "LimitCycle": "statistics",
+    "belt_summary": "statistics", "BeltSummary": "statistics",
+    "dense_eigenvalues": "numerics", "bisect": "numerics",
     "Record": "results", "write_json": "results", "get_logger": "results",
     # scenes
     "BlockData": "scenes", "BlockOnBelt": "scenes", "BlockModel": "scenes",
+    "BlockQuantities": "scenes.block", "Energies": "scenes.block", "Powers": "scenes.block",
+    "ContactStates": "scenes.block", "CentreOfMass": "scenes.block",
+    "ProbeValues": "scenes.block",
     # reduced models (no mesh)
-    "RigidBlock": "reduced", "ReducedDynamics": "reduced", "BouncingMass": "reduced",
+    "RigidBlock": "reduced", "RigidLoci": "reduced.rigid_block", "rigid_loci":
+    "reduced.rigid_block", "ReducedDynamics": "reduced", "BouncingMass": "reduced",
     "BeltOscillator": "reduced", "Slider": "reduced", "SliderMotion": "reduced",
     "Contact": "reduced", "table2_slider": "reduced", "stability_map": "reduced",
     "integrate_hybrid": "reduced", "HybridError": "reduced", "HybridResult": "reduced",
+    "BeltResult": "reduced", "AveragedStability": "reduced.slider",
+    "FloquetStability": "reduced.slider", "StabilityMap": "reduced.slider",
 }
 
 _SUBMODULES = ("dynamics", "forms", "io", "laws", "numerics", "plotting", "reduced", "results",
@@ -91,9 +100,10 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers and IDEs
         PiecewiseLinearFriction,
         StribeckFriction,
     )
-    from fenicsfriction.numerics import dense_eigenvalues
+    from fenicsfriction.numerics import bisect, dense_eigenvalues
     from fenicsfriction.reduced import (
         BeltOscillator,
+        BeltResult,
         BouncingMass,
         Contact,
         HybridError,
@@ -106,16 +116,35 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers and IDEs
         stability_map,
         table2_slider,
     )
+    from fenicsfriction.reduced.rigid_block import RigidLoci, rigid_loci
+    from fenicsfriction.reduced.slider import AveragedStability, FloquetStability, StabilityMap
     from fenicsfriction.results import Record, get_logger, write_json
     from fenicsfriction.scenes import BlockData, BlockModel, BlockOnBelt
+    from fenicsfriction.scenes.block import (
+        BlockQuantities,
+        CentreOfMass,
+        ContactStates,
+        Energies,
+        Powers,
+        ProbeValues,
+    )
     from fenicsfriction.stability import (
         EigenSolveError,
         Loci,
         Mode,
+        Onset,
         StabilitySolver,
         unstable_intervals,
     )
-    from fenicsfriction.statistics import stick_slip_statistics
+    from fenicsfriction.statistics import (
+        BeltSummary,
+        LimitCycle,
+        StickSlipStatistics,
+        belt_summary,
+        limit_cycle,
+        mode_intervals,
+        stick_slip_statistics,
+    )
     from fenicsfriction.steady import (
         ContinuationError,
         SolveError,
