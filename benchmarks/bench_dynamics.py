@@ -1,6 +1,6 @@
 r"""Work-precision of the dynamics integrators on the stick-slip cycle of the block.
 
-Problem 1ε (SPEC §1) on the block on a moving belt with the data of seed 000 Figs. 13-15
+Problem 1ε on the block on a moving belt with the data of Martins & Oden (1986), Figs. 13-15
 (μ = 0.6, belt speed 0.08 cm/s, normal damping b_n = 0.381e10, l_n = 2.5), ε = 1e-2 cm/s (the
 demo's stick band), on the paper's 4 × 3 mesh. From the steady sliding state plus a normal
 velocity perturbation of -0.01 cm/s the flutter oscillation grows (Re λ ≈ 400 s⁻¹), the
@@ -36,7 +36,6 @@ table. Serial (the 126-dof problem gains nothing from more ranks).
 
 from __future__ import annotations
 
-import argparse
 import logging
 import pathlib
 import time
@@ -44,6 +43,8 @@ import time
 from mpi4py import MPI
 
 import numpy as np
+from _common import parser as benchmark_parser
+from _common import save
 from scipy.integrate import trapezoid
 
 import fenicsfriction as ff
@@ -211,15 +212,11 @@ def plot(runs: list[dict], reference: dict, path: pathlib.Path) -> None:
     ax.legend(fontsize=8)
     fig.suptitle(f"Stick-slip cycle of the block (μ = {MU}, U = {BELT_SPEED} cm/s, ε = {EPS}): "
                  "error against wall time", fontsize=11)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save(fig, path, dpi=110)
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("results/benchmarks"),
-                        help="output folder (default: results/benchmarks)")
+    parser = benchmark_parser(__doc__)
     parser.add_argument("--t-end", type=float, default=T_END,
                         help=f"simulated time [s]; the cycle is measured on its second half "
                              f"(default {T_END:g})")

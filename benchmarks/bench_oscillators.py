@@ -21,12 +21,13 @@ markdown tables. Serial (the systems have 2 to 6 unknowns).
 
 from __future__ import annotations
 
-import argparse
 import json
 import pathlib
 import time
 
 import numpy as np
+from _common import parser as benchmark_parser
+from _common import save
 
 from fenicsfriction import laws
 from fenicsfriction.reduced import BeltOscillator
@@ -107,14 +108,11 @@ def _plot(out: dict, path: pathlib.Path) -> None:
     labels = [f"{r['method']}\n{r['range'][0]:g}-{r['range'][1]:g}" for r in rows]
     axes[1].bar(labels, [r["ms_per_omega"] for r in rows], color=["tab:blue", "tab:orange"] * 2)
     axes[1].set(yscale="log", ylabel="ms per forcing frequency", title="stability map cost")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save(fig, path, dpi=110)
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("results/benchmarks"))
+    parser = benchmark_parser(__doc__)
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     out: dict = {}

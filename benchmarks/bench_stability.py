@@ -1,6 +1,6 @@
 r"""Wall time and accuracy of the stability eigensolver (SLEPc PEP) against the number of dofs.
 
-Problem 3 (SPEC §2) on the block on a moving belt (seed 000, SPEC §4) at μ = 0.5, past the
+Problem 3 on the block on a moving belt (Martins & Oden 1986) at μ = 0.5, past the
 collision of the normal/rotation pair (flutter, λ ≈ ±403 + 5365i): every eigenvalue with
 |λ| ≤ 8000 rad/s, computed by :class:`fenicsfriction.stability.StabilitySolver` (TOAR,
 shift-and-invert about σ = 8000/4 = 2000 with a MUMPS LU factorisation), on the 4r × 3r
@@ -42,7 +42,6 @@ tables to stdout (progress goes to stderr). Rank 0 writes and prints; run serial
 
 from __future__ import annotations
 
-import argparse
 import logging
 import pathlib
 import time
@@ -51,10 +50,13 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 import numpy as np
+from _common import parser as benchmark_parser
+from _common import save
 
 import fenicsfriction as ff
 from fenicsfriction.numerics import dense_eigenvalues
 from fenicsfriction.reduced import RigidBlock
+from fenicsfriction.results import to_plain
 from fenicsfriction.stability import StabilitySolver
 
 MU = 0.5
@@ -196,17 +198,6 @@ def dense_check(stab: StabilitySolver, values: list[complex], comm: MPI.Comm) ->
             "max_relative_error": max(m["relative_error"] for m in modes),
             **{name: min(abs(named[name] - exact) / abs(exact) for exact in inside)
                for name in named}}
-
-
-def _plain(value):
-    """Complex numbers as [re, im] for JSON (nested dicts and lists)."""
-    if isinstance(value, dict):
-        return {k: _plain(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
-    if isinstance(value, (complex, np.complexfloating)):
-        return [float(value.real), float(value.imag)]
-    return value
 
 
 def named_modes(values: list[complex]) -> dict:
@@ -424,15 +415,11 @@ def plot(runs: list[dict], rigid: dict, path: pathlib.Path) -> None:
     for ax in (ax_time, ax_ratio, ax_acc):
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save(fig, path, dpi=120)
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("results/benchmarks"),
-                        help="output folder (default: results/benchmarks)")
+    parser = benchmark_parser(__doc__)
     parser.add_argument("--refine-2d", type=int, nargs="*", default=None,
                         help=f"2D refinement factors, increasing; the last is the reference "
                              f"(default: {' '.join(map(str, REFINE_2D))})")
@@ -490,7 +477,7 @@ def main(argv=None) -> None:
                       "variants": {k: {"options": o, "solve": s}
                                    for k, (o, s) in VARIANTS.items()},
                       "best_variant": best, "variant_geometric_means": means,
-                      "rigid": _plain(rigid), "total_time_s": total, "runs": _plain(runs)},
+                      "rigid": to_plain(rigid), "total_time_s": total, "runs": to_plain(runs)},
                      comm)
     say(f"wrote {args.out / 'bench_stability.json'} and {args.out / 'bench_stability.png'} "
         f"({total:.0f} s)")

@@ -1,6 +1,6 @@
 """Speed against accuracy of the steady-sliding continuation on refined block meshes.
 
-The paper's block on a moving belt (seed 000, SPEC §4) is followed in μ from 0 to 1.5 in 30
+The block on a moving belt of Martins & Oden (1986) is followed in μ from 0 to 1.5 in 30
 steps, Newton at each step (:func:`fenicsfriction.continuation`), on the 4r × 3r nine-node
 mesh for each refinement factor r (default 1, 2, 4, 8). For every mesh it records:
 
@@ -26,7 +26,6 @@ tables to stdout (progress goes to stderr). Rank 0 writes and prints; run serial
 
 from __future__ import annotations
 
-import argparse
 import itertools
 import logging
 import pathlib
@@ -38,6 +37,8 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 import numpy as np
+from _common import parser as benchmark_parser
+from _common import save
 from dolfinx import geometry
 
 import fenicsfriction as ff
@@ -266,15 +267,11 @@ def plot(runs: list[dict], path: pathlib.Path) -> None:
     ax_newton.yaxis.get_major_locator().set_params(integer=True)
     ax_newton.grid(True, alpha=0.3)
     ax_newton.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save(fig, path, dpi=120)
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("results/benchmarks"),
-                        help="output folder (default: results/benchmarks)")
+    parser = benchmark_parser(__doc__)
     parser.add_argument("--refine", type=int, nargs="+", default=[1, 2, 4, 8],
                         help="refinement factors, increasing; the last is the reference "
                              "(default: 1 2 4 8)")

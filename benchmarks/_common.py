@@ -1,0 +1,24 @@
+"""What the benchmark scripts share: the ``--out`` flag and saving a figure."""
+
+from __future__ import annotations
+
+import argparse
+import pathlib
+import typing
+
+
+def parser(doc: str | None) -> argparse.ArgumentParser:
+    """An argument parser described by the first line of ``doc``, with ``--out``."""
+    flags = argparse.ArgumentParser(description=(doc or "").splitlines()[0])
+    flags.add_argument("--out", type=pathlib.Path, default=pathlib.Path("results/benchmarks"),
+                       help="output folder (default: results/benchmarks)")
+    return flags
+
+
+def save(fig: typing.Any, path: pathlib.Path, dpi: int) -> None:
+    """Lay out, write and close a matplotlib figure."""
+    import matplotlib.pyplot as plt
+
+    fig.tight_layout()
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
