@@ -39,7 +39,8 @@ _EXPORTS: dict[str, str] = {
     "mode_intervals": "statistics", "limit_cycle": "statistics", "LimitCycle": "statistics",
     "belt_summary": "statistics", "BeltSummary": "statistics",
     "dense_eigenvalues": "numerics", "bisect": "numerics",
-    "Record": "results", "write_json": "results", "get_logger": "results",
+    "Record": "results", "write_json": "results", "get_logger": "results", "CsvRows": "results",
+    "StopSignals": "signals", "Interrupted": "signals",
     # scenes
     "BlockData": "scenes", "BlockOnBelt": "scenes", "BlockModel": "scenes",
     "BlockQuantities": "scenes.block", "Energies": "scenes.block", "Powers": "scenes.block",
@@ -56,7 +57,7 @@ _EXPORTS: dict[str, str] = {
 }
 
 _SUBMODULES = ("dynamics", "forms", "io", "laws", "numerics", "plotting", "reduced", "results",
-               "scenes", "stability", "statistics", "steady", "timestepping")
+               "scenes", "signals", "stability", "statistics", "steady", "timestepping")
 
 __all__ = sorted([*_EXPORTS, *_SUBMODULES, "__version__"])
 
@@ -87,6 +88,7 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers and IDEs
         reduced,
         results,
         scenes,
+        signals,
         stability,
         statistics,
         steady,
@@ -118,7 +120,7 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers and IDEs
     )
     from fenicsfriction.reduced.rigid_block import RigidLoci, rigid_loci
     from fenicsfriction.reduced.slider import AveragedStability, FloquetStability, StabilityMap
-    from fenicsfriction.results import Record, get_logger, write_json
+    from fenicsfriction.results import CsvRows, Record, get_logger, write_json
     from fenicsfriction.scenes import BlockData, BlockModel, BlockOnBelt
     from fenicsfriction.scenes.block import (
         BlockQuantities,
@@ -128,6 +130,7 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers and IDEs
         Powers,
         ProbeValues,
     )
+    from fenicsfriction.signals import Interrupted, StopSignals
     from fenicsfriction.stability import (
         EigenSolveError,
         Loci,

@@ -1,11 +1,13 @@
-"""How results leave the program: typed records with ``to_json``, JSON files written on rank 0,
-and the package logger (INFO on rank 0 only).
+"""How results leave the program: typed records with ``to_json``, JSON files and CSV tables
+written on rank 0 (tables row by row, as they are computed), and the package logger (INFO on
+rank 0 only).
 
 Imports NumPy and mpi4py only, so the reduced models use it as the finite element ones do.
 """
 
 from __future__ import annotations
 
+import csv
 import dataclasses
 import json
 import logging
@@ -16,7 +18,7 @@ from mpi4py import MPI
 
 import numpy as np
 
-__all__ = ["Record", "get_logger", "to_plain", "write_json"]
+__all__ = ["CsvRows", "Record", "get_logger", "to_plain", "write_json"]
 
 
 def to_plain(value: typing.Any) -> typing.Any:
@@ -71,3 +73,36 @@ def write_json(path: str | pathlib.Path, data: typing.Any,
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(json.dumps(to_plain(data), indent=1) + "\n")
     comm.Barrier()
+
+
+class CsvRows:
+    """A CSV table written row by row on rank 0 and flushed after each row, so that whatever
+    stops the run leaves every computed row on disk. The header is the first row's keys."""
+
+    def __init__(self, path: pathlib.Path, comm: MPI.Comm = MPI.COMM_WORLD):
+        self.path, self.comm = path, comm
+        self._file: typing.TextIO | None = None
+        self._writer: csv.DictWriter | None = None
+
+    def write(self, row: dict[str, typing.Any]) -> None:
+        """Append ``row`` (same keys as the first row)."""
+        if self.comm.rank != 0:
+            return
+        if self._writer is None:
+            self._file = open(self.path, "w", newline="")  # noqa: SIM115 (closed in close())
+            self._writer = csv.DictWriter(self._file, fieldnames=list(row))
+            self._writer.writeheader()
+        self._writer.writerow(row)
+        assert self._file is not None
+        self._file.flush()
+
+    def close(self) -> None:
+        if self._file is not None:
+            self._file.close()
+            self._file = None
+
+    def __enter__(self) -> CsvRows:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

@@ -3,7 +3,7 @@
 Each command writes what it computes as it goes (``steady.json``/``stability.json`` rewritten
 after every μ step, ``timeseries.csv`` one row per time step) and, stopped by a signal or a
 solver failure, keeps what it has, writes ``summary.json`` saying where it stopped and returns
-non-zero (see :mod:`fenicsfriction.cli.common`).
+non-zero (see :mod:`fenicsfriction.signals`).
 """
 
 from __future__ import annotations
@@ -20,16 +20,11 @@ from mpi4py import MPI
 import numpy as np
 
 from fenicsfriction import io, plotting, results
-from fenicsfriction.cli.common import (
-    CsvRows,
-    Interrupted,
-    Parser,
-    StopSignals,
-    floats,
-    output_folder,
-)
+from fenicsfriction.cli.common import Parser, floats, output_folder
 from fenicsfriction.laws import check
+from fenicsfriction.results import CsvRows
 from fenicsfriction.scenes import SCENES
+from fenicsfriction.signals import Interrupted, StopSignals
 
 if typing.TYPE_CHECKING:
     from fenicsfriction.scenes.block import BlockModel, BlockOnBelt

@@ -4,7 +4,7 @@ sliding instability in a multi-degree-of-freedom system with oscillatory normal 
 and the 1-d.o.f. oscillator on a belt).
 
 The slider's time series is written row by row as the integration samples it; a signal stops the
-run at the next sample with what was computed kept (see :mod:`fenicsfriction.cli.common`).
+run at the next sample with what was computed kept (see :mod:`fenicsfriction.signals`).
 """
 
 from __future__ import annotations
@@ -22,8 +22,10 @@ from mpi4py import MPI
 import numpy as np
 
 from fenicsfriction import laws, plotting, results
-from fenicsfriction.cli.common import CsvRows, Interrupted, StopSignals, omega_range, output_folder
+from fenicsfriction.cli.common import omega_range, output_folder
 from fenicsfriction.laws import check
+from fenicsfriction.results import CsvRows
+from fenicsfriction.signals import Interrupted, StopSignals
 
 __all__ = ["add_parsers", "run_oscillator", "run_stability_map"]
 
