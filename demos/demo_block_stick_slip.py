@@ -54,10 +54,10 @@
 # `FENICSFRICTION_DEMO_OUT` for the output folder.
 
 # %%
-import csv
 import logging
 import os
 import pathlib
+import sys
 
 from mpi4py import MPI
 
@@ -68,6 +68,8 @@ import fenicsfriction as ff
 from fenicsfriction.dynamics import DynamicsSolver
 from fenicsfriction.plotting import plot_stick_slip
 from fenicsfriction.reduced import ReducedDynamics, RigidBlock, rigid_block_observables
+from fenicsfriction.results import CsvRows
+from fenicsfriction.signals import Interrupted, StopSignals
 from fenicsfriction.stability import StabilitySolver
 from fenicsfriction.statistics import stick_slip_statistics
 
@@ -82,9 +84,41 @@ BELT_SPEEDS = [0.08, 0.287]  # [cm/s]
 PERTURBATION = -0.01  # [cm/s], normal velocity added to the steady state
 
 
+#: SIGINT/SIGTERM end a run at its next step (see "Stopping cleanly" below)
+stop = StopSignals(comm=MPI.COMM_SELF)
+interrupted: list[str] = []  # where this rank's runs stopped
+
+
 def belt_scene(belt_speed):
     """The data of Figs. 13-15 at one belt speed."""
     return ff.BlockOnBelt(mu=MU, belt_speed=belt_speed, b_n=0.381e10, eps=EPS)
+
+
+# %% [markdown]
+# ## Stopping cleanly
+# A run writes its time series row by row as it goes (`CsvRows`), and SIGINT/SIGTERM (Ctrl-C)
+# end it at its next step (`StopSignals`): the rows done stay on disk, the rank skips its
+# remaining runs, the summary says where each run stopped, and the demo exits with 130
+# (143 for SIGTERM) without its checks, which need complete runs.
+
+
+# %%
+def integrate(solver, records: list, **callbacks) -> None:
+    """``solver.run`` to T_END; a signal ends it at the next step with ``records`` kept."""
+    if interrupted:  # an earlier run of this rank was stopped: skip the rest
+        return
+    try:
+        solver.run(t_end=T_END, dt=DT, **callbacks)
+    except Interrupted as err:
+        interrupted.append(f"{err}")
+
+
+def statistics_of(records: list, mu: float, eps: float) -> ff.results.Record | None:
+    """The statistics over the second half of what was integrated (None: too little)."""
+    if len(records) < 3:
+        return None
+    t_from = records[-1]["time"] / 2 if interrupted else T_END / 2
+    return stick_slip_statistics(records, mu=mu, eps=eps, t_from=t_from)
 
 
 # %% [markdown]
@@ -96,7 +130,7 @@ def belt_scene(belt_speed):
 
 
 # %%
-def run(belt_speed: float, comm: MPI.Comm) -> tuple[list, ff.results.Record, dict]:
+def run(belt_speed: float, comm: MPI.Comm) -> tuple[list, ff.results.Record | None, dict]:
     scene = belt_scene(belt_speed)
     model = scene.build(comm=comm)
     model.initial_guess()
@@ -115,16 +149,19 @@ def run(belt_speed: float, comm: MPI.Comm) -> tuple[list, ff.results.Record, dic
     def on_step(record: dict) -> None:
         k = len(records)
         records.append(record)
+        table.write(record)
         if k % progress == 0:
             log(f"U = {belt_speed}: step {k:6d}  t = {record['time']:.4f} s  "
                 f"dt = {record['dt']:.1e}  Newton {record['newton_iterations']}  "
                 f"N = {record['normal_force']:.0f}  stick/slip/open {record['n_stick']}/"
                 f"{record['n_slip']}/{record['n_open']}  energy error "
                 f"{record['energy_error']:.2e}")
+        stop.check(f"U = {belt_speed} cm/s (finite elements), t = {record['time']:.4g} s")
 
     records: list[dict] = []
-    solver.run(t_end=T_END, dt=DT, observe=model.dynamics_observer(), on_step=on_step)
-    statistics = stick_slip_statistics(records, mu=MU, eps=EPS, t_from=T_END / 2)
+    with CsvRows(path=out / f"timeseries_FE_U{belt_speed}.csv", comm=comm) as table:
+        integrate(solver, records, observe=model.dynamics_observer(), on_step=on_step)
+    statistics = statistics_of(records, mu=MU, eps=EPS)
     about = {"belt_speed": belt_speed, "weight": scene.weight,
              "unstable_eigenvalue": [growth.real, growth.imag],
              "wall_time_s": sum(r["wall_time_s"] for r in records)}
@@ -139,14 +176,23 @@ def run(belt_speed: float, comm: MPI.Comm) -> tuple[list, ff.results.Record, dic
 
 
 # %%
-def run_rigid(block: RigidBlock, name: str) -> tuple[list, ff.results.Record, dict]:
+def run_rigid(block: RigidBlock, name: str, stem: str
+              ) -> tuple[list, ff.results.Record | None, dict]:
     q = block.steady_state()
     growth = max(block.eigenvalues(q), key=lambda lam: lam.real)
     solver = ReducedDynamics(model=block, q0=q, q_dot0=[0.0, PERTURBATION, 0.0],
                              prefix=f"rb_{name}_ts_")
-    records = solver.run(t_end=T_END, dt=DT, observe=lambda t: rigid_block_observables(
-        block, solver.q, solver.q_dot))
-    statistics = stick_slip_statistics(records, mu=block.mu, eps=block.eps, t_from=T_END / 2)
+    records: list[dict] = []
+
+    def on_step(record: dict) -> None:
+        records.append(record)
+        table.write(record)
+        stop.check(f"{name} (rigid), t = {record['time']:.4g} s")
+
+    with CsvRows(path=out / f"timeseries_{stem}.csv", comm=MPI.COMM_SELF) as table:
+        integrate(solver, records, observe=lambda t: rigid_block_observables(
+            block, solver.q, solver.q_dot), on_step=on_step)
+    statistics = statistics_of(records, mu=block.mu, eps=block.eps)
     about = {"belt_speed": block.belt_speed, "weight": block.weight,
              "unstable_eigenvalue": [growth.real, growth.imag],
              "wall_time_s": sum(r["wall_time_s"] for r in records)}
@@ -177,11 +223,17 @@ RIGID.update({f"Figs. 10-12: μ = 1, U = {U} cm/s": RigidBlock.with_modal_dampin
 # %%
 mine = BELT_SPEEDS[world.rank::world.size]
 comm = MPI.COMM_SELF if world.size > 1 else world
-results = {U: run(U, comm) for U in mine}
-names = list(RIGID)
-rigid = {name: run_rigid(RIGID[name], f"r{i}") for i, name in enumerate(names)
-         if i % world.size == world.rank}
-gathered = world.gather((results, rigid), root=0)
+if world.rank == 0:
+    out.mkdir(parents=True, exist_ok=True)
+world.Barrier()
+with stop:
+    results = {U: run(U, comm) for U in mine}
+    names = list(RIGID)
+    rigid = {name: run_rigid(RIGID[name], f"r{i}", f"rigid_{i}") for i, name in enumerate(names)
+             if i % world.size == world.rank}
+gathered = world.gather((results, rigid, interrupted), root=0)
+stopped = world.bcast([where for _, _, part in gathered for where in part]
+                      if world.rank == 0 else None, root=0)
 
 # %% [markdown]
 # ## What a friction experiment would measure
@@ -192,19 +244,15 @@ gathered = world.gather((results, rigid), root=0)
 
 # %%
 if world.rank == 0:
-    results = {U: r for part, _ in gathered for U, r in part.items()}
-    rigid = {name: r for _, part in gathered for name, r in part.items()}
-    out.mkdir(parents=True, exist_ok=True)
+    results = {U: r for part, _, _ in gathered for U, r in part.items()}
+    rigid = {name: r for _, part, _ in gathered for name, r in part.items()}
     # (kind, label, file stem, records, statistics, about the run, model mass, x-dashpot)
     entries = [("FE", f"U = {U} cm/s", f"FE_U{U}", *results[U], belt_scene(U).mass, 0.0)
-               for U in BELT_SPEEDS] + \
+               for U in BELT_SPEEDS if U in results] + \
         [("rigid", name, f"rigid_{i}", *rigid[name], RIGID[name].mass, RIGID[name].viscous[0])
-         for i, name in enumerate(names)]
-    for kind, label, stem, records, stats, about, _, _ in entries:
-        with open(out / f"timeseries_{stem}.csv", "w", newline="") as handle:
-            writer = csv.DictWriter(handle, fieldnames=list(records[0]))
-            writer.writeheader()
-            writer.writerows(records)
+         for i, name in enumerate(names) if name in rigid]
+    entries = [entry for entry in entries if entry[4] is not None]  # runs with statistics
+    for kind, label, _, _, stats, about, _, _ in entries:
         energy = "" if stats.max_energy_error is None else \
             f", energy error ≤ {stats.max_energy_error:.2e}"
         anywhere = "" if stats.any_stick_fraction is None else \
@@ -225,7 +273,10 @@ if world.rank == 0:
                for kind, label, _, _, stats, about, _, _ in entries]
     ff.results.write_json(out / "stick_slip.json", {"eps": EPS, "dt": DT, "t_end": T_END,
                                                     "perturbation": PERTURBATION,
-                                                    "runs": summary}, comm=MPI.COMM_SELF)
+                                                    "runs": summary,
+                                                    **({"interrupted": stopped} if stopped
+                                                       else {})}, comm=MPI.COMM_SELF)
+if world.rank == 0 and not stopped:
     plot_stick_slip(runs={f"U = {U} cm/s": results[U][0] for U in BELT_SPEEDS},
                     path=out / "stick_slip.png", mu=MU, eps=EPS)
     plot_stick_slip(runs={f"rigid, {name}": rigid[name][0]
@@ -235,6 +286,9 @@ if world.rank == 0:
                           for name in names[len(BELT_SPEEDS):]},
                     path=out / "stick_slip_rigid_figs10-12.png", mu=1.0, eps=EPS)
     say(f"wrote {out}/stick_slip.json, stick_slip*.png and the time series")
+if stopped:  # one line, the status a shell reports for the signal, no checks
+    say(f"{stopped[0]}; results so far in {out}/")
+    sys.exit(128 + stop.received if stop.received else 130)
 
 # %% [markdown]
 # ## Checks

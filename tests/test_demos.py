@@ -13,8 +13,16 @@ form of their claims (see each demo's "Checks"):
   e-foldings), no event at 62.0 and the growth of the nonlinear motion at 63.5.
 """
 
+import json
+import os
 import pathlib
 import runpy
+import signal
+import subprocess
+import sys
+import time
+
+from mpi4py import MPI
 
 import pytest
 
@@ -54,3 +62,28 @@ def test_demo_is_a_literate_notebook(path):
     assert "\n# %%\nimport " in text  # the imports open the first code cell
     assert text.count("\n# %% [markdown]\n") >= 3
     assert "assert " in text  # checks of its own
+
+
+@pytest.mark.skipif(MPI.COMM_WORLD.size > 1,
+                    reason="starts its own interpreter; runs in the serial pass")
+def test_interrupted_stick_slip_demo_keeps_its_rows_and_exits_130(tmp_path):
+    """Ctrl-C during the long demo: the rows of the run in progress stay on disk, the summary
+    says where it stopped, one closing line, status 130, no traceback."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_"))}
+    env.update(FENICSFRICTION_DEMO_OUT=str(tmp_path), FENICSFRICTION_DEMO_T_END="0.6")
+    table = tmp_path / "timeseries_FE_U0.08.csv"
+    process = subprocess.Popen([sys.executable, str(DEMOS[0].parent / "demo_block_stick_slip.py")],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    start = time.monotonic()
+    while (not table.exists() or len(table.read_text().splitlines()) < 20) \
+            and process.poll() is None:
+        assert time.monotonic() - start < 300, "no rows written"
+        time.sleep(0.2)
+    process.send_signal(signal.SIGINT)
+    _, err = process.communicate(timeout=120)
+    assert process.returncode == 130, err
+    assert "Traceback" not in err and "interrupted by SIGINT" in err.strip().splitlines()[-1]
+    rows = len(table.read_text().splitlines()) - 1
+    summary = json.loads((tmp_path / "stick_slip.json").read_text())
+    assert summary["interrupted"][0].startswith("interrupted by SIGINT")
+    assert summary["runs"][0]["steps"] == rows - 1
