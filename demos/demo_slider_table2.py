@@ -58,10 +58,10 @@
 # (default 300; the test suite runs 20) and `FENICSFRICTION_DEMO_OUT` for the output folder.
 
 # %%
-import csv
 import math
 import os
 import pathlib
+import sys
 import time
 
 from mpi4py import MPI
@@ -79,12 +79,16 @@ from fenicsfriction.reduced.slider import (
     stroboscopic_growth,
     table2_slider,
 )
+from fenicsfriction.results import CsvRows
+from fenicsfriction.signals import Interrupted, StopSignals
 from fenicsfriction.statistics import mode_intervals
 
 world = MPI.COMM_WORLD
 say = ff.results.get_logger(comm=world).info
 out = pathlib.Path(os.environ.get("FENICSFRICTION_DEMO_OUT", "results/slider"))
 T_END = float(os.environ.get("FENICSFRICTION_DEMO_T_END", "300"))
+#: SIGINT/SIGTERM end a time integration at its next sample (see section 4)
+stop = StopSignals(comm=MPI.COMM_SELF)
 OMEGAS = [30.16, 30.78, 62.0, 63.5]
 WINDOWS = {"Ω2 ± Ω1": np.linspace(29.5, 34.0, 46), "2 Ω2": np.linspace(60.0, 67.0, 36)}
 PERTURBATION = 0.01  # initial slider velocity added to steady sliding
@@ -145,7 +149,9 @@ def linearised(w: float) -> dict:
     period = 2 * math.pi / w
     start = time.perf_counter()
     run = integrate_hybrid(motion, motion.initial_state([PERTURBATION]), motion.slip_mode(),
-                           t_end, rtol=RTOL, atol=1e-2 * RTOL, sample_dt=period)
+                           t_end, rtol=RTOL, atol=1e-2 * RTOL, sample_dt=period,
+                           observe=lambda t, y, mode: stop.check(
+                               f"linearised ω_o = {w}, t = {t:.4g}") or {})
     seconds = time.perf_counter() - start
     try:
         t, d, measured = stroboscopic_growth(run.t, run.y, period=period, t_from=t_end / 2)
@@ -162,16 +168,31 @@ def linearised(w: float) -> dict:
 # PETSc TS.
 
 
+#
+# Each sample is written to the run's CSV as it is computed, on the rank that runs it; a
+# signal ends the run at its next sample with those rows kept (then the rank skips its other
+# runs, rank 0 writes what was done and the demo exits with 130, or 143 for SIGTERM).
+
+
 # %%
 def nonlinear(w: float) -> dict:
     """Eq. 59's μ(V) with true stick: the paper's Figs. 5-13."""
     slider = table2_slider(w)
     motion = SliderMotion(slider)
-    start = time.perf_counter()
-    run = integrate_hybrid(motion, motion.initial_state([PERTURBATION]), motion.slip_mode(),
-                           T_END, rtol=RTOL, atol=1e-2 * RTOL, sample_dt=min(0.05, T_END / 100))
-    seconds = time.perf_counter() - start
     n = motion.size // 2
+
+    def observe(t: float, y: np.ndarray, mode) -> dict:
+        table.write({"t": t, "y_s": y[0], "y_1": y[1], "v_1": y[n + 1],
+                     "stick": int(mode[0] == 0)})
+        stop.check(f"nonlinear ω_o = {w}, t = {t:.4g}")
+        return {}
+
+    start = time.perf_counter()
+    with CsvRows(path=out / f"timeseries_w{w}.csv", comm=MPI.COMM_SELF) as table:
+        run = integrate_hybrid(motion, motion.initial_state([PERTURBATION]), motion.slip_mode(),
+                               T_END, rtol=RTOL, atol=1e-2 * RTOL,
+                               sample_dt=min(0.05, T_END / 100), observe=observe)
+    seconds = time.perf_counter() - start
     stick = mode_intervals(run, holds=lambda mode: mode[0] == 0)
     tenth = T_END / 10
     first, last = run.t <= tenth, run.t >= T_END - tenth
@@ -185,8 +206,7 @@ def nonlinear(w: float) -> dict:
             "v1_range_start": [float(v1[start].min()), float(v1[start].max())],
             "v1_range_last_tenth": [float(v1[last].min()), float(v1[last].max())],
             "seconds": seconds, "steps": run.steps,
-            "_series": (run.t, run.y[:, 0], v1, run.y[:, 1], [int(m[0] == 0) for m in run.modes],
-                        stick)}
+            "_series": (run.t, run.y[:, 0], v1, stick)}
 
 
 # %% [markdown]
@@ -195,23 +215,36 @@ def nonlinear(w: float) -> dict:
 # %%
 tasks = [(linearised, w) for w in OMEGAS] + [(nonlinear, w) for w in OMEGAS]
 done = {}
-for i, (task, w) in enumerate(tasks):
-    if i % world.size == world.rank:
-        done[(task.__name__, w)] = task(w)
+interrupted: list[str] = []
+if world.rank == 0:
+    out.mkdir(parents=True, exist_ok=True)
+world.Barrier()
+with stop:
+    for i, (task, w) in enumerate(tasks):
+        if i % world.size != world.rank or interrupted:
+            continue
+        try:
+            done[(task.__name__, w)] = task(w)
+        except Interrupted as err:
+            interrupted.append(str(err))
+            continue
         r = done[(task.__name__, w)]
         ff.results.get_logger(comm=MPI.COMM_SELF).info(
             f"rank {world.rank}: {task.__name__} ω_o = {w}: {r['seconds']:.1f} s, "
             f"{r['steps']} steps")
-gathered = world.gather(done, root=0)
+gathered = world.gather((done, interrupted), root=0)
+stopped = world.bcast([where for _, part in gathered for where in part]
+                      if world.rank == 0 else None, root=0)
 
 # %% [markdown]
 # ## Results: JSON, CSV and figures
 
 # %%
 if world.rank == 0:
-    done = {key: r for part in gathered for key, r in part.items()}
-    out.mkdir(parents=True, exist_ok=True)
+    done = {key: r for part, _ in gathered for key, r in part.items()}
     for w in OMEGAS:
+        if ("linearised", w) not in done or ("nonlinear", w) not in done:
+            continue  # stopped by a signal
         lin, non = done[("linearised", w)], done[("nonlinear", w)]
         growth = "-" if lin["measured_growth"] is None else f"{lin['measured_growth']:+.5f}"
         print(f"ω_o = {w:5.2f}: Floquet growth {lin['floquet_growth']:+.5f}, linearised motion "
@@ -221,17 +254,13 @@ if world.rank == 0:
               f"{non['slider_amplitude_last_tenth']:.4f}, ẏ_1 in "
               f"[{non['v1_range_last_tenth'][0]:.1f}, {non['v1_range_last_tenth'][1]:.1f}] "
               f"(V_ref {non['surface_speed']:.1f}) at the end", flush=True)
-        t, ys, v1, y1, stuck, stick = non["_series"]
-        with open(out / f"timeseries_w{w}.csv", "w", newline="") as handle:
-            writer = csv.writer(handle)
-            writer.writerow(["t", "y_s", "y_1", "v_1", "stick"])
-            writer.writerows(zip(t, ys, y1, v1, stuck, strict=True))
+        t, ys, v1, stick = non["_series"]
         plot_oscillator(t, ys, v1, surface_speed=non["surface_speed"], stick=stick,
                         path=out / f"response_w{w}.png",
                         title=f"ω_o = {w}: {non['events']} stick/slip events",
                         names=("slider y_s", "velocity of mass 1, ẏ_1"))
     curves = {f"ω_o = {w}": done[("linearised", w)]["_curve"] for w in OMEGAS
-              if done[("linearised", w)]["_curve"][0] is not None}
+              if ("linearised", w) in done and done[("linearised", w)]["_curve"][0] is not None}
     if curves:
         plot_stroboscopic_growth(runs=curves, path=out / "linearised_growth.png")
     for name, m in maps.items():
@@ -243,9 +272,13 @@ if world.rank == 0:
         "reading": "paper", "natural_frequencies": omega, "bands": bands,
         "paper_bands": TABLE2_PAPER_BANDS, "forced_speed_over_surface_speed": forced,
         "runs": [{"model": kind, **{k: v for k, v in r.items() if not k.startswith("_")}}
-                 for (kind, _), r in sorted(done.items())], "t_end": T_END}, comm=MPI.COMM_SELF)
+                 for (kind, _), r in sorted(done.items())], "t_end": T_END,
+        **({"interrupted": stopped} if stopped else {})}, comm=MPI.COMM_SELF)
     say(f"wrote {out}/slider.json, response_w*.png, linearised_growth.png, stability_map_*.png "
         f"and the time series")
+if stopped:  # one line, the status a shell reports for the signal, no checks
+    say(f"{stopped[0]}; results so far in {out}/")
+    sys.exit(128 + stop.received if stop.received else 130)
 
 # %% [markdown]
 # ## Checks
