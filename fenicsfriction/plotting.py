@@ -14,8 +14,9 @@ from fenicsfriction import _compat
 
 PathLike = str | os.PathLike
 
-__all__ = ["cell_outlines", "plot_deformed", "plot_growth", "plot_loci", "plot_steady_forces",
-           "plot_stick_slip"]
+__all__ = ["cell_outlines", "plot_deformed", "plot_growth", "plot_loci", "plot_oscillator",
+           "plot_stability_map", "plot_steady_forces", "plot_stick_slip",
+           "plot_stroboscopic_growth"]
 
 
 def _pyplot() -> typing.Any:
@@ -183,11 +184,11 @@ def _last_cycle(t: np.ndarray, signal: np.ndarray) -> slice:
 
 
 def plot_stick_slip(runs: dict, path: PathLike, mu: float, eps: float) -> None:
-    """Seed 000 Figs. 10-15 for one or more runs (``{label: records}``, records from
-    ``BlockModel.dynamics_observer``): phase plane of the normal motion of the centre of mass,
-    tangential velocity of the probe node against the belt speed (last ~5 ms), spring
-    elongation against time, and the probe's normal and friction stress over the last cycle
-    of the normal oscillation (sticking marked)."""
+    """Martins & Oden (1986), Figs. 10-15, for one or more runs (``{label: records}``,
+    records from ``BlockModel.dynamics_observer``): phase plane of the normal motion of the
+    centre of mass, tangential velocity of the probe node against the belt speed (last ~5 ms),
+    spring elongation against time, and the probe's normal and friction stress over the last
+    cycle of the normal oscillation (sticking marked)."""
     plt = _pyplot()
     fig, axes = plt.subplots(2, 2, figsize=(12, 8.5))
     (phase, velocity), (spring, traction) = axes

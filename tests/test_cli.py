@@ -69,6 +69,9 @@ def test_stability_cli_writes_tracked_loci_and_both_onsets(out_dir):
     # flutter of the normal/rotational pair: FE and rigid onsets lie between the grid
     # points that bracket them (0.3 stable, 0.4 unstable for FE; 0.4 and 0.5 for rigid)
     assert 0.3 < data["mu_crit"]["fe"] < 0.4 and 0.4 < data["mu_crit"]["rigid"] < 0.5
+    # the block's elasticity softens the normal/rotation pair, so the FE block flutters before
+    # the rigid one, by a few hundredths of μ (0.370 against 0.404, docs/block-stability.md)
+    assert 0.02 < data["mu_crit"]["rigid"] - data["mu_crit"]["fe"] < 0.05
     onset = data["fe"]["onsets"][0]
     assert onset["interval"][1] - onset["interval"][0] <= 1e-3
     assert len({c["mode"] for c in onset["colliding"]}) == 2
@@ -186,26 +189,32 @@ def test_interrupted_dynamics_keeps_every_step_and_exits_130(tmp_path):
 
 @pytest.mark.skipif(MPI.COMM_WORLD.size > 1,
                     reason="starts its own interpreter; runs in the serial pass")
-def test_terminated_oscillator_keeps_its_samples_and_exits_143(tmp_path):
-    cmd = [sys.executable, "-m", "fenicsfriction", "oscillator", "mdof", "--t-end", "2000",
-           "--out", str(tmp_path)]
+@pytest.mark.parametrize("scene", [["mdof", "--t-end", "2000"], ["belt", "--t-end", "1e7"]])
+def test_terminated_oscillator_keeps_its_samples_and_exits_143(tmp_path, scene):
+    cmd = [sys.executable, "-m", "fenicsfriction", "oscillator", *scene, "--out", str(tmp_path)]
     result = _interrupt(cmd, tmp_path / "timeseries.csv", signal.SIGTERM, rows=50)
     assert result.returncode == 143, result.stderr
     assert "Traceback" not in result.stderr
-    assert "interrupted by SIGTERM" in result.stderr.strip().splitlines()[-1]
+    # progress lines, then one line saying where it stopped
+    stops = [line for line in result.stderr.splitlines() if "interrupted" in line]
+    assert len(stops) == 1 and stops[0] == result.stderr.strip().splitlines()[-1]
+    assert "interrupted by SIGTERM" in stops[0] and "t = " in stops[0]
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["samples"] == _rows(tmp_path / "timeseries.csv") >= 50
-    assert 0 < summary["t_end"] < 2000
+    assert 0 < summary["t_end"] < float(scene[-1])
 
 
 @pytest.mark.skipif(MPI.COMM_WORLD.size > 1,
                     reason="starts its own interpreter; runs in the serial pass")
 @pytest.mark.parametrize("command", [["steady", "block", "--mu-max", "0.5"],
+                                     ["dynamics", "block", "--mu", "0.5", "--t-end", "1e-3"],
                                      ["oscillator", "belt"]])
-def test_unwritable_output_folder_is_one_line_and_exit_2(tmp_path, command):
+@pytest.mark.parametrize("where", ["under a file", "/proc"])
+def test_unwritable_output_folder_is_one_line_and_exit_2(tmp_path, command, where):
     blocker = tmp_path / "a-file"
     blocker.write_text("")
-    cmd = [sys.executable, "-m", "fenicsfriction", *command, "--out", str(blocker / "out")]
+    out = blocker / "out" if where == "under a file" else pathlib.Path("/proc/ff-cli-test")
+    cmd = [sys.executable, "-m", "fenicsfriction", *command, "--out", str(out)]
     result = subprocess.run(cmd, capture_output=True, text=True, timeout=120, env=_environment())
     assert result.returncode == 2
     lines = [line for line in result.stderr.splitlines() if line.strip()]

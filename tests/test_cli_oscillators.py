@@ -43,6 +43,18 @@ def test_belt_cli_cycle_is_the_classic_closed_form(out_dir):
     assert summary["amplitude"] == pytest.approx(2 * radius, rel=1e-6)
     assert summary["period"] == pytest.approx(slip + stick, rel=1e-6)
     assert summary["events"] >= 10 and not summary["steady_sliding_stable"]
+    if MPI.COMM_WORLD.rank == 0:  # the table, row by row: stuck, the spring k x = x is held by
+        with open(out_dir / "timeseries.csv") as f:  # friction; slipping, F = μ_k N = 0.3
+            rows = [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
+        assert rows[-1]["t"] == pytest.approx(40.0) and len(rows) > 4000
+        stuck = [r for r in rows if r["stick"]]
+        assert stuck and len(stuck) < len(rows)
+        for r in stuck:
+            assert r["v"] == pytest.approx(v) and r["friction_force"] == pytest.approx(r["x"])
+            assert r["x"] <= 0.6 + 1e-9  # μ_s N / k: breakaway
+        for r in rows:
+            if not r["stick"]:
+                assert r["friction_force"] == pytest.approx(0.3, rel=1e-12)
 
 
 def test_mdof_oscillator_cli_writes_the_time_series(out_dir):

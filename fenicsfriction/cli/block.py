@@ -20,7 +20,7 @@ from mpi4py import MPI
 import numpy as np
 
 from fenicsfriction import io, plotting, results
-from fenicsfriction.cli.common import Parser, floats, output_folder
+from fenicsfriction.cli.common import Parser, floats, output_folder, stop_line
 from fenicsfriction.laws import check
 from fenicsfriction.results import CsvRows
 from fenicsfriction.scenes import SCENES
@@ -130,14 +130,13 @@ def _build(args: argparse.Namespace) -> tuple[BlockOnBelt, BlockModel, SteadySol
     return scene, model, solver, np.linspace(0.0, args.mu_max, args.steps + 1)
 
 
-def _stopped(log: logging.Logger, failure: str | None,
-             interrupted: Interrupted | None) -> int:
+def _stopped(failure: str | None, interrupted: Interrupted | None) -> int:
     """The one closing line of a run that did not finish, and its exit status."""
     if interrupted is not None:
-        log.error(f"fenicsfriction: {interrupted}; the results so far are written")
+        stop_line(f"{interrupted}; the results so far are written")
         return interrupted.exit_code
     if failure is not None:
-        log.error(f"fenicsfriction: {failure}")
+        stop_line(failure)
         return 1
     return 0
 
@@ -213,7 +212,7 @@ def run_steady(args: argparse.Namespace, log: logging.Logger) -> int:
     comm.Barrier()  # every file exists on return, whichever rank asks
     log.info(f"results in {out}/: steady.json, summary.json, steady.xdmf, deformed.png, forces.png"
              + (", epsilon.json" if eps_records else ""))
-    return _stopped(log, failure, interrupted)
+    return _stopped(failure, interrupted)
 
 
 def run_stability(args: argparse.Namespace, log: logging.Logger) -> int:
@@ -290,7 +289,7 @@ def run_stability(args: argparse.Namespace, log: logging.Logger) -> int:
              f"intervals by mode {fe['unstable_intervals']}; rigid "
              f"{rigid.unstable_intervals if rigid else None}")
     log.info(f"results in {out}/: stability.json, loci.png, growth.png, unstable_modes.xdmf")
-    return _stopped(log, failure, interrupted)
+    return _stopped(failure, interrupted)
 
 
 def run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
@@ -361,4 +360,4 @@ def run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
         "interrupted": None if interrupted is None else str(interrupted),
         "statistics": statistics}, comm)
     log.info(f"results in {out}/: timeseries.csv, summary.json, dynamics.xdmf, stick_slip.png")
-    return _stopped(log, failure, interrupted)
+    return _stopped(failure, interrupted)

@@ -8,11 +8,12 @@ from __future__ import annotations
 
 import argparse
 import pathlib
+import sys
 import typing
 
 from mpi4py import MPI
 
-__all__ = ["Parser", "floats", "omega_range", "output_folder"]
+__all__ = ["Parser", "floats", "omega_range", "output_folder", "stop_line"]
 
 
 class Parser(argparse.ArgumentParser):
@@ -59,3 +60,17 @@ def output_folder(path: pathlib.Path, comm: MPI.Comm = MPI.COMM_WORLD) -> pathli
     if problem is not None:
         raise ValueError(f"--out={str(path)!r} is invalid: {problem}")
     return path
+
+
+def stop_line(message: str, comm: MPI.Comm = MPI.COMM_WORLD) -> None:
+    """Print the one line that says where and why a run stopped, on rank 0's stderr.
+
+    Every rank reaches it together (a signal is agreed on over the ranks, a solver failure is
+    collective), and one rank says it, so the user sees one line whatever the rank count.
+
+    Args:
+        message: what to say, after ``fenicsfriction: ``.
+        comm: the run's communicator.
+    """
+    if comm.rank == 0:
+        print(f"fenicsfriction: {message}", file=sys.stderr, flush=True)

@@ -3,14 +3,14 @@ friction oscillators (the m.d.o.f. slider with oscillatory normal forces, "Frict
 sliding instability in a multi-degree-of-freedom system with oscillatory normal forces" (2003),
 and the 1-d.o.f. oscillator on a belt).
 
-The slider's time series is written row by row as the integration samples it; a signal stops the
-run at the next sample with what was computed kept (see :mod:`fenicsfriction.signals`).
+Both time series are written row by row as the integration samples them; a signal stops the run
+at the next sample, a failure of the integration where it failed, with what was computed kept
+(see :mod:`fenicsfriction.signals`).
 """
 
 from __future__ import annotations
 
 import argparse
-import csv
 import functools
 import logging
 import pathlib
@@ -22,7 +22,7 @@ from mpi4py import MPI
 import numpy as np
 
 from fenicsfriction import laws, plotting, results
-from fenicsfriction.cli.common import omega_range, output_folder
+from fenicsfriction.cli.common import omega_range, output_folder, stop_line
 from fenicsfriction.laws import check
 from fenicsfriction.results import CsvRows
 from fenicsfriction.signals import Interrupted, StopSignals
@@ -52,7 +52,8 @@ def add_parsers(commands: typing.Any) -> None:
         "oscillator", help="stick-slip time response of a friction oscillator",
         description="Integrates the m.d.o.f. slider (mdof) or the 1-d.o.f. oscillator on a "
                     "belt (belt) with stick and slip switched at events located by PETSc TS "
-                    "(or a regularised law with --eps); TS options as -hybrid_<option>.")
+                    "(or a regularised law with --eps); TS options as -hybrid_<option> (mdof) or "
+                    "-belt_<option> (belt).")
     osc.add_argument("scene", choices=["mdof", "belt"], help="scene to run")
     osc.add_argument("--t-end", type=float, default=100.0, help="final (dimensionless) time")
     osc.add_argument("--eps", type=float, help="regularised law of this width (no events)")
@@ -115,9 +116,20 @@ def run_stability_map(args: argparse.Namespace, log: logging.Logger) -> int:
     return 0
 
 
-def _belt(args: argparse.Namespace, observe: typing.Callable) -> tuple[dict, dict, tuple]:
-    """The belt oscillator's run: (summary, columns, what to plot)."""
+def _belt(args: argparse.Namespace, table: CsvRows,
+          progress: typing.Callable[[float, typing.Any], None]) -> tuple[dict, tuple]:
+    """The belt oscillator's run, its table written one sample at a time.
+
+    Args:
+        args: the parsed flags.
+        table: receives the row (t, x, v, friction_force, stick) of every sample.
+        progress: called with (t, mode) after each sample (reports, stops on a signal).
+
+    Returns:
+        (summary, what to plot).
+    """
     from fenicsfriction.reduced import BeltOscillator
+    from fenicsfriction.reduced.belt import STICK
     from fenicsfriction.statistics import belt_summary
 
     law: dict[str, typing.Callable[[], laws.FrictionCoefficient]] = {
@@ -127,6 +139,20 @@ def _belt(args: argparse.Namespace, observe: typing.Callable) -> tuple[dict, dic
     oscillator = BeltOscillator(args.m, args.k, args.c, args.N, args.v_belt,
                                 law[args.law](), mu_static=args.mu_s)
     method = "events" if args.eps is None else "regularised"
+
+    def friction(y: np.ndarray, mode: typing.Any) -> float:
+        """The friction force of the sample, as :meth:`BeltOscillator.simulate` reports it."""
+        if method == "regularised":
+            return float(oscillator.regularised_force(np.array([args.v_belt - y[1]]),
+                                                      args.eps)[0])
+        return oscillator.friction_force(y, mode)
+
+    def observe(t: float, y: np.ndarray, mode: typing.Any) -> dict:
+        table.write({"t": t, "x": y[0], "v": y[1], "friction_force": friction(y, mode),
+                     "stick": int(mode == STICK)})
+        progress(t, mode)
+        return {}
+
     run = oscillator.simulate(args.t_end, x0=args.x0,
                               v0=args.v_belt if args.v0 is None else args.v0, method=method,
                               eps=args.eps, rtol=args.rtol, atol=1e-2 * args.rtol,
@@ -139,17 +165,79 @@ def _belt(args: argparse.Namespace, observe: typing.Callable) -> tuple[dict, dic
                                       for s in oscillator.linear_eigenvalues()]}
     if args.law == "constant" and args.c == 0 and args.mu_s > args.mu_k:
         summary["classic_cycle"] = oscillator.classic_limit_cycle().to_json()
-    columns = {"t": run.t, "x": run.x, "v": run.v, "friction_force": run.friction_force,
-               "stick": [int(m == "stick") for m in run.modes]}
     plot = (run.t, run.x, run.v, args.v_belt, run.stick_intervals, ("x", "ẋ"))
-    return summary, columns, plot
+    return summary, plot
 
 
-def run_oscillator(args: argparse.Namespace, log: logging.Logger) -> int:
-    """Stick-slip time response of the slider or the belt oscillator: CSV, JSON and a figure."""
+def _slider(args: argparse.Namespace, table: CsvRows,
+            progress: typing.Callable[[float, typing.Any], None]) -> tuple[dict, tuple,
+                                                                            str | None]:
+    """The m.d.o.f. slider's run, its table written one sample at a time.
+
+    Args:
+        args: the parsed flags.
+        table: receives the row (t, y_s, y_1, x_1, v_s, v_1, normal_force, friction_force,
+            stick) of every sample.
+        progress: called with (t, mode) after each sample (reports, stops on a signal).
+
+    Returns:
+        (summary, what to plot, the failure of the integration or None). A run the
+        integration could not finish is summarised up to where it stopped.
+    """
     from fenicsfriction.reduced.events import HybridError, integrate_hybrid
     from fenicsfriction.reduced.slider import SliderMotion, table2_slider
     from fenicsfriction.statistics import mode_intervals
+
+    slider = table2_slider(args.omega, reading=args.reading)
+    motion = SliderMotion(slider, normal_force=args.normal_force, coupled=args.coupled,
+                          eps=args.eps)
+    n = motion.size // 2
+
+    def observe(t: float, y: np.ndarray, mode: typing.Any) -> dict:
+        normal, force = motion.contact_forces(t, y, mode)
+        table.write({"t": t, "y_s": y[0], "y_1": y[1], "x_1": y[2], "v_s": y[n],
+                     "v_1": y[n + 1], "normal_force": normal[0], "friction_force": force[0],
+                     "stick": int(mode[0] == 0)})
+        progress(t, mode)
+        return {}
+
+    failure = None
+    try:
+        run = integrate_hybrid(motion, motion.initial_state([args.perturbation]),
+                               motion.slip_mode(), args.t_end, rtol=args.rtol,
+                               atol=1e-2 * args.rtol, sample_dt=args.sample_dt,
+                               observe=observe)
+    except HybridError as error:
+        failure = f"integration stopped at t = {error.t:.6g}: {error}"
+        run = error.result
+    t, y = run.t, run.y
+    stick = mode_intervals(run, lambda mode: mode[0] == 0)
+    omega, _ = slider.natural_frequencies()
+    late = t >= t[-1] / 2
+    summary = {"omega": args.omega, "reading": args.reading, "natural_frequencies": omega,
+               "surface_speed": slider.contacts[0].surface_speed,
+               "averaged_growth": slider.averaged().growth,
+               "floquet_growth": slider.floquet().growth, "events": len(run.events),
+               "stick_fraction": sum(b - a for a, b in stick) / t[-1],
+               "slider_amplitude_first_half": float(np.ptp(y[~late, 0])) / 2,
+               "slider_amplitude_second_half": float(np.ptp(y[late, 0])) / 2,
+               "steps": run.steps, "t_end": float(t[-1])}
+    if failure is not None:
+        summary["failure"] = failure
+    plot = (t, y[:, 0], y[:, n + 1], slider.contacts[0].surface_speed, stick,
+            ("slider y_s", "velocity of mass 1, ẏ_1"))
+    return summary, plot, failure
+
+
+def run_oscillator(args: argparse.Namespace, log: logging.Logger) -> int:
+    """Stick-slip time response of the slider or the belt oscillator: CSV, JSON and a figure.
+
+    ``timeseries.csv`` gets one row per sample as the integration produces it (rank 0 writes;
+    every rank integrates the same small system). A signal stops the run at the next sample
+    (status 130/143) and a failure of the integration where it failed (status 1); either way
+    ``summary.json`` says where and why, the rows stay on disk and one line is printed.
+    """
+    from fenicsfriction.timestepping import DynamicsError
 
     check("--t-end", args.t_end, args.t_end > 0, "must be > 0")
     check("--sample-dt", args.sample_dt, 0 < args.sample_dt <= args.t_end,
@@ -161,6 +249,12 @@ def run_oscillator(args: argparse.Namespace, log: logging.Logger) -> int:
     samples = [0.0, 0]  # last sampled time, count
     start = time.perf_counter()
 
+    def stopped(key: str, why: Exception) -> dict:
+        """The summary of a run that ended early: what was sampled, and why it ended."""
+        return {key: str(why), "t_end": samples[0], "samples": samples[1],
+                "wall_seconds": time.perf_counter() - start}
+
+    failure = None
     with StopSignals(comm) as stop, CsvRows(out / "timeseries.csv", comm) as table:
         def progress(t: float, mode: typing.Any) -> None:
             samples[:] = t, samples[1] + 1
@@ -171,61 +265,18 @@ def run_oscillator(args: argparse.Namespace, log: logging.Logger) -> int:
 
         try:
             if args.scene == "belt":
-                def observe_belt(t: float, y: np.ndarray, mode: typing.Any) -> dict:
-                    progress(t, mode)
-                    return {}
-
-                summary, columns, plot = _belt(args, observe_belt)
+                summary, plot = _belt(args, table, progress)
             else:
-                slider = table2_slider(args.omega, reading=args.reading)
-                motion = SliderMotion(slider, normal_force=args.normal_force,
-                                      coupled=args.coupled, eps=args.eps)
-                n = motion.size // 2
-
-                def observe(t: float, y: np.ndarray, mode: typing.Any) -> dict:
-                    normal, force = motion.contact_forces(t, y, mode)
-                    table.write({"t": t, "y_s": y[0], "y_1": y[1], "x_1": y[2], "v_s": y[n],
-                                 "v_1": y[n + 1], "normal_force": normal[0],
-                                 "friction_force": force[0], "stick": int(mode[0] == 0)})
-                    progress(t, mode)
-                    return {}
-
-                try:
-                    run = integrate_hybrid(motion, motion.initial_state([args.perturbation]),
-                                           motion.slip_mode(), args.t_end, rtol=args.rtol,
-                                           atol=1e-2 * args.rtol, sample_dt=args.sample_dt,
-                                           observe=observe)
-                except HybridError as error:
-                    log.info(f"stopped: {error}")
-                    run = error.result
-                t, y = run.t, run.y
-                stick = mode_intervals(run, lambda mode: mode[0] == 0)
-                omega, _ = slider.natural_frequencies()
-                late = t >= t[-1] / 2
-                summary = {"omega": args.omega, "reading": args.reading,
-                           "natural_frequencies": omega,
-                           "surface_speed": slider.contacts[0].surface_speed,
-                           "averaged_growth": slider.averaged().growth,
-                           "floquet_growth": slider.floquet().growth,
-                           "events": len(run.events),
-                           "stick_fraction": sum(b - a for a, b in stick) / t[-1],
-                           "slider_amplitude_first_half": float(np.ptp(y[~late, 0])) / 2,
-                           "slider_amplitude_second_half": float(np.ptp(y[late, 0])) / 2,
-                           "steps": run.steps, "t_end": float(t[-1])}
-                columns = {}
-                plot = (t, y[:, 0], y[:, n + 1], slider.contacts[0].surface_speed, stick,
-                        ("slider y_s", "velocity of mass 1, ẏ_1"))
+                summary, plot, failure = _slider(args, table, progress)
         except Interrupted as err:
-            summary = {"interrupted": str(err), "t_end": samples[0], "samples": samples[1],
-                       "wall_seconds": time.perf_counter() - start}
-            results.write_json(out / "summary.json", summary)
-            log.error(f"fenicsfriction: {err}; the results so far are written")
+            results.write_json(out / "summary.json", stopped("interrupted", err))
+            stop_line(f"{err}; the results so far are written")
             return err.exit_code
-        if columns and comm.rank == 0:  # the belt's table, from the finished run
-            with open(out / "timeseries.csv", "w", newline="") as f:
-                writer = csv.writer(f)
-                writer.writerow(columns)
-                writer.writerows(zip(*columns.values(), strict=True))
+        except DynamicsError as err:  # the belt's integration failed: no cycle to summarise
+            results.write_json(out / "summary.json", stopped("failure", err))
+            stop_line(f"integration stopped after t = {samples[0]:.6g}: {err}; the results "
+                      "so far are written")
+            return 1
     summary["wall_seconds"] = time.perf_counter() - start
     log.info(f"{summary['events']} events, stick fraction {summary['stick_fraction']:.3f}, "
              f"{summary['wall_seconds']:.1f} s")
@@ -236,4 +287,7 @@ def run_oscillator(args: argparse.Namespace, log: logging.Logger) -> int:
                                  title=f"{args.scene}: {summary['events']} stick/slip events",
                                  names=names)
     comm.Barrier()
+    if failure is not None:
+        stop_line(f"{failure}; the results so far are written")
+        return 1
     return 0
