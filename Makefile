@@ -9,7 +9,7 @@ OUT ?= results
 APT_PACKAGES := python3-dolfinx python3-petsc4py python3-slepc4py python3-mpi4py python3-ufl \
     python3-basix python3-ffcx python3-numpy python3-scipy python3-matplotlib python3-pytest \
     python3-pytest-mpi python3-pytest-timeout python3-venv python3-pip python3-setuptools \
-    python3-wheel python3-dev openmpi-bin build-essential pkg-config
+    python3-wheel python3-dev openmpi-bin build-essential pkg-config libopenblas0-serial
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 MPIRUN := mpirun -n $(NP) $(shell [ "$$(id -u)" = 0 ] && echo --allow-run-as-root) --oversubscribe
 export OMPI_MCA_rmaps_base_oversubscribe := 1

@@ -270,7 +270,7 @@ def main(argv=None) -> None:
               f"U = {BELT_SPEED} cm/s, ε = {EPS}; central differences: stable step "
               f"{central.stable_dt:.3g} s (elastic {central.stable_dt_elastic:.3g} s); "
               f"total {total:.0f} s\n\n{table(runs, reference)}", flush=True)
-    ff.results.write_json(args.out / "bench_dynamics.json",
+    ff.results.write_summary(args.out / "bench_dynamics.json",
                      {"mu": MU, "belt_speed": BELT_SPEED, "b_n": B_N, "eps": EPS,
                       "perturbation": PERTURBATION, "t_end": args.t_end, "sample_s": sample,
                       "default_dt": DEFAULT_DT, "total_time_s": total,

@@ -21,7 +21,6 @@ markdown tables. Serial (the systems have 2 to 6 unknowns).
 
 from __future__ import annotations
 
-import json
 import pathlib
 import time
 
@@ -32,6 +31,7 @@ from _common import save
 from fenicsfriction import laws
 from fenicsfriction.reduced import BeltOscillator
 from fenicsfriction.reduced.slider import stability_map, table2_slider
+from fenicsfriction.results import write_summary
 from fenicsfriction.statistics import limit_cycle
 
 BANDS = [(29.0, 34.0), (60.0, 67.0)]
@@ -118,7 +118,7 @@ def main() -> None:
     out: dict = {}
     _stability(out)
     _belt(out)
-    (args.out / "bench_oscillators.json").write_text(json.dumps(out, indent=1) + "\n")
+    write_summary(args.out / "bench_oscillators.json", out)
     _plot(out, args.out / "bench_oscillators.png")
     print("| range | method | ms per ω_o | unstable bands | max edge error |")
     print("|---|---|---|---|---|")

@@ -471,7 +471,7 @@ def main(argv=None) -> None:
               f"variant and ≥ 1e4 dofs (or all with every variant): "
               + ", ".join(f"{k} {v:.2f}" for k, v in means.items()) + f"; best: {best}",
               flush=True)
-    ff.results.write_json(args.out / "bench_stability.json",
+    ff.results.write_summary(args.out / "bench_stability.json",
                      {"ranks": comm.size, "mu": MU, "max_modulus": MAX_MODULUS, "shift": SHIFT,
                       "repeats": REPEATS, "time_budget_s": TIME_BUDGET,
                       "variants": {k: {"options": o, "solve": s}

@@ -301,7 +301,7 @@ def main(argv=None) -> None:
     for run in runs:  # the sampled profiles are long and exist on rank 0 only
         for sample in run["samples"].values():
             sample.pop("penetration")
-    ff.results.write_json(args.out / "bench_steady.json",
+    ff.results.write_summary(args.out / "bench_steady.json",
                      {"ranks": comm.size, "mu_steps": MU_STEPS.tolist(), "mu_samples": MU_SAMPLES,
                       "base_points": NUM_BASE_POINTS, "corner_margin": CORNER_MARGIN,
                       "continuation_repeats": CONTINUATION_REPEATS, "bare_repeats": BARE_REPEATS,

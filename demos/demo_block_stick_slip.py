@@ -271,7 +271,7 @@ if world.rank == 0:
               flush=True)
     summary = [{"model": kind, "label": label, **stats.to_json(), **about}
                for kind, label, _, _, stats, about, _, _ in entries]
-    ff.results.write_json(out / "stick_slip.json", {"eps": EPS, "dt": DT, "t_end": T_END,
+    ff.results.write_summary(out / "stick_slip.json", {"eps": EPS, "dt": DT, "t_end": T_END,
                                                     "perturbation": PERTURBATION,
                                                     "runs": summary,
                                                     **({"interrupted": stopped} if stopped

@@ -268,7 +268,7 @@ if world.rank == 0:
         plot_stability_map(m.omega, growth=m.growth, bands=m.bands,
                            path=out / f"stability_map_{stem}.png",
                            reference_bands=TABLE2_PAPER_BANDS)
-    ff.results.write_json(out / "slider.json", {
+    ff.results.write_summary(out / "slider.json", {
         "reading": "paper", "natural_frequencies": omega, "bands": bands,
         "paper_bands": TABLE2_PAPER_BANDS, "forced_speed_over_surface_speed": forced,
         "runs": [{"model": kind, **{k: v for k, v in r.items() if not k.startswith("_")}}

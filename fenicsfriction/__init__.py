@@ -11,9 +11,10 @@ use, so ``import fenicsfriction.reduced`` (the models without a mesh) does not i
 
 from __future__ import annotations
 
-import importlib
 import typing
 from importlib import metadata as _metadata
+
+from fenicsfriction._lazy import attach
 
 try:
     __version__ = _metadata.version("fenicsfriction")
@@ -59,22 +60,8 @@ _EXPORTS: dict[str, str] = {
 _SUBMODULES = ("dynamics", "forms", "io", "laws", "numerics", "plotting", "reduced", "results",
                "scenes", "signals", "stability", "statistics", "steady", "timestepping")
 
-__all__ = sorted([*_EXPORTS, *_SUBMODULES, "__version__"])
-
-
-def __getattr__(name: str) -> typing.Any:
-    if name in _SUBMODULES:
-        return importlib.import_module(f"{__name__}.{name}")
-    module = _EXPORTS.get(name)
-    if module is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(f"{__name__}.{module}"), name)
-    globals()[name] = value  # later look-ups skip __getattr__
-    return value
-
-
-def __dir__() -> list[str]:
-    return __all__
+__getattr__, __dir__, __all__ = attach(__name__, _EXPORTS, _SUBMODULES)
+__all__.append("__version__")  # the same list __dir__ returns
 
 
 if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers and IDEs

@@ -11,14 +11,18 @@ import csv
 import dataclasses
 import json
 import logging
+import os
 import pathlib
+import platform
+import re
 import typing
 
 from mpi4py import MPI
 
 import numpy as np
 
-__all__ = ["CsvRows", "Record", "get_logger", "to_plain", "write_json"]
+__all__ = ["CsvRows", "Record", "blas_library", "environment", "get_logger", "to_plain",
+           "write_json", "write_summary"]
 
 
 def to_plain(value: typing.Any) -> typing.Any:
@@ -73,6 +77,58 @@ def write_json(path: str | pathlib.Path, data: typing.Any,
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(json.dumps(to_plain(data), indent=1) + "\n")
     comm.Barrier()
+
+
+_BLAS_PATTERN = re.compile(r"lib(openblas|blas|mkl_rt|mkl_core|blis|flexiblas|atlas)[^/]*\.so")
+
+
+def blas_library() -> dict[str, typing.Any]:
+    """The BLAS this process runs on, read from the shared objects it has mapped (Linux).
+
+    ``name`` is ``"OpenBLAS"``, ``"reference"`` (Netlib's unoptimised BLAS, which makes
+    MUMPS and dense eigensolvers 2-3x slower), ``"MKL"``, ``"BLIS"``, ... or ``"unknown"``;
+    ``paths`` are the mapped libraries (symbolic links resolved by the kernel), so a slow
+    machine can be diagnosed from any run's summary. On Debian, ``libopenblas0-serial``
+    switches the ``libblas.so.3`` alternative to OpenBLAS by itself.
+    """
+    try:
+        with open("/proc/self/maps") as maps:
+            paths = sorted({line.split()[-1] for line in maps
+                            if _BLAS_PATTERN.search(line.rsplit("/", 1)[-1])})
+    except OSError:
+        return {"name": "unknown", "optimized": None, "paths": []}
+    joined = " ".join(paths).lower()
+    for key, name in (("openblas", "OpenBLAS"), ("mkl", "MKL"), ("blis", "BLIS"),
+                      ("flexiblas", "FlexiBLAS"), ("atlas", "ATLAS")):
+        if key in joined:
+            return {"name": name, "optimized": True, "paths": paths}
+    if paths:
+        return {"name": "reference", "optimized": False, "paths": paths}
+    return {"name": "unknown", "optimized": None, "paths": paths}
+
+
+def environment(comm: MPI.Comm = MPI.COMM_WORLD) -> dict[str, typing.Any]:
+    """What a run ran on: ranks, BLAS, and the versions of Python, NumPy, PETSc, SLEPc and
+    dolfinx (those already imported; nothing is imported here to find out)."""
+    import sys
+
+    versions: dict[str, str] = {"python": platform.python_version(), "numpy": np.__version__}
+    if "petsc4py" in sys.modules:
+        from petsc4py import PETSc
+        versions["petsc"] = ".".join(map(str, PETSc.Sys.getVersion()))
+    if "slepc4py" in sys.modules:
+        from slepc4py import SLEPc
+        versions["slepc"] = ".".join(map(str, SLEPc.Sys.getVersion()))
+    if "dolfinx" in sys.modules:
+        versions["dolfinx"] = sys.modules["dolfinx"].__version__
+    return {"ranks": comm.size, "blas": blas_library(), "versions": versions,
+            "machine": platform.machine(), "cpus": os.cpu_count()}
+
+
+def write_summary(path: str | pathlib.Path, data: dict[str, typing.Any],
+                  comm: MPI.Comm = MPI.COMM_WORLD) -> None:
+    """:func:`write_json` of a run's summary, with the :func:`environment` it ran in added."""
+    write_json(path, {**data, "environment": environment(comm)}, comm)
 
 
 class CsvRows:

@@ -52,6 +52,11 @@ def test_steady_cli_writes_one_balanced_record_per_step(out_dir):
     assert np.allclose([r["mu"] for r in records], np.linspace(0, 0.9, 7))
     summary = json.loads((out_dir / "summary.json").read_text())
     assert summary["failure"] is None and summary["tipping_limit"] == pytest.approx(1.6)
+    # the BLAS the run used is recorded, read from the libraries the process mapped
+    environment = summary["environment"]
+    assert environment["ranks"] == MPI.COMM_WORLD.size
+    assert environment["blas"]["paths"] and environment["blas"]["name"] != "unknown"
+    assert environment["versions"]["petsc"].startswith(("3.", "4."))
     for name in ("steady.xdmf", "steady.h5", "deformed.png", "forces.png"):
         assert (out_dir / name).stat().st_size > 0, name
 
@@ -219,3 +224,17 @@ def test_unwritable_output_folder_is_one_line_and_exit_2(tmp_path, command, wher
     assert result.returncode == 2
     lines = [line for line in result.stderr.splitlines() if line.strip()]
     assert len(lines) == 1 and "--out=" in lines[0] and "Traceback" not in result.stderr
+
+
+@pytest.mark.parametrize("argv", [["--help"], ["steady", "block", "--mu-max", "x", "--out", "o"],
+                                  ["stability", "--help"], ["oscillator", "belt"]])
+def test_help_and_flag_errors_import_no_solver(argv):
+    """``--help`` and a flag error are answered by argparse alone: neither MPI, PETSc nor
+    dolfinx is imported (each costs tenths of a second), so they return at once."""
+    script = ("import sys\nfrom fenicsfriction.cli import main\ntry:\n"
+              f"    main({argv!r})\nexcept SystemExit as stop:\n    code = stop.code\n"
+              "print([m for m in ('dolfinx', 'mpi4py.MPI', 'petsc4py.PETSc', 'scipy') "
+              "if m in sys.modules], code)")
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          timeout=60)
+    assert done.stdout.splitlines()[-1] == f"[] {0 if '--help' in argv else 2}", done.stderr

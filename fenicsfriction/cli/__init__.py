@@ -3,34 +3,38 @@
 One module per family of commands: :mod:`~fenicsfriction.cli.block` (the finite element block:
 ``steady``, ``stability``, ``dynamics``) and :mod:`~fenicsfriction.cli.oscillators` (the reduced
 oscillators: ``stability-map``, ``oscillator``); :mod:`~fenicsfriction.cli.common` holds what they
-share. User errors (a bad flag or parameter value, an unwritable ``--out``) print one line and
-exit with status 2; a solver failure writes what converged, prints one line and exits with
+share. The flags are in :mod:`~fenicsfriction.cli.arguments`, which imports nothing heavy: the
+command's module (MPI, PETSc, dolfinx) is imported after the flags parse, so ``--help`` and a
+flag error answer at once.
+
+User errors (a bad flag or parameter value, an unwritable ``--out``) print one line and exit
+with status 2; a solver failure writes what converged, prints one line and exits with
 status 1; SIGINT/SIGTERM stop the run at the next step with everything computed so far written,
 one line, and status 130/143.
 """
 
 from __future__ import annotations
 
+import importlib
 import logging
 import sys
 
-from mpi4py import MPI
-
-from fenicsfriction.cli import block, oscillators
-from fenicsfriction.cli.common import Parser
+from fenicsfriction.cli.arguments import Parser, add_block_parsers, add_oscillator_parsers
 
 __all__ = ["main"]
 
-COMMANDS = {"steady": block.run_steady, "stability": block.run_stability,
-            "dynamics": block.run_dynamics, "stability-map": oscillators.run_stability_map,
-            "oscillator": oscillators.run_oscillator}
+# command -> (module of fenicsfriction.cli, function), imported once the flags have parsed
+COMMANDS = {"steady": ("block", "run_steady"), "stability": ("block", "run_stability"),
+            "dynamics": ("block", "run_dynamics"),
+            "stability-map": ("oscillators", "run_stability_map"),
+            "oscillator": ("oscillators", "run_oscillator")}
 
 
 def _parser() -> Parser:
     parser = Parser(prog="fenicsfriction", description=__doc__.splitlines()[0])
     commands = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
-    block.add_parsers(commands)
-    oscillators.add_parsers(commands)
+    add_block_parsers(commands)
+    add_oscillator_parsers(commands)
     return parser
 
 
@@ -47,10 +51,19 @@ def main(argv: list[str] | None = None) -> int:
     logging.getLogger("ffcx").setLevel(logging.WARNING)
     logging.getLogger("UFL").setLevel(logging.WARNING)
     logging.getLogger().setLevel(logging.WARNING)
-    from fenicsfriction.results import get_logger
+    from mpi4py import MPI
+
+    from fenicsfriction.results import blas_library, get_logger
     log = get_logger(MPI.COMM_WORLD)
+    blas = blas_library()
+    if blas["optimized"] is False:
+        log.warning("fenicsfriction: the reference BLAS is in use (%s): direct solvers and "
+                    "eigensolvers run 2-3x slower; install an optimized one (Debian: "
+                    "libopenblas0-serial)", ", ".join(blas["paths"]))
+    module, function = COMMANDS[args.command]
+    run = getattr(importlib.import_module(f"fenicsfriction.cli.{module}"), function)
     try:
-        return COMMANDS[args.command](args, log)
+        return run(args, log)
     except ValueError as err:
         if MPI.COMM_WORLD.rank == 0:
             print(f"fenicsfriction: error: {err}", file=sys.stderr)

@@ -20,7 +20,7 @@ from mpi4py import MPI
 import numpy as np
 
 from fenicsfriction import io, plotting, results
-from fenicsfriction.cli.common import Parser, floats, output_folder, stop_line
+from fenicsfriction.cli.common import output_folder, stop_line
 from fenicsfriction.laws import check
 from fenicsfriction.results import CsvRows
 from fenicsfriction.scenes import SCENES
@@ -30,81 +30,7 @@ if typing.TYPE_CHECKING:
     from fenicsfriction.scenes.block import BlockModel, BlockOnBelt
     from fenicsfriction.steady import SteadySolver
 
-__all__ = ["add_parsers", "run_dynamics", "run_stability", "run_steady"]
-
-
-def _scene_flags() -> argparse.ArgumentParser:
-    """Flags shared by the commands that follow the steady state in μ (None: scene default)."""
-    flags = Parser(add_help=False)
-    flags.add_argument("scene", choices=["block"], help="scene to run")
-    flags.add_argument("--mu-max", type=float, required=True, help="last friction coefficient")
-    flags.add_argument("--steps", type=int, default=30, help="continuation increments (NINCT)")
-    flags.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
-    flags.add_argument("--refine", type=int, default=1, help="mesh refinement (4r × 3r cells)")
-    flags.add_argument("--degree", type=int, default=2, help="Lagrange degree (2: Q2)")
-    flags.add_argument("--E", type=float, help="Young's modulus [10³ kg cm⁻¹ s⁻²] (1.4e6)")
-    flags.add_argument("--B0", type=float, help="breadth out of the plane [cm] (30.5)")
-    flags.add_argument("--K-x", type=float, dest="K_x", help="driver spring [10³ kg s⁻²] (11.1)")
-    flags.add_argument("--spring-height", type=float, help="spring height [cm] (H/2)")
-    flags.add_argument("--belt-speed", type=float, help="belt speed [cm/s] (0.287)")
-    flags.add_argument("--belt-direction", type=int, help="+1 or -1 (+1)")
-    flags.add_argument("--eps", type=float, help="regularisation ε [cm/s] (1e-3)")
-    flags.add_argument("--regularisation", help="c1 or smooth (c1)")
-    flags.add_argument("--contact-quadrature", help="gauss or gll (gauss)")
-    flags.add_argument("--max-halvings", type=int, default=8,
-                       help="step halvings allowed when a continuation step fails")
-    return flags
-
-
-def add_parsers(commands: typing.Any) -> None:
-    """``steady``, ``stability`` and ``dynamics``, each for the scene ``block``."""
-    scene = _scene_flags()
-    steady = commands.add_parser(
-        "steady", parents=[scene], help="steady sliding with continuation in μ (Problem 2)",
-        description="Steady sliding solved by Newton (PETSc SNES) at each μ from 0 to --mu-max; "
-                    "PETSc options can be given as -steady_<option> after the flags.")
-    steady.add_argument("--eps-sequence", type=floats, metavar="E1,E2,...",
-                        help="after the continuation, Kalker's sequential ε process at μ-max")
-    steady.add_argument("--snapshots", type=int, default=4, help="deformed shapes to draw")
-    stability = commands.add_parser(
-        "stability", parents=[scene], help="eigenvalue loci and flutter onset (Problem 3)",
-        description="Quadratic eigenvalues of the linearised steady sliding (SLEPc PEP) at each "
-                    "μ from 0 to --mu-max, FE and rigid model side by side; PETSc/SLEPc options "
-                    "as -stability_<option> after the flags.")
-    stability.add_argument("--max-frequency", type=float, default=3e4,
-                           help="every eigenvalue with |λ| below this [rad/s] is computed")
-    stability.add_argument("--onset-tol", type=float, default=1e-4,
-                           help="width of the μ interval the onset is bisected to")
-    stability.add_argument("--growth-tol", type=float, default=1e-6,
-                           help="a mode grows when Re λ > growth-tol |λ|")
-    dynamics = commands.add_parser(
-        "dynamics", help="dynamics from a perturbed steady state (Problem 1ε, PETSc TS)",
-        description="Generalized-α (TSALPHA2) integration from the steady sliding state at --mu "
-                    "plus a normal velocity perturbation; TS/SNES options as -dynamics_<option> "
-                    "after the flags (e.g. -dynamics_ts_adapt_type basic).")
-    dynamics.add_argument("scene", choices=["block"], help="scene to run")
-    dynamics.add_argument("--mu", type=float, required=True, help="friction coefficient")
-    dynamics.add_argument("--t-end", type=float, required=True, help="final time [s]")
-    dynamics.add_argument("--dt", type=float, default=1e-5, help="(initial) time step [s]")
-    dynamics.add_argument("--perturbation", type=float, default=-0.01,
-                          help="initial normal velocity added to the steady state [cm/s]")
-    dynamics.add_argument("--stride", type=int, default=20, help="steps between field outputs")
-    dynamics.add_argument("--probe-x", type=float,
-                          help="abscissa [cm] of the contact node whose tractions are recorded "
-                               "(default: L/2, the paper's node 29)")
-    dynamics.add_argument("--scheme", choices=["alpha2", "central"], default="alpha2",
-                          help="implicit generalized-α, or explicit central differences with "
-                               "a lumped mass (dt capped at 0.9 of the stable step)")
-    dynamics.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
-    for flag, dest, kind, text in (
-            ("--refine", "refine", int, "mesh refinement (1)"),
-            ("--belt-speed", "belt_speed", float, "belt speed [cm/s] (0.287)"),
-            ("--b-n", "b_n", float, "normal damping [10³ kg cm^(-2-l_n) s⁻¹] (0)"),
-            ("--K-x", "K_x", float, "driver spring [10³ kg s⁻²] (11.1)"),
-            ("--B0", "B0", float, "breadth [cm] (30.5)"),
-            ("--eps", "eps", float, "regularisation ε [cm/s] (1e-3)"),
-            ("--regularisation", "regularisation", str, "c1 or smooth (c1)")):
-        dynamics.add_argument(flag, dest=dest, type=kind, help=text)
+__all__ = ["run_dynamics", "run_stability", "run_steady"]
 
 
 def _scene(args: argparse.Namespace, **fixed: typing.Any) -> BlockOnBelt:
@@ -196,7 +122,7 @@ def run_steady(args: argparse.Namespace, log: logging.Logger) -> int:
             change = "-" if r["change"] is None else f"{r['change']:.3e}"
             log.info("%12.3e %12s %14.3e %8d", r["eps"], change, ratio, r["newton_iterations"])
     reached = records[-1]["mu"] if records else None  # last target of the μ grid reached
-    results.write_json(out / "summary.json", {
+    results.write_summary(out / "summary.json", {
         "scene": args.scene, "parameters": dataclasses.asdict(scene), "ranks": comm.size,
         "dofs": ndofs, "jit_time_s": solver.jit_time_s,
         "wall_time_s": time.perf_counter() - t_start, "mu_reached": reached,
@@ -241,7 +167,7 @@ def run_stability(args: argparse.Namespace, log: logging.Logger) -> int:
     records: list[dict] = []
 
     def write(fe: dict, rigid: typing.Any, failure: str | None, interrupted: str | None) -> None:
-        results.write_json(out / "stability.json", {
+        results.write_summary(out / "stability.json", {
             "scene": args.scene, "parameters": dataclasses.asdict(scene), "ranks": comm.size,
             "mu_crit": {"fe": fe["mu_crit"], "rigid": rigid.mu_crit if rigid else None},
             "fe": fe, "rigid": rigid, "max_frequency": args.max_frequency,
@@ -354,7 +280,7 @@ def run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
         log.info(f"apparent friction coefficient {statistics.apparent_coefficient:.4f} "
                  f"(μ = {args.mu}), probe node sticks {statistics.probe_stick_fraction:.1%} "
                  f"of the time (second half of the run)")
-    results.write_json(out / "summary.json", {
+    results.write_summary(out / "summary.json", {
         "scene": args.scene, "parameters": dataclasses.asdict(scene), "scheme": args.scheme,
         "dt": args.dt, "steps": len(records) - 1, "failure": failure,
         "interrupted": None if interrupted is None else str(interrupted),

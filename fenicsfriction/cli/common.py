@@ -1,4 +1,4 @@
-"""What every command shares: one-line argument errors and the output folder.
+"""What every command shares once it runs: the output folder and the one line that ends a run.
 
 Records are written as they are computed (:class:`fenicsfriction.results.CsvRows`) and a signal
 stops a run at the next step (:mod:`fenicsfriction.signals`).
@@ -6,39 +6,12 @@ stops a run at the next step (:mod:`fenicsfriction.signals`).
 
 from __future__ import annotations
 
-import argparse
 import pathlib
 import sys
-import typing
 
 from mpi4py import MPI
 
-__all__ = ["Parser", "floats", "omega_range", "output_folder", "stop_line"]
-
-
-class Parser(argparse.ArgumentParser):
-    """argparse with one-line errors (no usage block) and exit status 2."""
-
-    def error(self, message: str) -> typing.NoReturn:
-        self.exit(2, f"{self.prog}: error: {message}\n")
-
-
-def floats(text: str) -> list[float]:
-    """``"1e-2,1e-3"`` -> ``[0.01, 0.001]``."""
-    try:
-        return [float(v) for v in text.split(",") if v.strip()]
-    except ValueError:
-        raise argparse.ArgumentTypeError(
-            f"expected comma-separated numbers, got {text!r}") from None
-
-
-def omega_range(text: str) -> tuple[float, float]:
-    """``"30:31"`` -> ``(30.0, 31.0)``."""
-    try:
-        lo, hi = (float(v) for v in text.split(":"))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected LO:HI, got {text!r}") from None
-    return lo, hi
+__all__ = ["output_folder", "stop_line"]
 
 
 def output_folder(path: pathlib.Path, comm: MPI.Comm = MPI.COMM_WORLD) -> pathlib.Path:

@@ -13,7 +13,6 @@ from __future__ import annotations
 import argparse
 import functools
 import logging
-import pathlib
 import time
 import typing
 
@@ -22,69 +21,12 @@ from mpi4py import MPI
 import numpy as np
 
 from fenicsfriction import laws, plotting, results
-from fenicsfriction.cli.common import omega_range, output_folder, stop_line
+from fenicsfriction.cli.common import output_folder, stop_line
 from fenicsfriction.laws import check
 from fenicsfriction.results import CsvRows
 from fenicsfriction.signals import Interrupted, StopSignals
 
-__all__ = ["add_parsers", "run_oscillator", "run_stability_map"]
-
-
-def add_parsers(commands: typing.Any) -> None:
-    """``stability-map mdof`` and ``oscillator mdof|belt``."""
-    from fenicsfriction.reduced.slider import TABLE2_READINGS
-
-    readings = {"choices": sorted(TABLE2_READINGS), "default": "paper",
-                "help": "reading of the paper's dimensionless Table 2 model (paper)"}
-    smap = commands.add_parser(
-        "stability-map", help="stability of steady sliding vs forcing frequency (m.d.o.f. slider)",
-        description="Growth rate of perturbations of steady sliding of the Table 2 slider by "
-                    "first-order averaging and by Floquet multipliers (PETSc TS), with the "
-                    "unstable bands.")
-    smap.add_argument("scene", choices=["mdof"], help="scene to run")
-    smap.add_argument("--omega-range", type=omega_range, required=True, metavar="LO:HI")
-    smap.add_argument("--samples", type=int, default=101, help="forcing frequencies sampled")
-    smap.add_argument("--methods", default="averaging,floquet",
-                      help="comma-separated: averaging, floquet")
-    smap.add_argument("--reading", **readings)
-    smap.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
-    osc = commands.add_parser(
-        "oscillator", help="stick-slip time response of a friction oscillator",
-        description="Integrates the m.d.o.f. slider (mdof) or the 1-d.o.f. oscillator on a "
-                    "belt (belt) with stick and slip switched at events located by PETSc TS "
-                    "(or a regularised law with --eps); TS options as -hybrid_<option> (mdof) or "
-                    "-belt_<option> (belt).")
-    osc.add_argument("scene", choices=["mdof", "belt"], help="scene to run")
-    osc.add_argument("--t-end", type=float, default=100.0, help="final (dimensionless) time")
-    osc.add_argument("--eps", type=float, help="regularised law of this width (no events)")
-    osc.add_argument("--rtol", type=float, default=1e-8, help="relative tolerance of the steps")
-    osc.add_argument("--sample-dt", type=float, default=0.01, help="output sampling step")
-    osc.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
-    mdof = osc.add_argument_group("mdof (the m.d.o.f. slider, Table 2)")
-    mdof.add_argument("--omega", type=float, default=30.78, help="forcing frequency ω_o")
-    mdof.add_argument("--reading", **readings)
-    mdof.add_argument("--normal-force", choices=["signed", "absolute", "clipped"],
-                      default="signed", help="how N enters friction (signed, as eq. 21)")
-    mdof.add_argument("--coupled", action="store_true",
-                      help="the roughness under a contact follows its tangential motion")
-    mdof.add_argument("--perturbation", type=float, default=0.01,
-                      help="initial slider velocity added to steady sliding")
-    belt = osc.add_argument_group("belt (m ẍ + c ẋ + k x = μ(v_b − ẋ) N)")
-    for flag, default, text in (("--m", 1.0, "mass"), ("--k", 1.0, "stiffness"),
-                                ("--c", 0.0, "damping"), ("--N", 1.0, "normal force"),
-                                ("--v-belt", 0.5, "belt speed"),
-                                ("--mu-s", 0.6, "static coefficient"),
-                                ("--mu-k", 0.3, "kinetic coefficient (constant, stribeck)"),
-                                ("--slope", 0.03, "dμ/d|v| (piecewise)"),
-                                ("--v-c", 15.0, "end of the slope (piecewise)"),
-                                ("--v-s", 0.5, "Stribeck speed (stribeck)")):
-        belt.add_argument(flag, type=float, default=default, help=f"{text} ({default})")
-    belt.add_argument("--law", choices=["constant", "piecewise", "stribeck"],
-                      default="constant", help="μ(v) while slipping (constant: μ_k, with μ_s "
-                                               "for stick)")
-    belt.add_argument("--x0", type=float, default=0.0, help="initial displacement (0)")
-    belt.add_argument("--v0", type=float,
-                      help="initial velocity (the belt's: the mass starts stuck to the belt)")
+__all__ = ["run_oscillator", "run_stability_map"]
 
 
 def run_stability_map(args: argparse.Namespace, log: logging.Logger) -> int:
@@ -269,18 +211,18 @@ def run_oscillator(args: argparse.Namespace, log: logging.Logger) -> int:
             else:
                 summary, plot, failure = _slider(args, table, progress)
         except Interrupted as err:
-            results.write_json(out / "summary.json", stopped("interrupted", err))
+            results.write_summary(out / "summary.json", stopped("interrupted", err))
             stop_line(f"{err}; the results so far are written")
             return err.exit_code
         except DynamicsError as err:  # the belt's integration failed: no cycle to summarise
-            results.write_json(out / "summary.json", stopped("failure", err))
+            results.write_summary(out / "summary.json", stopped("failure", err))
             stop_line(f"integration stopped after t = {samples[0]:.6g}: {err}; the results "
                       "so far are written")
             return 1
     summary["wall_seconds"] = time.perf_counter() - start
     log.info(f"{summary['events']} events, stick fraction {summary['stick_fraction']:.3f}, "
              f"{summary['wall_seconds']:.1f} s")
-    results.write_json(out / "summary.json", summary)
+    results.write_summary(out / "summary.json", summary)
     if comm.rank == 0:
         t, x, v, surface, stick, names = plot
         plotting.plot_oscillator(t, x, v, surface, stick, out / "oscillator.png",

@@ -16,17 +16,31 @@ One module per question:
   nonlinear equations with true stick (events) or a regularised law.
 """
 
-from fenicsfriction.reduced.slider.model import Contact, ScaledFriction, Slider
-from fenicsfriction.reduced.slider.motion import SliderMotion
-from fenicsfriction.reduced.slider.stability import (
-    AveragedStability,
-    FloquetStability,
-    StabilityMap,
-    stability_map,
-    stroboscopic_growth,
-)
-from fenicsfriction.reduced.slider.table2 import TABLE2_PAPER_BANDS, TABLE2_READINGS, table2_slider
+from __future__ import annotations
 
-__all__ = ["TABLE2_PAPER_BANDS", "TABLE2_READINGS", "AveragedStability", "Contact",
-           "FloquetStability", "ScaledFriction", "Slider", "SliderMotion", "StabilityMap",
-           "stability_map", "stroboscopic_growth", "table2_slider"]
+import typing
+
+from fenicsfriction._lazy import attach
+
+__getattr__, __dir__, __all__ = attach(__name__, {
+    "Contact": "model", "ScaledFriction": "model", "Slider": "model", "SliderMotion": "motion",
+    "AveragedStability": "stability", "FloquetStability": "stability",
+    "StabilityMap": "stability", "stability_map": "stability",
+    "stroboscopic_growth": "stability", "TABLE2_PAPER_BANDS": "table2",
+    "TABLE2_READINGS": "table2", "table2_slider": "table2"})
+
+if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers
+    from fenicsfriction.reduced.slider.model import Contact, ScaledFriction, Slider
+    from fenicsfriction.reduced.slider.motion import SliderMotion
+    from fenicsfriction.reduced.slider.stability import (
+        AveragedStability,
+        FloquetStability,
+        StabilityMap,
+        stability_map,
+        stroboscopic_growth,
+    )
+    from fenicsfriction.reduced.slider.table2 import (
+        TABLE2_PAPER_BANDS,
+        TABLE2_READINGS,
+        table2_slider,
+    )

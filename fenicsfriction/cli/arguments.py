@@ -1,0 +1,192 @@
+"""The command line's flags: every sub-command's parser, built without importing the solvers.
+
+``fenicsfriction --help`` and a mistyped flag need nothing but argparse, so they answer at
+once; the module that runs a command (:mod:`~fenicsfriction.cli.block`,
+:mod:`~fenicsfriction.cli.oscillators`), and with it MPI, PETSc and dolfinx, is imported only
+once the flags are known.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import pathlib
+import typing
+
+__all__ = ["LazyChoices", "Parser", "add_block_parsers", "add_oscillator_parsers", "floats",
+           "omega_range"]
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (no usage block) and exit status 2."""
+
+    def error(self, message: str) -> typing.NoReturn:
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def floats(text: str) -> list[float]:
+    """``"1e-2,1e-3"`` -> ``[0.01, 0.001]``."""
+    try:
+        return [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected comma-separated numbers, got {text!r}") from None
+
+
+def omega_range(text: str) -> tuple[float, float]:
+    """``"30:31"`` -> ``(30.0, 31.0)``."""
+    try:
+        lo, hi = (float(v) for v in text.split(":"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected LO:HI, got {text!r}") from None
+    return lo, hi
+
+
+class LazyChoices:
+    """The ``choices`` of a flag, read from ``module.name`` (a dict or collection) when argparse
+    first checks a value or prints the sub-command's help, so that listing them costs no import.
+    """
+
+    def __init__(self, module: str, name: str):
+        self.module, self.name = module, name
+
+    def _values(self) -> list[str]:
+        return sorted(getattr(importlib.import_module(self.module), self.name))
+
+    def __contains__(self, value: object) -> bool:
+        return value in self._values()
+
+    def __iter__(self) -> typing.Iterator[str]:
+        return iter(self._values())
+
+
+def _scene_flags() -> argparse.ArgumentParser:
+    """Flags shared by the commands that follow the steady state in μ (None: scene default)."""
+    flags = Parser(add_help=False)
+    flags.add_argument("scene", choices=["block"], help="scene to run")
+    flags.add_argument("--mu-max", type=float, required=True, help="last friction coefficient")
+    flags.add_argument("--steps", type=int, default=30, help="continuation increments (NINCT)")
+    flags.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    flags.add_argument("--refine", type=int, default=1, help="mesh refinement (4r × 3r cells)")
+    flags.add_argument("--degree", type=int, default=2, help="Lagrange degree (2: Q2)")
+    flags.add_argument("--E", type=float, help="Young's modulus [10³ kg cm⁻¹ s⁻²] (1.4e6)")
+    flags.add_argument("--B0", type=float, help="breadth out of the plane [cm] (30.5)")
+    flags.add_argument("--K-x", type=float, dest="K_x", help="driver spring [10³ kg s⁻²] (11.1)")
+    flags.add_argument("--spring-height", type=float, help="spring height [cm] (H/2)")
+    flags.add_argument("--belt-speed", type=float, help="belt speed [cm/s] (0.287)")
+    flags.add_argument("--belt-direction", type=int, help="+1 or -1 (+1)")
+    flags.add_argument("--eps", type=float, help="regularisation ε [cm/s] (1e-3)")
+    flags.add_argument("--regularisation", help="c1 or smooth (c1)")
+    flags.add_argument("--contact-quadrature", help="gauss or gll (gauss)")
+    flags.add_argument("--max-halvings", type=int, default=8,
+                       help="step halvings allowed when a continuation step fails")
+    return flags
+
+
+def add_block_parsers(commands: typing.Any) -> None:
+    """``steady``, ``stability`` and ``dynamics``, each for the scene ``block``."""
+    scene = _scene_flags()
+    steady = commands.add_parser(
+        "steady", parents=[scene], help="steady sliding with continuation in μ (Problem 2)",
+        description="Steady sliding solved by Newton (PETSc SNES) at each μ from 0 to --mu-max; "
+                    "PETSc options can be given as -steady_<option> after the flags.")
+    steady.add_argument("--eps-sequence", type=floats, metavar="E1,E2,...",
+                        help="after the continuation, Kalker's sequential ε process at μ-max")
+    steady.add_argument("--snapshots", type=int, default=4, help="deformed shapes to draw")
+    stability = commands.add_parser(
+        "stability", parents=[scene], help="eigenvalue loci and flutter onset (Problem 3)",
+        description="Quadratic eigenvalues of the linearised steady sliding (SLEPc PEP) at each "
+                    "μ from 0 to --mu-max, FE and rigid model side by side; PETSc/SLEPc options "
+                    "as -stability_<option> after the flags.")
+    stability.add_argument("--max-frequency", type=float, default=3e4,
+                           help="every eigenvalue with |λ| below this [rad/s] is computed")
+    stability.add_argument("--onset-tol", type=float, default=1e-4,
+                           help="width of the μ interval the onset is bisected to")
+    stability.add_argument("--growth-tol", type=float, default=1e-6,
+                           help="a mode grows when Re λ > growth-tol |λ|")
+    dynamics = commands.add_parser(
+        "dynamics", help="dynamics from a perturbed steady state (Problem 1ε, PETSc TS)",
+        description="Generalized-α (TSALPHA2) integration from the steady sliding state at --mu "
+                    "plus a normal velocity perturbation; TS/SNES options as -dynamics_<option> "
+                    "after the flags (e.g. -dynamics_ts_adapt_type basic).")
+    dynamics.add_argument("scene", choices=["block"], help="scene to run")
+    dynamics.add_argument("--mu", type=float, required=True, help="friction coefficient")
+    dynamics.add_argument("--t-end", type=float, required=True, help="final time [s]")
+    dynamics.add_argument("--dt", type=float, default=1e-5, help="(initial) time step [s]")
+    dynamics.add_argument("--perturbation", type=float, default=-0.01,
+                          help="initial normal velocity added to the steady state [cm/s]")
+    dynamics.add_argument("--stride", type=int, default=20, help="steps between field outputs")
+    dynamics.add_argument("--probe-x", type=float,
+                          help="abscissa [cm] of the contact node whose tractions are recorded "
+                               "(default: L/2, the paper's node 29)")
+    dynamics.add_argument("--scheme", choices=["alpha2", "central"], default="alpha2",
+                          help="implicit generalized-α, or explicit central differences with "
+                               "a lumped mass (dt capped at 0.9 of the stable step)")
+    dynamics.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    for flag, dest, kind, text in (
+            ("--refine", "refine", int, "mesh refinement (1)"),
+            ("--belt-speed", "belt_speed", float, "belt speed [cm/s] (0.287)"),
+            ("--b-n", "b_n", float, "normal damping [10³ kg cm^(-2-l_n) s⁻¹] (0)"),
+            ("--K-x", "K_x", float, "driver spring [10³ kg s⁻²] (11.1)"),
+            ("--B0", "B0", float, "breadth [cm] (30.5)"),
+            ("--eps", "eps", float, "regularisation ε [cm/s] (1e-3)"),
+            ("--regularisation", "regularisation", str, "c1 or smooth (c1)")):
+        dynamics.add_argument(flag, dest=dest, type=kind, help=text)
+
+
+def add_oscillator_parsers(commands: typing.Any) -> None:
+    """``stability-map mdof`` and ``oscillator mdof|belt``."""
+    readings = {"choices": LazyChoices("fenicsfriction.reduced.slider.table2", "TABLE2_READINGS"),
+                "default": "paper",
+                "metavar": "READING",
+                "help": "reading of the paper's dimensionless Table 2 model: %(choices)s "
+                        "(default: %(default)s)"}
+    smap = commands.add_parser(
+        "stability-map", help="stability of steady sliding vs forcing frequency (m.d.o.f. slider)",
+        description="Growth rate of perturbations of steady sliding of the Table 2 slider by "
+                    "first-order averaging and by Floquet multipliers (PETSc TS), with the "
+                    "unstable bands.")
+    smap.add_argument("scene", choices=["mdof"], help="scene to run")
+    smap.add_argument("--omega-range", type=omega_range, required=True, metavar="LO:HI")
+    smap.add_argument("--samples", type=int, default=101, help="forcing frequencies sampled")
+    smap.add_argument("--methods", default="averaging,floquet",
+                      help="comma-separated: averaging, floquet")
+    smap.add_argument("--reading", **readings)
+    smap.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    osc = commands.add_parser(
+        "oscillator", help="stick-slip time response of a friction oscillator",
+        description="Integrates the m.d.o.f. slider (mdof) or the 1-d.o.f. oscillator on a "
+                    "belt (belt) with stick and slip switched at events located by PETSc TS "
+                    "(or a regularised law with --eps); TS options as -hybrid_<option> (mdof) or "
+                    "-belt_<option> (belt).")
+    osc.add_argument("scene", choices=["mdof", "belt"], help="scene to run")
+    osc.add_argument("--t-end", type=float, default=100.0, help="final (dimensionless) time")
+    osc.add_argument("--eps", type=float, help="regularised law of this width (no events)")
+    osc.add_argument("--rtol", type=float, default=1e-8, help="relative tolerance of the steps")
+    osc.add_argument("--sample-dt", type=float, default=0.01, help="output sampling step")
+    osc.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    mdof = osc.add_argument_group("mdof (the m.d.o.f. slider, Table 2)")
+    mdof.add_argument("--omega", type=float, default=30.78, help="forcing frequency ω_o")
+    mdof.add_argument("--reading", **readings)
+    mdof.add_argument("--normal-force", choices=["signed", "absolute", "clipped"],
+                      default="signed", help="how N enters friction (signed, as eq. 21)")
+    mdof.add_argument("--coupled", action="store_true",
+                      help="the roughness under a contact follows its tangential motion")
+    mdof.add_argument("--perturbation", type=float, default=0.01,
+                      help="initial slider velocity added to steady sliding")
+    belt = osc.add_argument_group("belt (m ẍ + c ẋ + k x = μ(v_b − ẋ) N)")
+    for flag, default, text in (("--m", 1.0, "mass"), ("--k", 1.0, "stiffness"),
+                                ("--c", 0.0, "damping"), ("--N", 1.0, "normal force"),
+                                ("--v-belt", 0.5, "belt speed"),
+                                ("--mu-s", 0.6, "static coefficient"),
+                                ("--mu-k", 0.3, "kinetic coefficient (constant, stribeck)"),
+                                ("--slope", 0.03, "dμ/d|v| (piecewise)"),
+                                ("--v-c", 15.0, "end of the slope (piecewise)"),
+                                ("--v-s", 0.5, "Stribeck speed (stribeck)")):
+        belt.add_argument(flag, type=float, default=default, help=f"{text} ({default})")
+    belt.add_argument("--law", choices=["constant", "piecewise", "stribeck"],
+                      default="constant", help="μ(v) while slipping (constant: μ_k, with μ_s "
+                                               "for stick)")
+    belt.add_argument("--x0", type=float, default=0.0, help="initial displacement (0)")
+    belt.add_argument("--v0", type=float,
+                      help="initial velocity (the belt's: the mass starts stuck to the belt)")
