@@ -84,12 +84,14 @@ def jit_options(cache_dir: str | None = None) -> dict:
 
 
 def assemble_matrix_into(A: PETSc.Mat, a: fem.FormMetaClass, bcs: list,
-                         diagonal: float = 1.0) -> None:
+                         diagonal: float = 1.0, zero: bool = True) -> None:
     """Assemble ``a`` into ``A`` (Dirichlet rows: ``diagonal`` on the diagonal), leaving A
     *unfinalised*: the caller adds its own entries (nodal springs), then ``A.assemble()``.
+    ``zero=False`` adds to what A holds (the Dirichlet diagonal is still set, not added).
     ``diagonal`` became ``diag`` in 0.8, so it is passed positionally.
     """
-    A.zeroEntries()
+    if zero:
+        A.zeroEntries()
     dolfinx.fem.petsc.assemble_matrix(A, a, bcs, diagonal)
 
 

@@ -40,12 +40,22 @@ def assemble_residual(b: PETSc.Vec, L: fem.FormMetaClass, a: fem.FormMetaClass, 
 
 
 def assemble_jacobian(A: PETSc.Mat, a: fem.FormMetaClass, bcs: list,
-                      springs: typing.Sequence = (), diagonal: float = 1.0) -> None:
+                      springs: typing.Sequence = (), diagonal: float = 1.0,
+                      base: PETSc.Mat | None = None) -> None:
     """A = dR/du (bilinear form ``a``) plus nodal spring stiffnesses.
 
     Dirichlet rows and columns are zeroed with ``diagonal`` on the diagonal (1 for a
     stiffness, 0 for damping and mass so that constrained dofs give infinite eigenvalues).
+
+    With ``base`` (a matrix of A's sparsity, e.g. the constant bulk part of the Jacobian with
+    its springs and Dirichlet rows, assembled once), A = base + the integrals of ``a``: only the
+    changing part is assembled, and ``springs`` are already in ``base``.
     """
+    if base is not None:
+        base.copy(A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        _compat.assemble_matrix_into(A, a, bcs, diagonal, zero=False)
+        A.assemble()
+        return
     _compat.assemble_matrix_into(A, a, bcs, diagonal)
     if springs:  # the Dirichlet diagonal was INSERTed; PETSc needs a flush before ADD
         A.assemblyBegin(PETSc.Mat.AssemblyType.FLUSH)
