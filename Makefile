@@ -1,7 +1,8 @@
 # Set-up and entry points. `make demo` and `make test` each install what is missing first.
 # As root the Debian packages are installed directly, otherwise through sudo.
 SHELL := /bin/bash
-PY := .venv/bin/python
+VENV ?= .venv
+PY := $(VENV)/bin/python
 NP ?= 2
 # the linters `make test` runs, pinned as in pyproject.toml's `lint` extra
 LINTERS := ruff==0.17.6 mypy==2.4.1
@@ -15,21 +16,21 @@ MPIRUN := mpirun -n $(NP) $(shell [ "$$(id -u)" = 0 ] && echo --allow-run-as-roo
 export OMPI_MCA_rmaps_base_oversubscribe := 1
 export PYTHONDONTWRITEBYTECODE := 1
 
-.PHONY: setup demo lint test test-serial test-mpi benchmark clean
+.PHONY: setup demo lint test test-serial test-mpi test-debian13 benchmark clean
 
-.venv/.installed: pyproject.toml
+$(VENV)/.installed: pyproject.toml
 	@missing=$$(for p in $(APT_PACKAGES); do dpkg-query -W -f='$${Status}' $$p 2>/dev/null \
 	    | grep -q "install ok installed" || echo $$p; done); \
 	if [ -n "$$missing" ]; then \
 	    echo "installing Debian packages:" $$missing; \
 	    $(SUDO) apt-get update && DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y \
 	        --no-install-recommends $$missing; fi
-	/usr/bin/python3 -m venv --system-site-packages .venv
+	/usr/bin/python3 -m venv --system-site-packages $(VENV)
 	$(PY) -m pip install --quiet --no-build-isolation --no-deps -e .
 	$(PY) -m pip install --quiet $(LINTERS)
 	@touch $@
 
-setup: .venv/.installed
+setup: $(VENV)/.installed
 
 demo: setup
 	$(PY) -m fenicsfriction steady block --mu-max 1.55 --steps 31 --out $(OUT)/steady-block
@@ -49,6 +50,10 @@ test-mpi: setup
 
 test: lint test-serial test-mpi
 
+# the same `make test` on Debian 13's FEniCSx (dolfinx 0.9), in a debootstrap chroot (.debian13/)
+test-debian13:
+	tools/debian13/run-tests.sh
+
 benchmark: setup
 	$(PY) benchmarks/bench_steady.py --out $(OUT)/benchmarks
 	$(PY) benchmarks/bench_stability.py --out $(OUT)/benchmarks
@@ -56,4 +61,5 @@ benchmark: setup
 	$(PY) benchmarks/bench_oscillators.py --out $(OUT)/benchmarks
 
 clean:
-	rm -rf .venv results *.egg-info
+	rm -rf .venv .venv-debian13 results *.egg-info
+	@echo "(the Debian 13 chroot .debian13/ is kept: rm -rf .debian13 removes it)"

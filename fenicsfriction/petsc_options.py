@@ -13,7 +13,7 @@ from petsc4py import PETSc
 
 import numpy as np
 
-__all__ = ["RoundoffConvergence", "options_with_defaults"]
+__all__ = ["RoundoffConvergence", "callback_exception", "options_with_defaults"]
 
 
 @contextlib.contextmanager
@@ -34,6 +34,18 @@ def options_with_defaults(prefix: str, defaults: dict) -> typing.Iterator[PETSc.
     finally:
         for key in added:
             opts.delValue(key)
+
+
+def callback_exception(error: PETSc.Error) -> BaseException | None:
+    """The Python exception raised inside a PETSc callback (monitor, post-step, event) that
+    ended a solve, or ``None`` for a PETSc failure of its own.
+
+    petsc4py 3.18 re-raises such an exception as it is; petsc4py >= 3.20 raises a
+    ``PETSc.Error`` (code -1) with the original as its ``__cause__``. Callers re-raise what
+    this returns, so a user's interrupt or a deliberate stop means the same on both.
+    """
+    cause = error.__cause__
+    return cause if cause is not None and not isinstance(cause, PETSc.Error) else None
 
 
 class RoundoffConvergence:

@@ -119,8 +119,12 @@ class StabilitySolver:
         self.pep.setOperators([self.K, self.C, self.M])
         self.pep.setProblemType(SLEPc.PEP.ProblemType.GENERAL)
         self.pep.setWhichEigenpairs(SLEPc.PEP.Which.TARGET_MAGNITUDE)
-        with options_with_defaults(prefix, {**DEFAULT_OPTIONS, **(options or {})}):
+        with options_with_defaults(prefix, {**DEFAULT_OPTIONS, **(options or {})}) as opts:
             self.pep.setFromOptions()
+            # the subspace sizes set by the user, else PETSc's choice for each nev: given at
+            # every setDimensions, as slepc4py >= 3.20 keeps the previous ncv when none is
+            self._subspace = {key: opts.getInt(f"pep_{key}", PETSc.DECIDE)
+                              for key in ("ncv", "mpd")}
         self._norms = (1.0, 1.0, 1.0)
 
     def assemble(self) -> None:
@@ -184,7 +188,7 @@ class StabilitySolver:
         self.pep.setTarget(shift)
         n = self.K.getSize()[0]
         while True:
-            self.pep.setDimensions(nev=min(nev, n))
+            self.pep.setDimensions(nev=min(nev, n), **self._subspace)
             self.pep.solve()
             count = self.pep.getConverged()
             values = [self.pep.getEigenpair(i) for i in range(count)]

@@ -17,7 +17,11 @@ from petsc4py import PETSc
 import numpy as np
 
 from fenicsfriction.laws import check
-from fenicsfriction.petsc_options import RoundoffConvergence, options_with_defaults
+from fenicsfriction.petsc_options import (
+    RoundoffConvergence,
+    callback_exception,
+    options_with_defaults,
+)
 
 __all__ = ["DEFAULT_OPTIONS", "Alpha2Integrator", "DynamicsError"]
 
@@ -150,6 +154,11 @@ class Alpha2Integrator:
         try:
             self.ts.solve(u)
         except PETSc.Error as err:  # e.g. a NaN in the error estimate: report, keep the state
+            cause = callback_exception(err)
+            if cause is not None:  # raised by a monitor (e.g. an interrupt): not a failure
+                self.ts.cancelMonitor()
+                self.ts.setPostStep(None)
+                raise cause from None
             error = err
         self.ts.cancelMonitor()
         self.ts.setPostStep(None)

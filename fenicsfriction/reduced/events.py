@@ -48,7 +48,7 @@ from petsc4py import PETSc
 import numpy as np
 
 from fenicsfriction.laws import check
-from fenicsfriction.petsc_options import options_with_defaults
+from fenicsfriction.petsc_options import callback_exception, options_with_defaults
 from fenicsfriction.results import Record
 from fenicsfriction.timestepping import DynamicsError
 
@@ -74,6 +74,11 @@ _MAX_LOCATION_TRIES = 1000
 # A stalled location is resumed with the event tolerance ×_RELAX, up to this; beyond, it fails
 _RELAX = 100.0
 _MAX_EVENT_TOL = 1e-6
+
+# First-step refinements of one segment (each 16x smaller, when an event function starting at
+# zero left it and came back within the first step) before the segment is reported as failed;
+# without a bound a Zeno accumulation loops here for ever under PETSc 3.22's event location
+_MAX_FIRST_STEP_RETRIES = 8
 
 # Segments in a row that PETSc ends at an event still within the tolerance of its starting zero
 _MAX_SPURIOUS = 100
@@ -332,7 +337,10 @@ class _Segment:
         except _Stop:
             pass
         except PETSc.Error as error:  # e.g. a NaN in the error estimate
-            if self.failure is None:
+            cause = callback_exception(error)
+            if cause is not None and not isinstance(cause, _Stop):
+                raise cause from None
+            if cause is None and self.failure is None:
                 self.failure = (f"TS failed in mode {self.mode!r} after t = {self.t:.12g} "
                                 f"with PETSc error {error.ierr}")
         finally:
@@ -353,7 +361,15 @@ def _smooth_segment(system: HybridSystem, mode: typing.Any, history: _History, t
     (smaller step), and a location stalled below the time resolution (larger tolerance)."""
     segment = _Segment(system, mode, history)
     segment.run(t, y, t_end, dt, options, prefix, event_tol)
+    retries = 0
     while segment.left_after is not None and segment.left_after > _SAME_INSTANT * t_end:
+        if retries == _MAX_FIRST_STEP_RETRIES:  # e.g. a Zeno accumulation of events: stop
+            segment.failure = (
+                f"mode {mode!r} from t = {t:.12g}: an event function starting at zero left "
+                f"it and came back within the first step {_MAX_FIRST_STEP_RETRIES} times "
+                f"with steps down to {dt:.3e}; the events accumulate (Zeno behaviour?)")
+            break
+        retries += 1
         dt = segment.left_after / 16  # look closer: the first step may have jumped over
         segment = _Segment(system, mode, history)  # a short excursion
         segment.run(t, y, t_end, dt, options, prefix, event_tol)
