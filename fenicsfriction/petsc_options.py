@@ -13,7 +13,8 @@ from petsc4py import PETSc
 
 import numpy as np
 
-__all__ = ["RoundoffConvergence", "callback_exception", "options_with_defaults"]
+__all__ = ["EVENTS_LOCATED_TO_RESOLUTION", "RoundoffConvergence", "callback_error",
+           "options_with_defaults"]
 
 
 @contextlib.contextmanager
@@ -36,16 +37,22 @@ def options_with_defaults(prefix: str, defaults: dict) -> typing.Iterator[PETSc.
             opts.delValue(key)
 
 
-def callback_exception(error: PETSc.Error) -> BaseException | None:
-    """The Python exception raised inside a PETSc callback (monitor, post-step, event) that
-    ended a solve, or ``None`` for a PETSc failure of its own.
+def callback_error(error: PETSc.Error) -> BaseException:
+    """What ended a solve, as a callback (monitor, right-hand side, event) raised it.
 
-    petsc4py 3.18 re-raises such an exception as it is; petsc4py >= 3.20 raises a
-    ``PETSc.Error`` (code -1) with the original as its ``__cause__``. Callers re-raise what
-    this returns, so a user's interrupt or a deliberate stop means the same on both.
+    petsc4py 3.18 re-raises an exception from a callback as it is; petsc4py 3.22 raises a
+    ``PETSc.Error`` with code -1 whose ``__cause__`` is the original. Returned: that original
+    (a Python exception, to re-raise, or a ``PETSc.Error`` with its real code), or ``error``
+    itself when PETSc failed on its own.
     """
     cause = error.__cause__
-    return cause if cause is not None and not isinstance(cause, PETSc.Error) else None
+    return error if cause is None else cause
+
+
+#: PETSc 3.22's event location (rewritten after 3.18) locates an event to the time resolution
+#: itself; 3.18's retries until |g| <= tol and stalls there, which the hybrid driver detects
+#: and resumes with a relaxed tolerance
+EVENTS_LOCATED_TO_RESOLUTION = PETSc.Sys.getVersion() >= (3, 22)
 
 
 class RoundoffConvergence:

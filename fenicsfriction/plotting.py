@@ -36,8 +36,8 @@ def cell_outlines(u: fem.Function) -> tuple[np.ndarray, np.ndarray] | None:
     u1 = fem.Function(V1)
     u1.interpolate(u)
     num_cells = msh.topology.index_map(msh.topology.dim).size_local
-    dofs = np.array([V1.dofmap.cell_dofs(c) for c in range(num_cells)]).reshape(num_cells, -1)
-    dofs = dofs[:, [0, 1, 3, 2]]  # tensor-product order -> counter-clockwise polygon
+    cell_dofs = np.array([V1.dofmap.cell_dofs(c) for c in range(num_cells)])
+    dofs = cell_dofs.reshape(num_cells, -1)[:, [0, 1, 3, 2]]  # tensor-product order -> polygon
     X = V1.tabulate_dof_coordinates()[:, :2][dofs]
     U = u1.x.array.reshape(-1, 2)[dofs]
     gathered = msh.comm.gather((X, U), root=0)

@@ -19,7 +19,7 @@ import numpy as np
 from fenicsfriction.laws import check
 from fenicsfriction.petsc_options import (
     RoundoffConvergence,
-    callback_exception,
+    callback_error,
     options_with_defaults,
 )
 
@@ -154,12 +154,12 @@ class Alpha2Integrator:
         try:
             self.ts.solve(u)
         except PETSc.Error as err:  # e.g. a NaN in the error estimate: report, keep the state
-            cause = callback_exception(err)
-            if cause is not None:  # raised by a monitor (e.g. an interrupt): not a failure
+            cause = callback_error(err)
+            if not isinstance(cause, PETSc.Error):  # from a monitor (an interrupt): not a failure
                 self.ts.cancelMonitor()
                 self.ts.setPostStep(None)
                 raise cause from None
-            error = err
+            error = cause
         self.ts.cancelMonitor()
         self.ts.setPostStep(None)
         reason = self.ts.getConvergedReason()

@@ -6,6 +6,7 @@ Every rank integrates the same sequential system (PETSc objects on COMM_SELF).
 import numpy as np
 import pytest
 
+from fenicsfriction.petsc_options import EVENTS_LOCATED_TO_RESOLUTION
 from fenicsfriction.reduced.events import HybridError, integrate_hybrid
 from fenicsfriction.statistics import mode_intervals
 
@@ -75,7 +76,10 @@ def test_steep_events_below_the_time_resolution_are_located_with_a_relaxed_toler
     result = integrate_hybrid(Steep(), [1.0, 0.0], "down", 0.5)
     times = np.array([event.t for event in result.events])
     k = np.arange(1, times.size + 1)
-    assert times.size == int(0.5 * 1e3 / np.pi) and result.relaxed_locations > 0
+    assert times.size == int(0.5 * 1e3 / np.pi)
+    # PETSc 3.18's location stalls there and the driver relaxes the tolerance; PETSc 3.22's
+    # locates to the time resolution by itself
+    assert (result.relaxed_locations > 0) != EVENTS_LOCATED_TO_RESOLUTION
     # the same relative accuracy as at ω = 2 (test above: 1e-8 in time there, ×2/ω here)
     assert np.abs(times - k * np.pi / 1e3).max() < 1e-10
 
@@ -153,14 +157,18 @@ class BouncingBall:
         return np.array([0.0, -self.e * y[1]]), mode
 
 
-def test_zeno_impacts_stop_at_max_events_near_the_accumulation_time():
+def test_zeno_impacts_stop_near_the_accumulation_time():
     zeno_time = np.sqrt(2.0) * 3.0
-    with pytest.raises(HybridError, match="max_events = 200") as info:
+    with pytest.raises(HybridError, match=r"max_events = 200|accumulate \(Zeno") as info:
         integrate_hybrid(BouncingBall(), [1.0, 0.0], "flight", 10.0, max_events=200)
-    # the impact speeds halve down to the floor sqrt(2 g tol) ~ 1e-6 set by the event tolerance
-    # (|y| < 1e-12 counts as an impact), then the ball chatters there: ~180 impacts * 3e-6
-    assert zeno_time - 1e-6 < info.value.t < zeno_time + 1e-3
-    assert len(info.value.result.events) == 200
+    # the impact speeds halve down to the floor sqrt(2 g tol) ~ 1.4e-6 set by the event
+    # tolerance (|y| < 1e-12 counts as an impact), 20 halvings from the first impact's 1.4.
+    # PETSc 3.18 then chatters there until max_events (~180 impacts * 3e-6 after the limit);
+    # PETSc 3.22's location gives up one flight before it, and the time left after an impact
+    # at speed v is 4 v (e = 1/2): some 6e-6 at the floor
+    events = len(info.value.result.events)
+    assert zeno_time - 1e-5 < info.value.t < zeno_time + 1e-3
+    assert events == 200 if "max_events" in str(info.value) else events >= 20
 
 
 def test_a_ts_failure_raises_with_the_last_good_state():

@@ -48,7 +48,7 @@ from petsc4py import PETSc
 import numpy as np
 
 from fenicsfriction.laws import check
-from fenicsfriction.petsc_options import callback_exception, options_with_defaults
+from fenicsfriction.petsc_options import callback_error, options_with_defaults
 from fenicsfriction.results import Record
 from fenicsfriction.timestepping import DynamicsError
 
@@ -336,11 +336,11 @@ class _Segment:
                                     f"{ts.getStepNumber()} steps")
         except _Stop:
             pass
-        except PETSc.Error as error:  # e.g. a NaN in the error estimate
-            cause = callback_exception(error)
-            if cause is not None and not isinstance(cause, _Stop):
-                raise cause from None
-            if cause is None and self.failure is None:
+        except PETSc.Error as raised:  # e.g. a NaN in the error estimate
+            error = callback_error(raised)
+            if not isinstance(error, PETSc.Error | _Stop):
+                raise error from None
+            if isinstance(error, PETSc.Error) and self.failure is None:
                 self.failure = (f"TS failed in mode {self.mode!r} after t = {self.t:.12g} "
                                 f"with PETSc error {error.ierr}")
         finally:
@@ -381,7 +381,7 @@ def _smooth_segment(system: HybridSystem, mode: typing.Any, history: _History, t
         g = np.abs(np.asarray(system.events(segment.t, segment.y, mode), dtype=float))
         close = np.flatnonzero((g <= tol) & ~segment.pending)
         if close.size:  # that step is on the event already, to the larger tolerance
-            segment.fired, segment.failure, segment.stalled = close.tolist(), None, False
+            segment.fired, segment.failure, segment.stalled = [int(k) for k in close], None, False
             segment.event_tol = tol
             break
         resume_t, resume_y = segment.t, segment.y

@@ -54,9 +54,14 @@ $sudo mount --bind /dev/pts "$root/dev/pts"
 $sudo mount -t tmpfs tmpfs "$root/dev/shm"
 $sudo mount --bind "$here" "$root/src"
 $sudo cp /etc/resolv.conf "$root/etc/resolv.conf" 2>/dev/null || true
+# the host's certificate authorities (pip reaches PyPI over TLS for the linters; a site may
+# add its own authority to the host's bundle)
+$sudo mkdir -p "$root/etc/ssl/certs"
+$sudo cp /etc/ssl/certs/ca-certificates.crt "$root/etc/ssl/certs/host-ca-certificates.crt"
 
 # `make setup` installs the Debian packages (apt-get update first) and the venv, as on a fresh
 # machine; VENV keeps the chroot's venv apart from the host's
 $sudo chroot "$root" /usr/bin/env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin HOME=/root LANG=C.UTF-8 \
     OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 \
+    PIP_CERT=/etc/ssl/certs/host-ca-certificates.crt \
     bash -c "cd /src && make VENV=.venv-debian13 test"

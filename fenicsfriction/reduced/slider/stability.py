@@ -242,7 +242,8 @@ def _integrate_ode(rhs: typing.Callable[[PETSc.TS, float, PETSc.Vec, PETSc.Vec],
 # --- over the forcing frequency ------------------------------------------------------------------
 
 
-def stability_map(make_slider: typing.Callable[[float], Slider], omegas: typing.Sequence[float],
+def stability_map(make_slider: typing.Callable[[float], Slider],
+                  omegas: typing.Sequence[float] | np.ndarray,
                   methods: typing.Sequence[str] = ("averaging", "floquet"),
                   tol: float = 1e-4) -> StabilityMap:
     """Sample the growth rate of each method over ``omegas`` and locate its unstable bands.
