@@ -59,6 +59,8 @@ benchmark: setup
 	$(PY) benchmarks/bench_stability.py --out $(OUT)/benchmarks
 	$(PY) benchmarks/bench_dynamics.py --out $(OUT)/benchmarks
 	$(PY) benchmarks/bench_oscillators.py --out $(OUT)/benchmarks
+	$(PY) benchmarks/bench_scaling.py --out $(OUT)/benchmarks
+	$(MPIRUN) $(PY) benchmarks/bench_scaling.py --out $(OUT)/benchmarks
 
 clean:
 	rm -rf .venv .venv-debian13 results *.egg-info

@@ -81,24 +81,6 @@ VARIANTS = {
 LOG_EVENTS = ("MatLUFactorSym", "MatLUFactorNum", "MatSolve", "PEPSolve")
 
 
-class _KeepNcv:
-    """The PEP of a StabilitySolver with ``ncv`` held fixed.
-
-    Work-around: ``StabilitySolver.solve`` calls ``pep.setDimensions(nev=...)``, which resets
-    ncv (and mpd) to PETSC_DECIDE and so silently overrides ``-pep_ncv``; this proxy passes
-    the requested ncv along (at least 2 nev, should solve() double nev).
-    """
-
-    def __init__(self, pep, ncv: int):
-        self._pep, self._ncv = pep, ncv
-
-    def __getattr__(self, name):
-        return getattr(self._pep, name)
-
-    def setDimensions(self, nev: int) -> None:
-        self._pep.setDimensions(nev=nev, ncv=max(self._ncv, 2 * nev))
-
-
 def best_of(measure, comm: MPI.Comm) -> dict:
     """The fastest of up to REPEATS calls of ``measure`` (returns a dict with ``time_s``,
     already the maximum over ranks); no further call once TIME_BUDGET seconds are spent."""
@@ -241,8 +223,6 @@ def run_mesh(dim: int, refine: int, comm: MPI.Comm, dense_max_dofs: int,
     for i, name in enumerate(names):
         options, solve_args = VARIANTS[name]
         solver = StabilitySolver(model.residual, prefix=f"{tag}v{i}_", options=options)
-        if "pep_ncv" in options:
-            solver.pep = _KeepNcv(solver.pep, options["pep_ncv"])
         variants[name] = best_of(lambda s=solver, a=solve_args: pep_solve(s, comm, a), comm)
         if name == "default":
             stab = solver  # kept for the baselines and the dense check

@@ -188,7 +188,10 @@ class StabilitySolver:
         self.pep.setTarget(shift)
         n = self.K.getSize()[0]
         while True:
-            self.pep.setDimensions(nev=min(nev, n), **self._subspace)
+            ncv, mpd = self._subspace["ncv"], self._subspace["mpd"]
+            if ncv != PETSc.DECIDE:  # the user's subspace, large enough for a doubled nev
+                ncv = min(max(ncv, 2 * nev), n)
+            self.pep.setDimensions(nev=min(nev, n), ncv=ncv, mpd=mpd)
             self.pep.solve()
             count = self.pep.getConverged()
             values = [self.pep.getEigenpair(i) for i in range(count)]

@@ -395,3 +395,21 @@ def test_unstable_intervals_are_the_runs_of_growing_steps_of_each_mode():
                                     {"mode": 2, "re": -100.0, "im": 5e3}]}
     records = [record(mu, mu in (0.4, 0.5, 0.7)) for mu in (0.3, 0.4, 0.5, 0.6, 0.7)]
     assert unstable_intervals(records, growth_tol=1e-6) == {1: [[0.4, 0.5], [0.7, 0.7]]}
+
+
+def test_a_subspace_size_given_in_the_options_is_kept_as_nev_grows():
+    """``-pep_ncv`` set by the user survives solve()'s setDimensions (slepc4py 3.18 reset it to
+    PETSC_DECIDE, 3.22 keeps the previous one): the subspace is the user's, enlarged to 2 nev
+    when solve() has to double nev, and the eigenvalues are those of the default subspace."""
+    model, _ = sliding_block(COMM, 0.5, prefix("ncv"))
+    default = StabilitySolver(model.residual, prefix=prefix("ncv_default"))
+    modes = default.solve(max_modulus=MAX_MODULUS)
+    fixed = StabilitySolver(model.residual, prefix=prefix("ncv_fixed"), options={"pep_ncv": 28})
+    fixed_modes = fixed.solve(max_modulus=MAX_MODULUS, nev=2)
+    nev, ncv, _ = fixed.pep.getDimensions()
+    assert ncv == max(28, 2 * nev) and nev > 2  # nev was doubled to cover the disc
+    assert len(fixed_modes) == len(modes)
+    for a in modes:  # the flutter pair ±Re λ has one modulus: match by distance, not order
+        b = min(fixed_modes, key=lambda m, a=a: abs(m.value - a.value))
+        # the spring mode (|λ| ≈ 5) is conditioned to κ ε_mach ≈ 4e-7 (see the dense test)
+        assert b.value == pytest.approx(a.value, rel=1e-6 if abs(a.value) < 10 else 1e-9)
