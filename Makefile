@@ -11,6 +11,8 @@ APT_PACKAGES := python3-dolfinx python3-petsc4py python3-slepc4py python3-mpi4py
     python3-basix python3-ffcx python3-numpy python3-scipy python3-matplotlib python3-pytest \
     python3-pytest-mpi python3-pytest-timeout python3-venv python3-pip python3-setuptools \
     python3-wheel python3-dev openmpi-bin build-essential pkg-config libopenblas0-serial
+# the peer library of benchmarks/bench_getfem.py, installed by `make benchmark` only
+BENCH_PACKAGES := python3-getfem
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 MPIRUN := mpirun -n $(NP) $(shell [ "$$(id -u)" = 0 ] && echo --allow-run-as-root) --oversubscribe
 export OMPI_MCA_rmaps_base_oversubscribe := 1
@@ -55,12 +57,16 @@ test-debian13:
 	tools/debian13/run-tests.sh
 
 benchmark: setup
+	@dpkg-query -W -f='$${Status}' $(BENCH_PACKAGES) 2>/dev/null | grep -q "install ok installed" \
+	    || ($(SUDO) apt-get update && DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y \
+	        --no-install-recommends $(BENCH_PACKAGES))
 	$(PY) benchmarks/bench_steady.py --out $(OUT)/benchmarks
 	$(PY) benchmarks/bench_stability.py --out $(OUT)/benchmarks
 	$(PY) benchmarks/bench_dynamics.py --out $(OUT)/benchmarks
 	$(PY) benchmarks/bench_oscillators.py --out $(OUT)/benchmarks
 	$(PY) benchmarks/bench_scaling.py --out $(OUT)/benchmarks
 	$(MPIRUN) $(PY) benchmarks/bench_scaling.py --out $(OUT)/benchmarks
+	$(PY) benchmarks/bench_getfem.py --out $(OUT)/benchmarks
 
 clean:
 	rm -rf .venv .venv-debian13 results *.egg-info
