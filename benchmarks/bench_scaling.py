@@ -38,7 +38,7 @@ STEADY_STAGES = {
     "residual assembly": ["SNESFunctionEval"],
     "Jacobian (interface) assembly": ["SNESJacobianEval"],
     "K_II factorisation": ["MatLUFactorSym", "MatLUFactorNum"],
-    "bulk Schur complement (|Γ| solves)": ["MatMatSolve"],
+    "bulk Schur complement (a solve per interface dof)": ["MatMatSolve"],
     "Newton triangular solves": ["MatSolve"],
 }
 PEP_STAGES = {

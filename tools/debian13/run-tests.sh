@@ -3,6 +3,7 @@
 # Python 3.13), in a chroot built with debootstrap from the host's own Debian mirror.
 #
 #   tools/debian13/run-tests.sh          # build .debian13/ once (a few minutes), then `make test`
+#   tools/debian13/run-tests.sh demo     # any make targets instead of `test`
 #   DEBIAN13_ROOT=/path tools/debian13/run-tests.sh
 #
 # The chroot is kept and reused; its packages are those of the Makefile's set-up, installed by
@@ -64,4 +65,4 @@ $sudo cp /etc/ssl/certs/ca-certificates.crt "$root/etc/ssl/certs/host-ca-certifi
 $sudo chroot "$root" /usr/bin/env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin HOME=/root LANG=C.UTF-8 \
     OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 \
     PIP_CERT=/etc/ssl/certs/host-ca-certificates.crt \
-    bash -c "cd /src && make VENV=.venv-debian13 test"
+    bash -c "cd /src && make VENV=.venv-debian13 ${*:-test}"
