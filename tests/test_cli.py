@@ -226,15 +226,22 @@ def test_unwritable_output_folder_is_one_line_and_exit_2(tmp_path, command, wher
     assert len(lines) == 1 and "--out=" in lines[0] and "Traceback" not in result.stderr
 
 
-@pytest.mark.parametrize("argv", [["--help"], ["steady", "block", "--mu-max", "x", "--out", "o"],
-                                  ["stability", "--help"], ["oscillator", "belt"]])
-def test_help_and_flag_errors_import_no_solver(argv):
+SOLVERS = ("dolfinx", "mpi4py.MPI", "petsc4py.PETSc")
+
+
+@pytest.mark.parametrize(("argv", "not_imported"), [
+    (["--help"], (*SOLVERS, "scipy")),
+    (["steady", "block", "--mu-max", "x", "--out", "o"], (*SOLVERS, "scipy")),
+    (["stability", "--help"], (*SOLVERS, "scipy")),
+    (["oscillator", "belt"], (*SOLVERS, "scipy")),
+    # checking a reading loads the slider's model (NumPy, SciPy) but no solver
+    (["oscillator", "mdof", "--reading", "nope", "--out", "o"], SOLVERS)])
+def test_help_and_flag_errors_import_no_solver(argv, not_imported):
     """``--help`` and a flag error are answered by argparse alone: neither MPI, PETSc nor
     dolfinx is imported (each costs tenths of a second), so they return at once."""
     script = ("import sys\nfrom fenicsfriction.cli import main\ntry:\n"
               f"    main({argv!r})\nexcept SystemExit as stop:\n    code = stop.code\n"
-              "print([m for m in ('dolfinx', 'mpi4py.MPI', 'petsc4py.PETSc', 'scipy') "
-              "if m in sys.modules], code)")
+              f"print([m for m in {not_imported!r} if m in sys.modules], code)")
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
                           timeout=60)
     assert done.stdout.splitlines()[-1] == f"[] {0 if '--help' in argv else 2}", done.stderr

@@ -47,7 +47,9 @@ import scipy.linalg
 
 from fenicsfriction import laws
 from fenicsfriction.laws import check, check_positive
-from fenicsfriction.reduced.slider import stability
+
+if typing.TYPE_CHECKING:
+    from fenicsfriction.reduced.slider import stability
 
 __all__ = ["Contact", "FrictionLaw", "ScaledFriction", "Slider"]
 
@@ -283,10 +285,14 @@ class Slider:
 
     def averaged(self) -> stability.AveragedStability:
         """First-order averaging (:func:`~fenicsfriction.reduced.slider.stability.averaged`)."""
+        from fenicsfriction.reduced.slider import stability  # MPI/PETSc: only when asked
+
         return stability.averaged(self)
 
     def floquet(self, rtol: float = 1e-10, atol: float = 1e-12,
                 prefix: str = "floquet_") -> stability.FloquetStability:
         """Floquet multipliers over one forcing period
         (:func:`~fenicsfriction.reduced.slider.stability.floquet`)."""
+        from fenicsfriction.reduced.slider import stability
+
         return stability.floquet(self, rtol=rtol, atol=atol, prefix=prefix)
