@@ -69,7 +69,8 @@ def interface_split(jacobian: ufl.Form, u: fem.Function
         return None
     if any(i.integral_type() != "exterior_facet" for i in varying):
         return None
-    return ufl.Form(constant), varying
+    # expanded, so that u (inside the derivative nodes) no longer appears in the bulk's inputs
+    return ufl.algorithms.expand_derivatives(ufl.Form(constant)), varying
 
 
 def _interface_dofs(V: fem.FunctionSpace, integrals: list) -> np.ndarray:

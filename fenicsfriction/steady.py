@@ -28,6 +28,7 @@ from petsc4py import PETSc
 
 import dolfinx.fem.petsc
 import numpy as np
+import ufl
 from dolfinx import fem
 
 from fenicsfriction import _compat
@@ -158,10 +159,15 @@ class SteadySolver:
             pc.setPythonContext(self.condensation)
             # the bulk's Jacobian is constant: assembled once, the interface at each iteration
             self._a_interface = _compat.form(self.condensation.interface_form, jit_cache_dir)
-            a_bulk = _compat.form(self.condensation.bulk_form, jit_cache_dir)
+            self._a_bulk = _compat.form(self.condensation.bulk_form, jit_cache_dir)
+            # what the bulk depends on besides u (constants, fields): a change of any of them
+            # (a continued bulk parameter) re-assembles the bulk and refactorises it
+            bulk_form = self.condensation.bulk_form
+            self._bulk_inputs = [*ufl.algorithms.analysis.extract_constants(bulk_form),
+                                 *ufl.algorithms.analysis.extract_coefficients(bulk_form)]
             assemble_jacobian(self.A, self.a, residual.bcs, residual.springs)  # full pattern
             self._bulk = self.A.duplicate(copy=True)  # so the copy in _J keeps it
-            assemble_jacobian(self._bulk, a_bulk, residual.bcs, residual.springs)
+            self._assemble_bulk()
         else:
             self.condensation = None
         self.convergence = RoundoffConvergence(self.snes, roundoff_safety)
@@ -176,11 +182,24 @@ class SteadySolver:
         self._update(x)
         assemble_residual(b, self.L, self.a, self.residual.bcs, x, self.residual.springs)
 
+    def _bulk_values(self) -> list[np.ndarray]:
+        return [np.array(c.value if hasattr(c, "value") else c.x.array)
+                for c in self._bulk_inputs]
+
+    def _assemble_bulk(self) -> None:
+        assemble_jacobian(self._bulk, self._a_bulk, self.residual.bcs, self.residual.springs)
+        self._bulk_state = self._bulk_values()
+
     def _J(self, snes, x, A, P):
         if (self.condensation is not None
                 and snes.getKSP().getIterationNumber() > REFACTORISE_AFTER_ITERATIONS):
             self.condensation.stale = True
         if self._bulk is not None:
+            if any(not np.array_equal(a, b)
+                   for a, b in zip(self._bulk_values(), self._bulk_state, strict=True)):
+                self._assemble_bulk()
+                assert self.condensation is not None
+                self.condensation.stale = True
             assemble_jacobian(A, self._a_interface, self.residual.bcs, base=self._bulk)
         else:
             assemble_jacobian(A, self.a, self.residual.bcs, self.residual.springs)

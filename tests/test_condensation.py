@@ -50,3 +50,30 @@ def test_condensed_newton_matches_sparse_lu_with_one_factorisation():
     diff.axpy(-1.0, x_lu)
     assert diff.norm() <= 1e-8 * x_lu.norm()
     assert solver.condensation.factorisations == 1
+
+
+def test_a_changed_bulk_parameter_is_seen_by_the_condensed_solver():
+    """A bulk term with a parameter (an elastic foundation k u in the block) is constant in u,
+    so it is condensed; changing k between solves must re-assemble and refactorise the bulk and
+    give the LU's state, not a Newton that stalls on a stale bulk."""
+    from dolfinx import fem
+
+    states = {}
+    for condense in (False, True):
+        model = ff.BlockOnBelt(refine=2).build(MPI.COMM_WORLD, with_friction=True)
+        k = fem.Constant(model.msh, 0.01)
+        R = model.residual
+        R.form = R.form + model.thickness * k * ufl.inner(R.u, R.v) * ufl.dx
+        model.initial_guess()
+        solver = ff.SteadySolver(R, prefix=f"bulk{int(condense)}_",
+                                 options=model.solver_options(), condense=condense)
+        ff.continuation(solver, model.mu, [0.2, 0.4])
+        k.value = 0.02  # the foundation twice as stiff: the spring force changes by ~1/3
+        report = solver.solve()
+        states[condense] = (petsc_vec(R.u).copy(), report.iterations, solver)
+    (x_lu, its_lu, _), (x_c, its_c, condensed) = states[False], states[True]
+    assert condensed.condensation.factorisations == 2
+    assert its_c == its_lu
+    diff = x_c.copy()
+    diff.axpy(-1.0, x_lu)
+    assert diff.norm() <= 1e-8 * x_lu.norm()
