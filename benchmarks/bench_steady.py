@@ -44,7 +44,6 @@ from petsc4py import PETSc
 import numpy as np
 from _common import parser as benchmark_parser
 from _common import save
-from dolfinx import geometry
 
 import fenicsfriction as ff
 from fenicsfriction import _compat
@@ -67,9 +66,7 @@ class BaseProbe:
         self.num_points = num_points
         points = np.zeros((num_points, 3))
         points[:, 0] = np.linspace(0.0, model.scene.L, num_points)
-        tree = geometry.BoundingBoxTree(msh, msh.topology.dim)
-        colliding = geometry.compute_colliding_cells(
-            msh, geometry.compute_collisions(tree, points), points)
+        colliding = _compat.colliding_cells(msh, points)
         self.found = np.array([i for i in range(num_points) if len(colliding.links(i))],
                               dtype=np.int32)
         self.cells = np.array([colliding.links(i)[0] for i in self.found], dtype=np.int32)

@@ -16,10 +16,11 @@ from petsc4py import PETSc
 import dolfinx.fem.petsc
 import numpy as np
 import ufl
-from dolfinx import fem, mesh
+from dolfinx import fem, geometry, mesh
 
 __all__ = [
     "assemble_matrix_into",
+    "colliding_cells",
     "create_box",
     "evaluate_expression",
     "create_rectangle",
@@ -65,6 +66,19 @@ def create_box(comm: MPI.Comm, corner0: typing.Sequence[float], corner1: typing.
     points = [np.asarray(corner0, dtype=float), np.asarray(corner1, dtype=float)]
     return mesh.create_box(comm=comm, points=points, n=list(n),
                            cell_type=mesh.CellType.hexahedron)
+
+
+def colliding_cells(msh: mesh.Mesh, points: np.ndarray) -> typing.Any:
+    """The local cells containing each point (``points``: shape (n, 3)), as an AdjacencyList
+    (``links(i)``: the cells of point i, empty if it is off this rank's part of the mesh), for
+    ``Function.eval``. ``BoundingBoxTree`` and ``compute_collisions`` became ``bb_tree`` and
+    ``compute_collisions_points`` in 0.7."""
+    tdim = msh.topology.dim
+    if hasattr(geometry, "bb_tree"):
+        candidates = geometry.compute_collisions_points(geometry.bb_tree(msh, tdim), points)
+    else:
+        candidates = geometry.compute_collisions(geometry.BoundingBoxTree(msh, tdim), points)
+    return geometry.compute_colliding_cells(msh, candidates, points)
 
 
 def interpolation_points(V: fem.FunctionSpace) -> np.ndarray:
