@@ -17,7 +17,7 @@ The same problem in both (Martins & Oden's 1986 block on a belt, plane strain, Î
   (:class:`fenicsfriction.petsc_options.RoundoffConvergence`), atol = 1e-10 Ã— the weight.
 
 fenicsfriction is timed with its defaults (the bulk condensed onto the contact interface,
-the secant predictor) and with the LU-per-iteration path (``condense=False``, no predictor:
+the secant predictor) and with the LU-per-iteration path (``linear_solver="lu"``, no predictor:
 the same algorithm as the GetFEM loop). GetFEM runs in a subprocess: both libraries link
 MUMPS, and two copies of its symbols in one process are not safe. Timings exclude each side's
 set-up (mesh, compiled forms; reported apart) and are the best of ``--repeats``; the
@@ -137,7 +137,7 @@ def fenicsfriction_run(refine: int, repeats: int) -> dict:
     model = ff.BlockOnBelt(refine=refine).build(MPI.COMM_SELF, with_friction=True)
     default = ff.SteadySolver(model.residual, prefix=f"gf{refine}_",
                               options=model.solver_options())
-    lu = ff.SteadySolver(model.residual, prefix=f"gflu{refine}_", condense=False,
+    lu = ff.SteadySolver(model.residual, prefix=f"gflu{refine}_", linear_solver="lu",
                          options={**model.solver_options(), "ksp_type": "preonly",
                                   "pc_type": "lu"})
     setup = time.perf_counter() - t0

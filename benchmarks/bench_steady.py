@@ -8,7 +8,7 @@ mesh for each refinement factor r (default 1, 2, 4, 8). For every mesh it record
   apart from the solve time (the sum of the continuation's per-step wall times, best of 3
   runs of the whole continuation);
 * Newton iterations per μ step;
-* the same continuation by the LU-per-iteration path (``condense=False``, sparse LU at every
+* the same continuation by the LU-per-iteration path (``linear_solver="lu"``, sparse LU at every
   Newton iteration, each step started from the last state: the package's solver before the
   bulk was condensed onto the interface and the secant predictor added), timed in the same
   run; *speed-up* is its time over the default solver's;
@@ -137,7 +137,7 @@ def run_mesh(refine: int, comm: MPI.Comm) -> dict:
     # from the last state (the package's solver before the condensation and the predictor)
     direct = ff.SteadySolver(model.residual, prefix=f"d{refine}_",
                              options={**model.solver_options(), "ksp_type": "preonly",
-                                      "pc_type": "lu"}, jit_cache_dir=cache, condense=False)
+                                      "pc_type": "lu"}, jit_cache_dir=cache, linear_solver="lu")
 
     def best_of(run_solver: ff.SteadySolver, predictor: str, repeats: int) -> tuple:
         attempts = []

@@ -50,6 +50,9 @@ __all__ = ["InterfaceCondensation", "condensation_for", "interface_split"]
 #: columns of K_IΓ solved for at once when C is formed (multiple right-hand sides)
 BLOCK_COLUMNS = 64
 
+#: a Krylov count above this makes the condensation factorise the bulk anew (exact, it takes 1)
+REFACTORISE_AFTER_ITERATIONS = 5
+
 
 def interface_split(jacobian: ufl.Form, u: fem.Function
                     ) -> tuple[ufl.Form, list[ufl.classes.Integral]] | None:
@@ -104,10 +107,8 @@ class InterfaceCondensation:
         size: |Γ|, the number of interface dofs.
         setup_time_s: time spent factorising K_II and forming C.
         factorisations: how many times K_II was factorised.
-        stale: set to factorise anew at the next set-up (the solver does it when the Krylov
-            count says the bulk no longer matches).
-        bulk_form, interface_form: the Jacobian's constant integrals and the others (UFL),
-            so that a solver can assemble the bulk once and the interface at each iteration.
+        stale: set to factorise anew at the next set-up (the solver does it when the bulk
+            changed, :meth:`krylov_count` when the Krylov count says it no longer matches).
     """
 
     def __init__(self, interface: np.ndarray, comm: MPI.Comm, prefix: str = ""):
@@ -122,8 +123,6 @@ class InterfaceCondensation:
         self.setup_time_s = 0.0
         self.stale = False
         self._lu: tuple | None = None
-        self.bulk_form: ufl.Form | None = None
-        self.interface_form: ufl.Form | None = None
 
     def _index_sets(self, J: PETSc.Mat) -> None:
         lo, hi = J.getOwnershipRange()
@@ -188,6 +187,12 @@ class InterfaceCondensation:
         dense.destroy()
         return np.vstack(self.comm.allgather(rows))
 
+    def krylov_count(self, iterations: int) -> None:
+        """Told the Krylov count of the last Newton iteration: more than one means the bulk no
+        longer matches its factorisation, so factorise anew."""
+        if iterations > REFACTORISE_AFTER_ITERATIONS:
+            self.stale = True
+
     # --- PCPYTHON interface -------------------------------------------------------------------
     def setUp(self, pc: PETSc.PC) -> None:  # petsc4py's name
         J = pc.getOperators()[0]
@@ -221,21 +226,13 @@ class InterfaceCondensation:
             v.destroy()
 
 
-def condensation_for(residual_jacobian: ufl.Form, u: fem.Function, prefix: str = "",
-                     max_interface: int = 6000
-                     ) -> InterfaceCondensation | None:
-    """The condensation of a Jacobian, or ``None`` where it does not apply (the Jacobian does
-    not split into a constant bulk and facet terms, or Γ has more than ``max_interface`` dofs,
-    beyond which the dense |Γ|² work outweighs a sparse factorisation)."""
-    split = interface_split(residual_jacobian, u)
-    if split is None:
-        return None
-    bulk, varying = split
-    V = u.function_space
-    interface = _interface_dofs(V, varying)
+def condensation_for(split: tuple[ufl.Form, list], V: fem.FunctionSpace, prefix: str = "",
+                     max_interface: int = 6000) -> InterfaceCondensation | None:
+    """The condensation of a Jacobian split by :func:`interface_split`, or ``None`` where Γ has
+    more than ``max_interface`` dofs, beyond which the dense |Γ|² work outweighs a sparse
+    factorisation."""
+    interface = _interface_dofs(V, split[1])
     comm = V.mesh.comm
     if comm.allreduce(len(interface)) > max_interface:
         return None
-    condensation = InterfaceCondensation(interface, comm, prefix)
-    condensation.bulk_form, condensation.interface_form = bulk, ufl.Form(varying)
-    return condensation
+    return InterfaceCondensation(interface, comm, prefix)

@@ -1,12 +1,15 @@
 r"""Problem 2, steady sliding: :math:`R(u_0, 0, 0; v) = 0` solved with PETSc SNES.
 
-Defaults: Newton with backtracking line search (``newtonls``/``bt``). Its linear systems are
-solved by condensing the linear elastic bulk onto the nonlinear contact interface
-(:mod:`fenicsfriction.condensation`: one MUMPS factorisation of the bulk for a whole
-continuation, a small dense system per iteration) wherever the Jacobian splits so, and by a
-MUMPS LU per iteration otherwise. Every option can be changed through the PETSc options
-database under the solver's prefix (default ``steady_``), e.g. ``-steady_snes_rtol 1e-12``, or
-``-steady_ksp_type preonly -steady_pc_type lu`` for the LU at every iteration.
+Defaults: Newton with backtracking line search (``newtonls``/``bt``). Where the Jacobian
+splits into a constant (linear elastic) bulk and a nonlinear contact interface, its linear
+systems are solved without a factorisation per iteration (``linear_solver``): small interfaces
+by condensing the bulk onto them (:mod:`fenicsfriction.condensation`: one MUMPS factorisation
+and one dense Schur complement for a whole continuation, a small dense system per iteration),
+large ones (3D) by flexible GMRES preconditioned with a factorisation kept across iterations
+and steps (:mod:`fenicsfriction.reused_lu`); elsewhere by a MUMPS LU per iteration. Every
+option can be changed through the PETSc options database under the solver's prefix (default
+``steady_``), e.g. ``-steady_snes_rtol 1e-12``, or ``-steady_ksp_type preonly -steady_pc_type
+lu`` for the LU at every iteration.
 
 Drivers on top of one solve (Martins & Oden 1986, "NINCT increments"):
 
@@ -33,10 +36,15 @@ from dolfinx import fem
 
 from fenicsfriction import _compat
 from fenicsfriction.assembly import assemble_jacobian, assemble_residual
-from fenicsfriction.condensation import condensation_for
+from fenicsfriction.condensation import (
+    InterfaceCondensation,
+    condensation_for,
+    interface_split,
+)
 from fenicsfriction.forms import Residual
 from fenicsfriction.laws import check
 from fenicsfriction.petsc_options import RoundoffConvergence, options_with_defaults
+from fenicsfriction.reused_lu import ReusedFactorisation
 
 __all__ = ["ContinuationError", "SolveError", "SolveReport", "SteadySolver", "continuation",
            "epsilon_sequence"]
@@ -53,19 +61,27 @@ DEFAULT_OPTIONS = {
     "pc_factor_mat_solver_type": "mumps",
 }
 
-#: defaults when the linear bulk is condensed onto the interface (see
-#: :mod:`fenicsfriction.condensation`): flexible GMRES (right preconditioning, so the test is
-#: on the true residual, and no extra preconditioner application to form the solution) with
-#: the condensed inverse; it stops after one iteration while the split holds
-CONDENSED_OPTIONS = {
+#: defaults when Newton's systems are preconditioned by a factorisation that outlives the
+#: iteration (the condensed bulk or the reused LU): flexible GMRES (right preconditioning, so
+#: the test is on the true residual, and no extra preconditioner application to form the
+#: solution); with the condensation it stops after one iteration while the split holds
+KRYLOV_OPTIONS = {
     "ksp_type": "fgmres",
     "ksp_rtol": 1e-8,
     "ksp_max_it": 200,
     "pc_type": "python",
 }
 
-#: a GMRES count above this makes the condensation factorise K0 anew at the next iteration
-REFACTORISE_AFTER_ITERATIONS = 5
+#: the choices of ``SteadySolver(linear_solver=...)``
+LINEAR_SOLVERS = ("auto", "condensed", "reused-lu", "lu")
+
+#: ``"auto"`` condenses the bulk onto the interface Γ while its dense Schur complement holds
+#: at most this fraction of the Jacobian's nonzeros, |Γ|² <= f nnz(J), and reuses an LU beyond.
+#: Forming the complement costs about one solve per interface dof, the reused LU a few solves
+#: per Newton iteration. On the block's 2D meshes |Γ|² is 0.08-0.1 nnz(J) and condensing is 2x
+#: faster (99,202 dofs); on its 3D meshes |Γ|² is 0.14 nnz(J) (945 dofs) to 0.55 (135,975) and
+#: from 0.3 (18,525 dofs) the reused LU is the faster (docs/benchmarks.md)
+AUTO_CONDENSE_MAX_FILL = 0.2
 
 
 class SolveError(RuntimeError):
@@ -114,40 +130,60 @@ class SteadySolver:
             large when a soft spring carries a large rigid displacement); 0 disables it. The
             bound over-estimates the floor Newton actually reaches by 10-100x on the block
             (e.g. 7e-4 against 5e-6 on the 32x24 mesh), so a factor 1 is safe.
-        condense: solve Newton's linear systems by condensing the linear bulk onto the
+        linear_solver: how Newton's linear systems are solved (one of
+            :data:`LINEAR_SOLVERS`). ``"condensed"``: the linear bulk condensed onto the
             nonlinear interface (one factorisation of the bulk for the whole continuation,
-            :mod:`fenicsfriction.condensation`) rather than by a sparse LU per iteration.
-            ``True`` (default): wherever the Jacobian splits so (else the sparse LU);
-            ``False``: never. A PC chosen in the PETSc options (``-<prefix>pc_type lu``) also
-            switches it off. On the block's continuation it is 3-4x faster than the LU from
-            1.6e3 dofs up (docs/benchmarks.md).
+            :mod:`fenicsfriction.condensation`), where the Jacobian splits so (else the sparse
+            LU); ``"reused-lu"``: flexible GMRES preconditioned by the LU of an earlier
+            iteration's Jacobian, renewed when the Krylov count grows
+            (:mod:`fenicsfriction.reused_lu`); ``"lu"``: a sparse LU at every iteration;
+            ``"auto"`` (default): condensed while the dense Schur complement is small against
+            the Jacobian (:data:`AUTO_CONDENSE_MAX_FILL`: in 2D), the reused LU beyond (3D),
+            the LU where the Jacobian does not split. A PC chosen
+            in the PETSc options (``-<prefix>pc_type lu``) overrides it. Where the Jacobian
+            splits, the first two assemble the constant bulk once and only the interface at
+            each iteration (docs/benchmarks.md has what each costs).
 
     Attributes:
         snes: the PETSc SNES, exposed for monitoring or further configuration.
         L, a: the compiled residual and Jacobian forms.
+        linear_solver: the choice in effect (``"auto"`` resolved).
+        preconditioner: the ``PCPYTHON`` context of the first two choices (``None`` for the
+            LU); ``condensation`` is it when it condenses, else ``None``.
     """
 
     def __init__(self, residual: Residual, prefix: str = "steady_",
                  options: dict | None = None, jit_cache_dir: str | None = None,
-                 roundoff_safety: float = 1.0, condense: bool = True):
+                 roundoff_safety: float = 1.0, linear_solver: str = "auto"):
+        check("linear_solver", linear_solver, linear_solver in LINEAR_SOLVERS,
+              f"use one of {', '.join(LINEAR_SOLVERS)}")
         self.residual = residual
         self.u = residual.u
         t0 = time.perf_counter()
         self.L = _compat.form(residual.steady(), jit_cache_dir)
-        self.a = _compat.form(residual.steady_jacobian(), jit_cache_dir)
+        self.a_ufl = residual.steady_jacobian()
+        self.a = _compat.form(self.a_ufl, jit_cache_dir)
         self.jit_time_s = time.perf_counter() - t0
         self.b = dolfinx.fem.petsc.create_vector(self.L)
         self.A = dolfinx.fem.petsc.create_matrix(self.a)
         self.x = self.b.duplicate()
         comm = self.u.function_space.mesh.comm
-        self.condensation = None
-        if condense:
-            self.condensation = condensation_for(residual.steady_jacobian(), self.u, prefix)
+        split = None if linear_solver == "lu" else interface_split(self.a_ufl, self.u)
+        self.preconditioner: InterfaceCondensation | ReusedFactorisation | None = None
+        if split is not None and linear_solver in ("auto", "condensed"):
+            nonzeros = self.A.getInfo(PETSc.Mat.InfoType.GLOBAL_SUM)["nz_allocated"]
+            self.preconditioner = condensation_for(
+                split, self.u.function_space, prefix,
+                **({"max_interface": int(np.sqrt(AUTO_CONDENSE_MAX_FILL * nonzeros))}
+                   if linear_solver == "auto" else {}))
+        if linear_solver == "reused-lu" or (linear_solver == "auto" and split is not None
+                                             and self.preconditioner is None):
+            self.preconditioner = ReusedFactorisation(comm, prefix)
         self.snes = PETSc.SNES().create(comm)
         self.snes.setOptionsPrefix(prefix)
         self.snes.setFunction(self._F, self.b)
         self.snes.setJacobian(self._J, self.A)
-        defaults = {**DEFAULT_OPTIONS, **(CONDENSED_OPTIONS if self.condensation else {}),
+        defaults = {**DEFAULT_OPTIONS, **(KRYLOV_OPTIONS if self.preconditioner else {}),
                     **(options or {})}
         with options_with_defaults(prefix, defaults):
             self.snes.setFromOptions()
@@ -155,21 +191,26 @@ class SteadySolver:
             self.snes.getKSP().getPC().setFromOptions()
         pc = self.snes.getKSP().getPC()
         self._bulk = None
-        if self.condensation is not None and pc.getType() == "python":
-            pc.setPythonContext(self.condensation)
+        if self.preconditioner is not None and pc.getType() == "python":
+            pc.setPythonContext(self.preconditioner)
+            self.linear_solver = ("condensed" if isinstance(self.preconditioner,
+                                                           InterfaceCondensation)
+                                  else "reused-lu")
+        else:
+            self.preconditioner = None
+            self.linear_solver = "lu"
+        if self.preconditioner is not None and split is not None:
             # the bulk's Jacobian is constant: assembled once, the interface at each iteration
-            self._a_interface = _compat.form(self.condensation.interface_form, jit_cache_dir)
-            self._a_bulk = _compat.form(self.condensation.bulk_form, jit_cache_dir)
+            bulk_form, interface = split
+            self._a_interface = _compat.form(ufl.Form(interface), jit_cache_dir)
+            self._a_bulk = _compat.form(bulk_form, jit_cache_dir)
             # what the bulk depends on besides u (constants, fields): a change of any of them
-            # (a continued bulk parameter) re-assembles the bulk and refactorises it
-            bulk_form = self.condensation.bulk_form
+            # (a continued bulk parameter) re-assembles the bulk and refactorises
             self._bulk_inputs = [*ufl.algorithms.analysis.extract_constants(bulk_form),
                                  *ufl.algorithms.analysis.extract_coefficients(bulk_form)]
             assemble_jacobian(self.A, self.a, residual.bcs, residual.springs)  # full pattern
             self._bulk = self.A.duplicate(copy=True)  # so the copy in _J keeps it
             self._assemble_bulk()
-        else:
-            self.condensation = None
         self.convergence = RoundoffConvergence(self.snes, roundoff_safety)
         self.snes.setConvergenceTest(self.convergence)
 
@@ -190,16 +231,21 @@ class SteadySolver:
         assemble_jacobian(self._bulk, self._a_bulk, self.residual.bcs, self.residual.springs)
         self._bulk_state = self._bulk_values()
 
+    @property
+    def condensation(self) -> InterfaceCondensation | None:
+        """The condensation in use, if the bulk is condensed onto the interface."""
+        condensed = isinstance(self.preconditioner, InterfaceCondensation)
+        return typing.cast(InterfaceCondensation, self.preconditioner) if condensed else None
+
     def _J(self, snes, x, A, P):
-        if (self.condensation is not None
-                and snes.getKSP().getIterationNumber() > REFACTORISE_AFTER_ITERATIONS):
-            self.condensation.stale = True
+        if self.preconditioner is not None:
+            self.preconditioner.krylov_count(snes.getKSP().getIterationNumber())
         if self._bulk is not None:
             if any(not np.array_equal(a, b)
                    for a, b in zip(self._bulk_values(), self._bulk_state, strict=True)):
                 self._assemble_bulk()
-                assert self.condensation is not None
-                self.condensation.stale = True
+                assert self.preconditioner is not None
+                self.preconditioner.stale = True
             assemble_jacobian(A, self._a_interface, self.residual.bcs, base=self._bulk)
         else:
             assemble_jacobian(A, self.a, self.residual.bcs, self.residual.springs)

@@ -14,11 +14,11 @@ from fenicsfriction.condensation import interface_split
 MU = np.linspace(0.0, 1.2, 9)
 
 
-def _continuation(condense: bool, refine: int = 2):
+def _continuation(linear_solver: str, refine: int = 2):
     model = ff.BlockOnBelt(refine=refine).build(MPI.COMM_WORLD, with_friction=True)
     model.initial_guess()
-    solver = ff.SteadySolver(model.residual, prefix=f"cond{int(condense)}_",
-                             options=model.solver_options(), condense=condense)
+    solver = ff.SteadySolver(model.residual, prefix=f"cond{linear_solver.replace('-', '')}_",
+                             options=model.solver_options(), linear_solver=linear_solver)
     records = ff.continuation(solver, model.mu, MU, observe=model.quantities)
     return model, solver, records
 
@@ -35,8 +35,8 @@ def test_jacobian_splits_into_constant_bulk_and_contact_facets():
 
 
 def test_condensed_newton_matches_sparse_lu_with_one_factorisation():
-    model_lu, _, lu = _continuation(False)
-    model_c, solver, condensed = _continuation(True)
+    model_lu, _, lu = _continuation("lu")
+    model_c, solver, condensed = _continuation("condensed")
     assert solver.condensation is not None, "the block's Jacobian must split"
     assert solver.condensation.size == 2 * (2 * 4 * 2 + 1)  # both components of the base nodes
     # Newton sees the same linear systems (solved to 1e-8 relative): same iteration counts
@@ -60,13 +60,14 @@ def test_a_changed_bulk_parameter_is_seen_by_the_condensed_solver():
 
     states = {}
     for condense in (False, True):
+        linear_solver = "condensed" if condense else "lu"
         model = ff.BlockOnBelt(refine=2).build(MPI.COMM_WORLD, with_friction=True)
         k = fem.Constant(model.msh, 0.01)
         R = model.residual
         R.form = R.form + model.thickness * k * ufl.inner(R.u, R.v) * ufl.dx
         model.initial_guess()
         solver = ff.SteadySolver(R, prefix=f"bulk{int(condense)}_",
-                                 options=model.solver_options(), condense=condense)
+                                 options=model.solver_options(), linear_solver=linear_solver)
         ff.continuation(solver, model.mu, [0.2, 0.4])
         k.value = 0.02  # the foundation twice as stiff: the spring force changes by ~1/3
         report = solver.solve()
