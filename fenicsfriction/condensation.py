@@ -45,6 +45,8 @@ import scipy.linalg
 import ufl
 from dolfinx import fem, mesh
 
+from fenicsfriction import mumps_schur
+
 __all__ = ["InterfaceCondensation", "condensation_for", "interface_split"]
 
 #: columns of K_IΓ solved for at once when C is formed (multiple right-hand sides)
@@ -106,7 +108,12 @@ class InterfaceCondensation:
     Attributes:
         size: |Γ|, the number of interface dofs.
         setup_time_s: time spent factorising K_II and forming C.
-        factorisations: how many times K_II was factorised.
+        factorisations: how many times the bulk was factorised.
+        whole: serial with MUMPS: J itself is factorised with Γ last, MUMPS's Schur complement
+            gives C, and each Newton system is one solve with that factor (its Schur
+            complement replaced by J_ΓΓ(u) − C); otherwise K_II is factorised and C formed by
+            MUMPS's Schur complement of J centralised on rank 0 (or, with another LU package,
+            by one solve per interface dof).
         stale: set to factorise anew at the next set-up (the solver does it when the bulk
             changed, :meth:`krylov_count` when the Krylov count says it no longer matches).
     """
@@ -123,6 +130,7 @@ class InterfaceCondensation:
         self.setup_time_s = 0.0
         self.stale = False
         self._lu: tuple | None = None
+        self.whole = False
 
     def _index_sets(self, J: PETSc.Mat) -> None:
         lo, hi = J.getOwnershipRange()
@@ -132,7 +140,7 @@ class InterfaceCondensation:
             np.setdiff1d(owned, self.interface, assume_unique=True).astype(PETSc.IntType),
             comm=self.comm)
 
-    # --- the one-off part: K_II, its factorisation, C -----------------------------------------
+    # --- the one-off part: the factorisation and C ---------------------------------------------
     def _factorise(self, J: PETSc.Mat) -> None:
         t0 = time.perf_counter()
         if self.ksp is None:
@@ -144,17 +152,59 @@ class InterfaceCondensation:
             pc.setType("lu")
             pc.setFactorSolverType("mumps")
             self.ksp.setFromOptions()
-        self.K_II = J.createSubMatrix(self.is_inner, self.is_inner)
-        self.K_IG = J.createSubMatrix(self.is_inner, self.is_gamma)
-        self.K_GI = J.createSubMatrix(self.is_gamma, self.is_inner)
-        self.ksp.setOperators(self.K_II)
-        self.ksp.setUp()
+            self._mumps_schur = (mumps_schur.available()
+                                 and pc.getFactorSolverType() == "mumps")
+            self.whole = self._mumps_schur and self.comm.size == 1
+            if self.whole:
+                self.ksp.setOperators(J)
+                pc.setFactorSetUpSolverType()  # the factor exists before the factorisation
+                mumps_schur.set_schur_indices(pc.getFactorMatrix(), self.is_gamma)
+        pc = self.ksp.getPC()
+        if self.whole:
+            pc.setReusePreconditioner(False)  # factorise J as it is now, Γ last (KSPSetUp
+            self.ksp.setOperators(J)  # does nothing unless handed the operators anew)
+            self.ksp.setUp()
+            pc.setReusePreconditioner(True)  # and keep it while J changes under it
+            with mumps_schur.schur_complement(pc.getFactorMatrix()) as S:
+                self.C = self._gather_gamma(J) - S
+        else:
+            self.K_II = J.createSubMatrix(self.is_inner, self.is_inner)
+            self.K_IG = J.createSubMatrix(self.is_inner, self.is_gamma)
+            self.K_GI = J.createSubMatrix(self.is_gamma, self.is_inner)
+            self.ksp.setOperators(self.K_II)
+            self.ksp.setUp()
+            self.C = self._centralised_schur(J) if self._mumps_schur else self._bulk_schur(J)
         self.factorisations += 1
-        self.C = self._bulk_schur(J)
         self.setup_time_s += time.perf_counter() - t0
 
+    def _centralised_schur(self, J: PETSc.Mat) -> np.ndarray:
+        """C from MUMPS's Schur complement of J with Γ on rank 0 (a second, parallel
+        factorisation, dropped afterwards: PETSc solves with a Schur factor in serial only),
+        broadcast to every rank."""
+        ksp = PETSc.KSP().create(self.comm)
+        ksp.setOptionsPrefix(f"{self.prefix}condensed_")
+        ksp.setType("preonly")
+        pc = ksp.getPC()
+        pc.setType("lu")
+        pc.setFactorSolverType("mumps")
+        ksp.setOperators(J)
+        ksp.setFromOptions()
+        pc.setFactorSetUpSolverType()
+        everything = self.comm.gather(self.interface)
+        on_root = PETSc.IS().createGeneral(
+            np.concatenate(everything).astype(PETSc.IntType) if self.comm.rank == 0
+            else np.empty(0, dtype=PETSc.IntType), comm=self.comm)
+        mumps_schur.set_schur_indices(pc.getFactorMatrix(), on_root)
+        ksp.setUp()
+        with mumps_schur.schur_complement(pc.getFactorMatrix()) as S:
+            schur = self.comm.bcast(S.copy() if self.comm.rank == 0 else None, root=0)
+        ksp.destroy()
+        on_root.destroy()
+        return self._gather_gamma(J) - schur
+
     def _bulk_schur(self, J: PETSc.Mat) -> np.ndarray:
-        """C = K_ΓI K_II⁻¹ K_IΓ, replicated on every rank, BLOCK_COLUMNS columns at a time."""
+        """C = K_ΓI K_II⁻¹ K_IΓ, replicated on every rank, BLOCK_COLUMNS columns at a time: the
+        fallback where MUMPS's Schur complement cannot be had (another LU package)."""
         n = self.size
         C = np.empty((n, n))
         factor = self.ksp.getPC().getFactorMatrix()
@@ -199,9 +249,16 @@ class InterfaceCondensation:
         if self.ksp is None or self.stale:
             self._factorise(J)
             self.stale = False
-        self._lu = scipy.linalg.lu_factor(self._gather_gamma(J) - self.C)
+        if self.whole:  # the factor's own Schur complement becomes J_ΓΓ(u) - C
+            with mumps_schur.schur_complement(self.ksp.getPC().getFactorMatrix()) as S:
+                S[:] = self._gather_gamma(J) - self.C
+        else:
+            self._lu = scipy.linalg.lu_factor(self._gather_gamma(J) - self.C)
 
     def apply(self, pc: PETSc.PC, r: PETSc.Vec, z: PETSc.Vec) -> None:
+        if self.whole:  # MUMPS condenses r onto Γ, PETSc solves with S, MUMPS expands
+            self.ksp.solve(r, z)
+            return
         assert self._lu is not None, "setUp comes first"
         r_I, r_G = r.getSubVector(self.is_inner), r.getSubVector(self.is_gamma)
         y = r_I.duplicate()

@@ -67,12 +67,12 @@ class ReusedFactorisation:
             inner = self.ksp.getPC()
             inner.setType("lu")
             inner.setFactorSolverType("mumps")
-            self.ksp.setOperators(J)
             self.ksp.setFromOptions()
         elif not self.stale:
             return
         inner = self.ksp.getPC()
-        inner.setReusePreconditioner(False)  # factorise J as it is now
+        inner.setReusePreconditioner(False)  # factorise J as it is now (KSPSetUp does
+        self.ksp.setOperators(J)  # nothing unless handed the operators anew)
         self.ksp.setUp()
         inner.setReusePreconditioner(True)  # and keep it while J changes under it
         self.factorisations += 1

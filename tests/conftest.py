@@ -29,3 +29,14 @@ def shared_tmp_path(request) -> pathlib.Path:
     comm = MPI.COMM_WORLD
     path = request.getfixturevalue("tmp_path") if comm.rank == 0 else None
     return pathlib.Path(comm.bcast(path, root=0))
+
+
+@pytest.fixture
+def lu_factorisations():
+    """How many numerical LU factorisations PETSc has made so far (its event log, switched on
+    here): the count a solver's own bookkeeping is checked against."""
+    from petsc4py import PETSc
+
+    PETSc.Log.begin()
+    event = PETSc.Log.Event("MatLUFactorNum")
+    return lambda: event.getPerfInfo()["count"]

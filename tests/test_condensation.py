@@ -2,6 +2,7 @@
 Newton iterates as the sparse LU, with one factorisation for a whole continuation."""
 
 from mpi4py import MPI
+from petsc4py import PETSc
 
 import numpy as np
 import pytest
@@ -34,8 +35,9 @@ def test_jacobian_splits_into_constant_bulk_and_contact_facets():
     assert interface_split(ufl.derivative(nonlinear, u), u) is None
 
 
-def test_condensed_newton_matches_sparse_lu_with_one_factorisation():
+def test_condensed_newton_matches_sparse_lu_with_one_factorisation(lu_factorisations):
     model_lu, _, lu = _continuation("lu")
+    before = lu_factorisations()
     model_c, solver, condensed = _continuation("condensed")
     assert solver.condensation is not None, "the block's Jacobian must split"
     assert solver.condensation.size == 2 * (2 * 4 * 2 + 1)  # both components of the base nodes
@@ -50,6 +52,8 @@ def test_condensed_newton_matches_sparse_lu_with_one_factorisation():
     diff.axpy(-1.0, x_lu)
     assert diff.norm() <= 1e-8 * x_lu.norm()
     assert solver.condensation.factorisations == 1
+    # serial: J with Γ last; in parallel K_II and the Schur complement's J, centralised
+    assert lu_factorisations() - before == (1 if MPI.COMM_WORLD.size == 1 else 2)
 
 
 def test_a_changed_bulk_parameter_is_seen_by_the_condensed_solver():
@@ -78,3 +82,26 @@ def test_a_changed_bulk_parameter_is_seen_by_the_condensed_solver():
     diff = x_c.copy()
     diff.axpy(-1.0, x_lu)
     assert diff.norm() <= 1e-8 * x_lu.norm()
+
+
+def test_without_mumps_the_schur_complement_is_formed_by_solves():
+    """Another LU package (SuperLU_dist) has no Schur complement to give: C is then formed by one
+    solve per interface dof, and Newton takes the same steps as with MUMPS's complement."""
+    _, mumps, with_mumps = _continuation("condensed")
+    model = ff.BlockOnBelt(refine=2).build(MPI.COMM_WORLD, with_friction=True)
+    model.initial_guess()
+    solver = ff.SteadySolver(model.residual, prefix="condslu_", options=model.solver_options(),
+                             linear_solver="condensed")
+    options = PETSc.Options()
+    options["condslu_condensed_pc_factor_mat_solver_type"] = "superlu_dist"  # as a user would
+    try:
+        with_superlu = ff.continuation(solver, model.mu, MU, observe=model.quantities)
+    finally:
+        options.delValue("condslu_condensed_pc_factor_mat_solver_type")
+    assert mumps.condensation._mumps_schur and not solver.condensation._mumps_schur
+    assert not solver.condensation.whole
+    assert ([r["newton_iterations"] for r in with_superlu]
+            == [r["newton_iterations"] for r in with_mumps])
+    for a, b in zip(with_mumps, with_superlu, strict=True):
+        assert b["spring_force"] == pytest.approx(a["spring_force"], rel=1e-9, abs=1e-9)
+        assert b["max_penetration"] == pytest.approx(a["max_penetration"], rel=1e-8)

@@ -32,8 +32,10 @@ def _relative_difference(a, b) -> float:
 
 
 @pytest.mark.parametrize("dim", [2, 3])
-def test_reused_factorisation_gives_the_lu_iterates_with_one_factorisation(dim):
+def test_reused_factorisation_gives_the_lu_iterates_with_one_factorisation(dim,
+                                                                         lu_factorisations):
     model_lu, _, lu = _continuation("lu", f"lu{dim}", refine=1 if dim == 3 else 2, dim=dim)
+    before = lu_factorisations()
     model_r, solver, reused = _continuation("reused-lu", f"r{dim}", refine=1 if dim == 3 else 2,
                                             dim=dim)
     assert solver.linear_solver == "reused-lu"
@@ -48,13 +50,13 @@ def test_reused_factorisation_gives_the_lu_iterates_with_one_factorisation(dim):
                                 petsc_vec(model_r.residual.u)) <= 1e-8
     # the contact stiffness is small against the bulk's: the μ = 0 factorisation preconditions
     # the whole continuation to μ = 1.2 within the renewal threshold
-    assert solver.preconditioner.factorisations == 1
+    assert solver.preconditioner.factorisations == 1 == lu_factorisations() - before
     # and it is the μ = 0 factorisation that is applied (an LU of the current Jacobian would
     # take GMRES one iteration)
     assert solver.snes.getKSP().getIterationNumber() > 1
 
 
-def test_a_growing_krylov_count_renews_the_factorisation():
+def test_a_growing_krylov_count_renews_the_factorisation(lu_factorisations):
     """With a renewal threshold of 2 Krylov iterations the factorisation is renewed along the
     path (the count reaches 3-11 with the μ = 0 factorisation) and the states do not change."""
     _, solver_once, once = _continuation("reused-lu", "once")
@@ -63,8 +65,10 @@ def test_a_growing_krylov_count_renews_the_factorisation():
     solver = ff.SteadySolver(model.residual, prefix="reuserenew_",
                              options=model.solver_options(), linear_solver="reused-lu")
     solver.preconditioner.refactorise_after = 2
+    before = lu_factorisations()
     renewed = ff.continuation(solver, model.mu, MU, observe=model.quantities)
     assert solver.preconditioner.factorisations > 2
+    assert lu_factorisations() - before == solver.preconditioner.factorisations
     assert solver_once.preconditioner.factorisations == 1
     for a, b in zip(once, renewed, strict=True):
         assert b["spring_force"] == pytest.approx(a["spring_force"], rel=1e-9, abs=1e-9)
