@@ -190,9 +190,9 @@ class InterfaceCondensation:
         ksp.setOperators(J)
         ksp.setFromOptions()
         pc.setFactorSetUpSolverType()
-        everything = self.comm.gather(self.interface)
+        everything = self.comm.gather(self.interface)  # Γ on rank 0, in global order
         on_root = PETSc.IS().createGeneral(
-            np.concatenate(everything).astype(PETSc.IntType) if self.comm.rank == 0
+            np.concatenate(everything).astype(PETSc.IntType) if everything is not None
             else np.empty(0, dtype=PETSc.IntType), comm=self.comm)
         mumps_schur.set_schur_indices(pc.getFactorMatrix(), on_root)
         ksp.setUp()
