@@ -1,5 +1,6 @@
 r"""The linear bulk condensed onto the nonlinear interface: a direct solver for Newton's
-systems that factorises once per continuation instead of once per iteration.
+systems that factorises once per continuation instead of once per iteration, for interfaces
+small against the body (2D; :mod:`fenicsfriction.reused_lu` for large ones).
 
 In every scene of the package the body is linear elastic and the nonlinearity lives on the
 contact surface Γ_C (normal compliance, friction). Split the dofs into the few on the facets of
@@ -11,15 +12,23 @@ with the state:
     \end{pmatrix},
 
 whether an integral's Jacobian is constant being decided symbolically, by differentiating it
-once more (:func:`interface_split`). :math:`K_{II}` is factorised once and the Schur complement
-of the bulk, :math:`C = K_{\Gamma I} K_{II}^{-1} K_{I\Gamma}` (|Γ| × |Γ|, dense), is formed once;
-each Newton system is then solved by two triangular solves with :math:`K_{II}` and a dense LU
-of :math:`J_{\Gamma\Gamma}(u) - C`:
+once more (:func:`interface_split`). The Schur complement of the bulk,
+:math:`C = K_{\Gamma I} K_{II}^{-1} K_{I\Gamma}` (|Γ| × |Γ|, dense), is formed once, and each
+Newton system is the bulk's solve with :math:`J_{\Gamma\Gamma}(u) - C` on the interface:
 
 .. math::
     y = K_{II}^{-1} r_I,\quad
     (J_{\Gamma\Gamma} - C)\,\delta_\Gamma = r_\Gamma - K_{\Gamma I} y,\quad
     \delta_I = y - K_{II}^{-1} K_{I\Gamma} \delta_\Gamma.
+
+MUMPS forms C itself (its Schur complement option, :mod:`fenicsfriction.mumps_schur`): the
+Jacobian is factorised once with Γ eliminated last, which leaves
+:math:`J_{\Gamma\Gamma}(u_0) - C` as a by-product. In serial that factor then solves every Newton
+system in one forward and one backward sweep, its dense Schur block replaced by
+:math:`J_{\Gamma\Gamma}(u) - C` and re-factorised by PETSc at each iteration; in parallel (PETSc
+solves with a Schur factor in serial only) C comes from a factorisation with Γ centralised on
+rank 0, and the sweeps above use a separate factorisation of :math:`K_{II}`. With another LU
+package C is formed by one solve per interface dof.
 
 This is static condensation of the elastic body onto its contact surface, the finite element
 counterpart of the influence numbers of boundary-element contact solvers (Kalker 1990). Unlike

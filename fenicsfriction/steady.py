@@ -77,11 +77,12 @@ LINEAR_SOLVERS = ("auto", "condensed", "reused-lu", "lu")
 
 #: ``"auto"`` condenses the bulk onto the interface Γ while its dense Schur complement holds
 #: at most this fraction of the Jacobian's nonzeros, |Γ|² <= f nnz(J), and reuses an LU beyond.
-#: Forming the complement costs about one solve per interface dof, the reused LU a few solves
-#: per Newton iteration. On the block's 2D meshes |Γ|² is 0.08-0.1 nnz(J) and condensing is 2x
-#: faster (99,202 dofs); on its 3D meshes |Γ|² is 0.14 nnz(J) (945 dofs) to 0.55 (135,975) and
-#: from 0.3 (18,525 dofs) the reused LU is the faster (docs/benchmarks.md)
-AUTO_CONDENSE_MAX_FILL = 0.2
+#: MUMPS forms the complement within the factorisation, at a cost that grows with |Γ|² against
+#: the factor; the reused LU costs a few solves per Newton iteration instead. On the block's 2D
+#: meshes |Γ|² is 0.08-0.1 nnz(J) and condensing is 4.6x faster (99,202 dofs); on its 3D meshes
+#: |Γ|² is 0.14 nnz(J) (945 dofs) to 0.55 (135,975): condensing is 1.2-1.3x faster up to 0.30
+#: (18,525 dofs), even at 0.39 (42,075) and slower at 0.55 (docs/benchmarks.md)
+AUTO_CONDENSE_MAX_FILL = 0.45
 
 
 class SolveError(RuntimeError):

@@ -75,15 +75,16 @@ def test_a_growing_krylov_count_renews_the_factorisation(lu_factorisations):
         assert b["max_penetration"] == pytest.approx(a["max_penetration"], rel=1e-8)
 
 
-def test_auto_condenses_in_2d_and_reuses_the_lu_in_3d(monkeypatch):
+def test_auto_condenses_small_interfaces_and_reuses_the_lu_beyond(monkeypatch):
     model = ff.BlockOnBelt(refine=2).build(MPI.COMM_WORLD, with_friction=True)
     small = ff.SteadySolver(model.residual, prefix="autosmall_", options=model.solver_options())
     assert small.linear_solver == "condensed" and small.condensation is not None
-    # 459 interface dofs, 945,945 nonzeros: |Γ|² = 0.22 nnz(J)
+    # 459 interface dofs, 945,945 nonzeros: |Γ|² = 0.22 nnz(J), reused beyond 0.2
+    monkeypatch.setattr(steady, "AUTO_CONDENSE_MAX_FILL", 0.2)
     model3 = ff.BlockOnBelt(refine=2, dim=3).build(MPI.COMM_WORLD, with_friction=True)
     solver3 = ff.SteadySolver(model3.residual, prefix="auto3d_", options=model3.solver_options())
     assert solver3.linear_solver == "reused-lu"
-    # 34 interface dofs, 12,740 nonzeros: |Γ|² = 0.09 nnz(J), condensed up to 0.2
+    # 34 interface dofs, 12,740 nonzeros: |Γ|² = 0.09 nnz(J), reused below that
     monkeypatch.setattr(steady, "AUTO_CONDENSE_MAX_FILL", 0.05)
     large = ff.SteadySolver(model.residual, prefix="autolarge_", options=model.solver_options())
     assert large.linear_solver == "reused-lu" and large.condensation is None
