@@ -163,7 +163,7 @@ def run_mesh(refine: int, comm: MPI.Comm) -> dict:
             "dofs": model.V.dofmap.index_map.size_global * model.V.dofmap.index_map_bs,
             "jit_time_s": comm.allreduce(solver.jit_time_s, op=MPI.MAX),
             "solve_time_s": solve_time,
-            "linear_solver": "condensed" if solver.condensation is not None else "lu",
+            "linear_solver": solver.linear_solver,
             "interface_dofs": None if solver.condensation is None else solver.condensation.size,
             "direct_solve_time_s": direct_time,
             "direct_newton_iterations_total": int(sum(r["newton_iterations"]
