@@ -199,7 +199,7 @@ def steady_state(model, tag: str, comm: MPI.Comm) -> dict:
 
     def solve_and_polish():
         first = solver.solve()
-        solver.snes.setForceIteration(True)
+        solver.convergence.force_iteration = True
         return first, solver.solve()
 
     wall, reports = timed(solve_and_polish, comm)

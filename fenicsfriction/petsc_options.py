@@ -66,12 +66,16 @@ class RoundoffConvergence:
 
     Install with ``snes.setConvergenceTest(test)`` after ``setFromOptions`` and call
     :meth:`jacobian_assembled` from the Jacobian callback. ``atol_used`` is the tolerance of
-    the last test.
+    the last test. ``force_iteration`` (from ``-<prefix>snes_force_iteration``, which PETSc
+    leaves to the convergence test) makes every solve take at least one iteration, e.g. to
+    polish a state accepted at its round-off floor.
     """
 
     def __init__(self, snes: PETSc.SNES, safety: float = 1.0):
         self.safety = safety
         self.rtol, self.atol = snes.getTolerances()[:2]
+        self.force_iteration = PETSc.Options(snes.getOptionsPrefix()).getBool(
+            "snes_force_iteration", False)
         self.atol_used = self.atol
         self._jacobian_norm = 0.0
         self._f0 = np.inf
@@ -90,6 +94,8 @@ class RoundoffConvergence:
             return PETSc.SNES.ConvergedReason.DIVERGED_FNORM_NAN
         if it == 0:
             self._f0 = fnorm
+            if self.force_iteration:
+                return PETSc.SNES.ConvergedReason.ITERATING
         self.atol_used = max(self.atol, self.safety * self.floor(snes.getSolution()))
         if fnorm <= self.atol_used:
             return PETSc.SNES.ConvergedReason.CONVERGED_FNORM_ABS

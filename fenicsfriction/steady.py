@@ -190,6 +190,7 @@ class SteadySolver:
             self.snes.setFromOptions()
             self.snes.getKSP().setFromOptions()
             self.snes.getKSP().getPC().setFromOptions()
+            self.convergence = RoundoffConvergence(self.snes, roundoff_safety)  # reads options
         pc = self.snes.getKSP().getPC()
         self._bulk = None
         if self.preconditioner is not None and pc.getType() == "python":
@@ -212,7 +213,6 @@ class SteadySolver:
             assemble_jacobian(self.A, self.a, residual.bcs, residual.springs)  # full pattern
             self._bulk = self.A.duplicate(copy=True)  # so the copy in _J keeps it
             self._assemble_bulk()
-        self.convergence = RoundoffConvergence(self.snes, roundoff_safety)
         self.snes.setConvergenceTest(self.convergence)
 
     def _update(self, x: PETSc.Vec) -> None:

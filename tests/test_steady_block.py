@@ -362,3 +362,21 @@ def test_failed_epsilon_step_restores_eps_with_the_state():
         ff.epsilon_sequence(solver, model.eps, [0.0008])
     assert float(model.eps.value) == 0.08
     assert np.array_equal(model.residual.u.x.array, u_converged)
+
+
+def test_a_forced_iteration_polishes_a_converged_state():
+    """PETSc leaves -snes_force_iteration to the convergence test: ours must honour it, given as
+    an option of the solver or set on its test, or a state accepted at its round-off floor
+    cannot be polished (the stability benchmark relies on it)."""
+    model = ff.BlockOnBelt(refine=1).build(MPI.COMM_WORLD, with_friction=True)
+    model.mu.value = 0.5
+    model.initial_guess()
+    solver = ff.SteadySolver(model.residual, prefix="force0_", options=model.solver_options())
+    solver.solve()
+    assert solver.solve().iterations == 0  # converged already
+    solver.convergence.force_iteration = True
+    assert solver.solve().iterations == 1
+    forced = ff.SteadySolver(model.residual, prefix="force1_",
+                             options={**model.solver_options(), "snes_force_iteration": True})
+    assert forced.convergence.force_iteration
+    assert forced.solve().iterations == 1
