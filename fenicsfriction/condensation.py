@@ -55,6 +55,7 @@ import ufl
 from dolfinx import fem, mesh
 
 from fenicsfriction import mumps_schur
+from fenicsfriction.reused_lu import factorise_and_keep, lu_solver
 
 __all__ = ["InterfaceCondensation", "condensation_for", "interface_split"]
 
@@ -154,13 +155,8 @@ class InterfaceCondensation:
         t0 = time.perf_counter()
         if self.ksp is None:
             self._index_sets(J)
-            self.ksp = PETSc.KSP().create(self.comm)
-            self.ksp.setOptionsPrefix(f"{self.prefix}condensed_")
-            self.ksp.setType("preonly")
+            self.ksp = lu_solver(self.comm, f"{self.prefix}condensed_")
             pc = self.ksp.getPC()
-            pc.setType("lu")
-            pc.setFactorSolverType("mumps")
-            self.ksp.setFromOptions()
             self._mumps_schur = (mumps_schur.available()
                                  and pc.getFactorSolverType() == "mumps")
             self.whole = self._mumps_schur and self.comm.size == 1
@@ -170,10 +166,7 @@ class InterfaceCondensation:
                 mumps_schur.set_schur_indices(pc.getFactorMatrix(), self.is_gamma)
         pc = self.ksp.getPC()
         if self.whole:
-            pc.setReusePreconditioner(False)  # factorise J as it is now, Γ last (KSPSetUp
-            self.ksp.setOperators(J)  # does nothing unless handed the operators anew)
-            self.ksp.setUp()
-            pc.setReusePreconditioner(True)  # and keep it while J changes under it
+            factorise_and_keep(self.ksp, J)  # Γ last; kept while J changes under it
             with mumps_schur.schur_complement(pc.getFactorMatrix()) as S:
                 self.C = self._gather_gamma(J) - S
         else:
@@ -190,14 +183,9 @@ class InterfaceCondensation:
         """C from MUMPS's Schur complement of J with Γ on rank 0 (a second, parallel
         factorisation, dropped afterwards: PETSc solves with a Schur factor in serial only),
         broadcast to every rank."""
-        ksp = PETSc.KSP().create(self.comm)
-        ksp.setOptionsPrefix(f"{self.prefix}condensed_")
-        ksp.setType("preonly")
-        pc = ksp.getPC()
-        pc.setType("lu")
-        pc.setFactorSolverType("mumps")
+        ksp = lu_solver(self.comm, f"{self.prefix}condensed_")
         ksp.setOperators(J)
-        ksp.setFromOptions()
+        pc = ksp.getPC()
         pc.setFactorSetUpSolverType()
         everything = self.comm.gather(self.interface)  # Γ on rank 0, in global order
         on_root = PETSc.IS().createGeneral(

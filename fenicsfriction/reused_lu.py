@@ -24,10 +24,33 @@ from __future__ import annotations
 from mpi4py import MPI
 from petsc4py import PETSc
 
-__all__ = ["ReusedFactorisation"]
+__all__ = ["ReusedFactorisation", "factorise_and_keep", "lu_solver"]
 
 #: the default Krylov count above which the next Newton iteration factorises anew
 REFACTORISE_AFTER = 12
+
+
+def lu_solver(comm: MPI.Comm, prefix: str) -> PETSc.KSP:
+    """A ``preonly`` KSP with a MUMPS LU under ``prefix``, the options database read."""
+    ksp = PETSc.KSP().create(comm)
+    ksp.setOptionsPrefix(prefix)
+    ksp.setType("preonly")
+    pc = ksp.getPC()
+    pc.setType("lu")
+    pc.setFactorSolverType("mumps")
+    ksp.setFromOptions()
+    return ksp
+
+
+def factorise_and_keep(ksp: PETSc.KSP, A: PETSc.Mat) -> None:
+    """Factorise ``A`` now and keep that factorisation while ``A`` changes under it (KSPSetUp
+    does nothing unless handed the operators anew; the PC's reuse flag holds the factors across
+    later solves)."""
+    pc = ksp.getPC()
+    pc.setReusePreconditioner(False)
+    ksp.setOperators(A)
+    ksp.setUp()
+    pc.setReusePreconditioner(True)
 
 
 class ReusedFactorisation:
@@ -61,20 +84,10 @@ class ReusedFactorisation:
     def setUp(self, pc: PETSc.PC) -> None:  # petsc4py's name
         J = pc.getOperators()[0]
         if self.ksp is None:
-            self.ksp = PETSc.KSP().create(self.comm)
-            self.ksp.setOptionsPrefix(f"{self.prefix}reused_")
-            self.ksp.setType("preonly")
-            inner = self.ksp.getPC()
-            inner.setType("lu")
-            inner.setFactorSolverType("mumps")
-            self.ksp.setFromOptions()
+            self.ksp = lu_solver(self.comm, f"{self.prefix}reused_")
         elif not self.stale:
             return
-        inner = self.ksp.getPC()
-        inner.setReusePreconditioner(False)  # factorise J as it is now (KSPSetUp does
-        self.ksp.setOperators(J)  # nothing unless handed the operators anew)
-        self.ksp.setUp()
-        inner.setReusePreconditioner(True)  # and keep it while J changes under it
+        factorise_and_keep(self.ksp, J)
         self.factorisations += 1
         self.stale = False
 
