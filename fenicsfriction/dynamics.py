@@ -53,10 +53,12 @@ class DynamicsSolver(Alpha2Integrator):
         prefix: PETSc options prefix of the TS (and its SNES/KSP/PC).
         options: defaults over :data:`DEFAULT_OPTIONS`; options in the database win.
         atol: absolute Newton tolerance on the residual (force units).
+        predictor: start Newton from x_n + Δt ẋ_n (see
+            :class:`~fenicsfriction.timestepping.Alpha2Integrator`), else from x_n.
     """
 
     def __init__(self, residual: Residual, prefix: str = "dynamics_",
-                 options: dict | None = None, atol: float = 1e-8):
+                 options: dict | None = None, atol: float = 1e-8, predictor: bool = True):
         self.residual = residual
         msh = residual.V.mesh
         self.shift_v = fem.Constant(msh, 0.0)
@@ -71,7 +73,7 @@ class DynamicsSolver(Alpha2Integrator):
         self.a = _compat.form(jacobian)
         self.b = dolfinx.fem.petsc.create_vector(self.L)
         self.A = dolfinx.fem.petsc.create_matrix(self.a)
-        super().__init__(msh.comm, prefix, self.b, self.A, options, atol)
+        super().__init__(msh.comm, prefix, self.b, self.A, options, atol, predictor)
 
     def _state(self) -> tuple[PETSc.Vec, PETSc.Vec]:
         return _compat.petsc_vec(self.residual.u), _compat.petsc_vec(self.residual.u_dot)
