@@ -122,7 +122,8 @@ def _split_constant(jacobian: ufl.Form) -> tuple[ufl.Form | None, list]:
     if jacobian.empty():
         return None, []
     expanded = ufl.algorithms.expand_derivatives(jacobian)
-    constant, varying = [], []
+    constant: list = []
+    varying: list = []
     for integral in expanded.integrals():
         fields = ufl.algorithms.extract_coefficients(integral.integrand())
         (varying if fields else constant).append(integral)
@@ -168,6 +169,7 @@ class _ConstantJacobian:
         if self._key != (shift_v, shift_a):
             same = PETSc.Mat.Structure.SAME_NONZERO_PATTERN
             stiffness, damping, mass = self.parts
+            assert stiffness is not None, "the solver splits the Jacobian only when K0 exists"
             if self.sum is None:
                 self.sum = stiffness.copy()
             else:
