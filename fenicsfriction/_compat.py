@@ -24,6 +24,7 @@ __all__ = [
     "create_box",
     "evaluate_expression",
     "create_rectangle",
+    "dg0_vector_space",
     "interpolation_points",
     "jit_options",
     "petsc_vec",
@@ -44,6 +45,13 @@ def scalar_function_space(msh: mesh.Mesh, family: str, degree: int) -> fem.Funct
     if hasattr(fem, "functionspace"):
         return fem.functionspace(msh, (family, degree))
     return fem.FunctionSpace(msh, (family, degree))
+
+
+def dg0_vector_space(msh: mesh.Mesh, components: int) -> fem.FunctionSpace:
+    """Cellwise constant vectors with ``components`` entries (one value per cell and entry)."""
+    if hasattr(fem, "functionspace"):
+        return fem.functionspace(msh, ("DG", 0, (components,)))
+    return fem.VectorFunctionSpace(msh, ("DG", 0), dim=components)
 
 
 def petsc_vec(u: fem.Function) -> PETSc.Vec:

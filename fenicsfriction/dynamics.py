@@ -53,25 +53,38 @@ class DynamicsSolver(Alpha2Integrator):
         prefix: PETSc options prefix of the TS (and its SNES/KSP/PC).
         options: defaults over :data:`DEFAULT_OPTIONS`; options in the database win.
         atol: absolute Newton tolerance on the residual (force units).
+        predictor: start Newton from x_n + Δt ẋ_n (see
+            :class:`~fenicsfriction.timestepping.Alpha2Integrator`), else from x_n.
     """
 
     def __init__(self, residual: Residual, prefix: str = "dynamics_",
-                 options: dict | None = None, atol: float = 1e-8):
+                 options: dict | None = None, atol: float = 1e-8, predictor: bool = True):
         self.residual = residual
         msh = residual.V.mesh
         self.shift_v = fem.Constant(msh, 0.0)
         self.shift_a = fem.Constant(msh, 0.0)
         R = residual.form
         jacobian = residual.derivative(R, residual.u)
-        for field, shift in ((residual.u_dot, self.shift_v), (residual.u_ddot, self.shift_a)):
+        fixed: list[ufl.Form | None] = []  # the state-independent parts of K, C, M
+        varying: list = []  # the other integrals of the Jacobian, shifts included
+        for field, shift in ((residual.u, None), (residual.u_dot, self.shift_v),
+                             (residual.u_ddot, self.shift_a)):
             part = residual.derivative(R, field)
-            if not part.empty():
+            if field is not residual.u and not part.empty():
                 jacobian = jacobian + shift * part
+            constant, other = _split_constant(part)
+            fixed.append(constant)
+            varying += [i if shift is None else i.reconstruct(integrand=shift * i.integrand())
+                        for i in other]
         self.L = _compat.form(R)
         self.a = _compat.form(jacobian)
         self.b = dolfinx.fem.petsc.create_vector(self.L)
         self.A = dolfinx.fem.petsc.create_matrix(self.a)
-        super().__init__(msh.comm, prefix, self.b, self.A, options, atol)
+        # once in full, which fixes the matrix's nonzero structure for the sums below
+        assemble_jacobian(self.A, self.a, residual.bcs, residual.springs)
+        self._bulk = _ConstantJacobian(fixed, self.A, residual) if fixed[0] else None
+        self.a_varying = _compat.form(ufl.Form(varying)) if self._bulk else self.a
+        super().__init__(msh.comm, prefix, self.b, self.A, options, atol, predictor)
 
     def _state(self) -> tuple[PETSc.Vec, PETSc.Vec]:
         return _compat.petsc_vec(self.residual.u), _compat.petsc_vec(self.residual.u_dot)
@@ -91,8 +104,81 @@ class DynamicsSolver(Alpha2Integrator):
     def _J(self, ts, t, x, xdot, xddot, shift_v, shift_a, J, P):
         self.shift_v.value = shift_v
         self.shift_a.value = shift_a
-        assemble_jacobian(J, self.a, self.residual.bcs, self.residual.springs)
+        if self._bulk is None:
+            assemble_jacobian(J, self.a, self.residual.bcs, self.residual.springs)
+        else:
+            assemble_jacobian(J, self.a_varying, self.residual.bcs,
+                              base=self._bulk.matrix(shift_v, shift_a))
         self.convergence.jacobian_assembled(J)
+
+
+def _split_constant(jacobian: ufl.Form) -> tuple[ufl.Form | None, list]:
+    """(the integrals of ``jacobian`` that involve no field, the others), derivatives expanded.
+
+    An integral without coefficients (the elastic stiffness, the mass) is the same at every
+    state; only constants (``fem.Constant``) may enter it, and :class:`_ConstantJacobian`
+    watches them.
+    """
+    if jacobian.empty():
+        return None, []
+    expanded = ufl.algorithms.expand_derivatives(jacobian)
+    constant: list = []
+    varying: list = []
+    for integral in expanded.integrals():
+        fields = ufl.algorithms.extract_coefficients(integral.integrand())
+        (varying if fields else constant).append(integral)
+    return (ufl.Form(constant) if constant else None), varying
+
+
+class _ConstantJacobian:
+    """K0 + s_v C0 + s_a M0: the state-independent part of the Jacobian (springs and Dirichlet
+    rows included), assembled once; the sum is formed again when the shifts change (a new
+    step size) or a constant of K0, C0, M0 does (e.g. the density)."""
+
+    def __init__(self, forms: list[ufl.Form | None], A: PETSc.Mat, residual: Residual):
+        self.residual = residual
+        self.forms = [None if f is None else _compat.form(f) for f in forms]
+        self.constants = [c for f in forms if f is not None for c in f.constants()]
+        self.parts: list[PETSc.Mat | None] = [None, None, None]
+        self.pattern = A
+        self.sum: PETSc.Mat | None = None
+        self._key: tuple | None = None
+        self._values: list | None = None
+
+    def _assemble_parts(self) -> None:
+        for k, form in enumerate(self.forms):
+            if form is None:
+                continue
+            if self.parts[k] is None:
+                self.parts[k] = self.pattern.duplicate()
+            # the stiffness carries the springs and the unit Dirichlet diagonal
+            stiffness = k == 0
+            assemble_jacobian(self.parts[k], form, self.residual.bcs,
+                              self.residual.springs if stiffness else (),
+                              diagonal=1.0 if stiffness else 0.0)
+        self._values = [np.array(c.value, copy=True) for c in self.constants]
+
+    def matrix(self, shift_v: float, shift_a: float) -> PETSc.Mat:
+        """K0 + s_v C0 + s_a M0 for the given shifts."""
+        changed = self._values is None or any(
+            not np.array_equal(c.value, v) for c, v in zip(self.constants, self._values,
+                                                           strict=True))
+        if changed:
+            self._assemble_parts()
+            self._key = None
+        if self._key != (shift_v, shift_a):
+            same = PETSc.Mat.Structure.SAME_NONZERO_PATTERN
+            stiffness, damping, mass = self.parts
+            assert stiffness is not None, "the solver splits the Jacobian only when K0 exists"
+            if self.sum is None:
+                self.sum = stiffness.copy()
+            else:
+                stiffness.copy(self.sum, structure=same)
+            for scale, part in ((shift_v, damping), (shift_a, mass)):
+                if part is not None:
+                    self.sum.axpy(scale, part, structure=same)
+            self._key = (shift_v, shift_a)
+        return self.sum
 
 
 class CentralDifference:

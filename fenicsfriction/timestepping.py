@@ -3,8 +3,9 @@ element dynamics (:class:`fenicsfriction.dynamics.DynamicsSolver`) and the few-d
 (:class:`fenicsfriction.reduced.ReducedDynamics`).
 
 The default scheme is PETSc's generalized-α method for second-order systems (``TSALPHA2``),
-Newton (SNES) at each step, with the step cut back to a quarter when Newton fails and grown back
-afterwards (see :class:`Alpha2Integrator`). It imports petsc4py only (no dolfinx).
+Newton (SNES) at each step from a constant-velocity predictor, with the step cut back to a
+quarter when Newton fails and grown back afterwards (see :class:`Alpha2Integrator`). It imports
+petsc4py only (no dolfinx).
 """
 
 from __future__ import annotations
@@ -75,6 +76,17 @@ class Alpha2Integrator:
     where ``observe`` reads it) and ``_state()`` (the initial displacement and velocity vectors,
     which receive the final state).
 
+    Newton starts each step from the constant-velocity predictor
+    :math:`x_{n+1} = x_n + \\Delta t\\,\\dot x_n` (``predictor=True``, the default), not from
+    PETSc's :math:`x_{n+1} = x_n`, which with Newmark's β = 1/4 means
+    :math:`\\dot x_{n+1} = -\\dot x_n`: Newton would start every contact point of a body that
+    slides with the belt at rest relative to the ground, slipping at −U_T, across the
+    regularisation band |u̇_T − U_T| < ε of a sticking point, where the friction force turns
+    by 2 c_T d^{m_T} within 2ε and Newton cycles when ε is small. From the predictor a sticking
+    point starts at its last slip speed. Only the starting point changes: the step still solves
+    R = 0 to the same tolerance. (Block on a belt, ε = 1e-3 cm/s, dt = 1e-5 s, the
+    first 10 ms: 2451 Newton iterations and 70 cut-backs instead of 24150 and 1546.)
+
     Attributes:
         ts: the PETSc TS, exposed for monitoring or further configuration.
         fixed_steps: no error control (``ts_adapt_type none``): a cut step grows back.
@@ -82,7 +94,7 @@ class Alpha2Integrator:
     """
 
     def __init__(self, comm: typing.Any, prefix: str, F: PETSc.Vec, J: PETSc.Mat,
-                 options: dict | None, atol: float):
+                 options: dict | None, atol: float, predictor: bool = True):
         check("atol", atol, np.isfinite(atol) and atol > 0, "must be a finite number > 0")
         self.ts = PETSc.TS().create(comm)
         self.ts.setOptionsPrefix(prefix)
@@ -96,6 +108,15 @@ class Alpha2Integrator:
             self.fixed_steps = opts.getString("ts_adapt_type") == "none"
         self.convergence = RoundoffConvergence(self.ts.getSNES())
         self.ts.getSNES().setConvergenceTest(self.convergence)
+        if predictor:
+            self.ts.getSNES().setInitialGuess(self._predict)
+
+    def _predict(self, snes: PETSc.SNES, x: PETSc.Vec) -> None:
+        """Newton's starting point x_n + Δt ẋ_n (TS holds x_n, ẋ_n until the step is accepted;
+        Δt is the step being tried, cut back or not)."""
+        x_n, v_n = self.ts.getSolution2()
+        x_n.copy(x)
+        x.axpy(self.ts.getTimeStep(), v_n)
 
     def _F(self, ts, t, x, xdot, xddot, F):
         raise NotImplementedError

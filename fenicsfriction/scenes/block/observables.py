@@ -6,6 +6,10 @@ Every traction is the one of :mod:`fenicsfriction.laws`
 that the residual integrates, evaluated in UFL for the integrals and in NumPy at a node for
 :func:`probe`. Integrals over :math:`\Gamma_C` use the
 contact measure of the residual (same quadrature), times the plane-strain breadth in 2D.
+
+The integrals of a record are assembled together, in one pass over the mesh and one reduction
+over the ranks (:class:`Functionals`): a time step's observation costs one vector assembly,
+not eighteen scalar ones.
 """
 
 from __future__ import annotations
@@ -14,7 +18,9 @@ import dataclasses
 import typing
 
 from mpi4py import MPI
+from petsc4py import PETSc
 
+import dolfinx.fem.petsc
 import numpy as np
 import ufl
 from dolfinx import fem
@@ -27,9 +33,9 @@ from fenicsfriction.scenes.block.data import TOP
 if typing.TYPE_CHECKING:
     from fenicsfriction.scenes.block.model import BlockModel
 
-__all__ = ["BlockQuantities", "CentreOfMass", "ContactStates", "Energies", "Powers",
-           "ProbeValues", "centre_of_mass", "contact_states", "dynamics_observer", "energies",
-           "powers", "probe", "quantities"]
+__all__ = ["BlockQuantities", "CentreOfMass", "ContactStates", "Energies", "Functionals",
+           "Powers", "ProbeValues", "centre_of_mass", "contact_states", "dynamics_observer",
+           "energies", "powers", "probe", "quantities"]
 
 
 @dataclasses.dataclass
@@ -122,13 +128,115 @@ class ProbeValues(Record):
     friction: float
 
 
-def _integral(model: BlockModel, key: str, integrand: typing.Callable[[], typing.Any]) -> float:
-    """∫_Γc integrand() ds (times the thickness), compiled at the first call only."""
+class Functionals:
+    r"""Several scalar integrals :math:`\int f_i`, assembled in one pass.
+
+    The integrals become one linear form :math:`\sum_i \int f_i\, q_i` with :math:`q` a test
+    function of the cellwise constant vectors with one entry per integral: its vector holds
+    each integral's share on each cell, and the sum over the (owned) cells of entry i is
+    :math:`\int f_i`. Every integral keeps its own measure and quadrature, so the values are
+    those of ``fem.assemble_scalar`` on each form up to the order of summation.
+
+    Args:
+        msh: the mesh of the integrands.
+        forms: scalar forms by name (functionals: no arguments).
+    """
+
+    def __init__(self, msh: typing.Any, forms: dict[str, ufl.Form]):
+        self.names = list(forms)
+        q = ufl.TestFunction(_compat.dg0_vector_space(msh, len(forms)))
+        integrals = [integral.reconstruct(integrand=integral.integrand() * q[i])
+                     for i, form in enumerate(forms.values()) for integral in form.integrals()]
+        self.form = _compat.form(ufl.Form(integrals))
+        self.vector = dolfinx.fem.petsc.create_vector(self.form)
+        self.comm = msh.comm
+
+    def local(self) -> np.ndarray:
+        """This rank's share of each integral, in the order of ``names`` (no communication)."""
+        with self.vector.localForm() as b:
+            b.set(0.0)
+        dolfinx.fem.petsc.assemble_vector(self.vector, self.form)
+        self.vector.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        return self.vector.array_r.reshape(-1, len(self.names)).sum(axis=0)
+
+    def values(self) -> dict[str, float]:
+        """The integrals by name (same on every rank)."""
+        totals = self.local()
+        self.comm.Allreduce(MPI.IN_PLACE, totals, op=MPI.SUM)
+        return {name: float(v) for name, v in zip(self.names, totals, strict=True)}
+
+
+def _contact(model: BlockModel, integrand: typing.Any) -> ufl.Form:
+    """∫_Γc integrand ds (times the thickness), with the residual's contact quadrature."""
+    return model.thickness * integrand * model.ds_contact
+
+
+def _quantity_forms(model: BlockModel) -> dict[str, ufl.Form]:
+    """The integrals of :func:`quantities`: normal force (elastic part and damping), its moment
+    about mid-base, the friction force."""
+    forms = {"normal_elastic": _contact(model, model.pressure())}
+    law = model.scene.law
+    if law.b_n > 0:  # the damping part of the normal traction (zero at rest)
+        forms["normal_damping"] = _contact(model, laws.normal_damping_pressure(
+            model.penetration(), normal_part(model.residual.u_dot, model.normal), law.b_n,
+            law.l_n))
+    forms["moment"] = _contact(model, (ufl.SpatialCoordinate(model.msh)[0]
+                                       - model.scene.L / 2) * model.pressure())
+    if model.with_friction:
+        forms["friction"] = _contact(model, model.friction_traction()[0])
+    return forms
+
+
+def _energy_forms(model: BlockModel) -> dict[str, ufl.Form]:
+    """Kinetic, strain, interface and load-potential energies (:func:`energies`)."""
+    s, R = model.scene, model.residual
+    u, u_dot = R.u, R.u_dot
+    d = model.penetration()
+    ds = ufl.Measure("ds", domain=model.msh, subdomain_data=model.facet_tags)
+    forms = {"kinetic": 0.5 * model.rho * ufl.inner(u_dot, u_dot) * model.dx,
+             "strain": 0.5 * elasticity(u, u, s.E, s.nu, model.dx),
+             "interface": model.c_n * d ** (model.m_n + 1) / (model.m_n + 1) * model.ds_contact,
+             "load": -ufl.inner(model.gravity, u) * model.dx
+             - ufl.inner(model.top_traction, u) * ds(TOP)}
+    return {k: model.thickness * f for k, f in forms.items()}
+
+
+def _power_forms(model: BlockModel) -> dict[str, ufl.Form]:
+    """Power of friction and normal damping (:func:`powers`): the residual's own terms with the
+    velocity as test function, sign reversed."""
+    R, n, law = model.residual, model.normal, model.scene.law
+    forms = {}
+    if model.with_friction:
+        forms["friction"] = -friction(R.u, R.u_dot, R.u_dot, n, model.friction_c_T, model.m_T,
+                                      model.gap, model.belt_velocity, model.eps,
+                                      model.ds_contact, law.regularisation)
+    if law.b_n > 0:
+        forms["damping"] = -normal_damping(R.u, R.u_dot, R.u_dot, n, law.b_n, law.l_n,
+                                           model.gap, model.ds_contact)
+    return {k: model.thickness * f for k, f in forms.items()}
+
+
+def _centre_forms(model: BlockModel) -> dict[str, ufl.Form]:
+    """∫ u_i, ∫ u̇_i, ∫ ½ curl u and the area (:func:`centre_of_mass`)."""
+    R, dx, dim = model.residual, model.dx, model.scene.dim
+    forms = {f"u{i}": R.u[i] * dx for i in range(dim)}
+    forms.update({f"v{i}": R.u_dot[i] * dx for i in range(dim)})
+    forms["curl"] = 0.5 * (R.u[1].dx(0) - R.u[0].dx(1)) * dx
+    forms["area"] = fem.Constant(model.msh, 1.0) * dx
+    return forms
+
+
+def _evaluate(model: BlockModel, key: str,
+              builder: typing.Callable[[BlockModel], dict[str, ufl.Form]]) -> dict[str, float]:
+    """The integrals ``builder`` states, compiled at the first call only."""
     cache = model._functionals
     if key not in cache:
-        cache[key] = _compat.form(model.thickness * integrand() * model.ds_contact)
-    value = fem.assemble_scalar(cache[key])
-    return model.msh.comm.allreduce(value, op=MPI.SUM)
+        cache[key] = Functionals(model.msh, builder(model))
+    return cache[key].values()
+
+
+def _spring_energy(model: BlockModel, force: float) -> float:
+    return 0.5 * force**2 / model.spring.stiffness
 
 
 def energies(model: BlockModel) -> Energies:
@@ -136,24 +244,8 @@ def energies(model: BlockModel) -> Energies:
 
     The load potential is -∫ b·u (weight) - ∫ t·u (top pressure).
     """
-    s, R = model.scene, model.residual
-    u, u_dot = R.u, R.u_dot
-    if "energy" not in model._functionals:
-        d = model.penetration()
-        ds = ufl.Measure("ds", domain=model.msh, subdomain_data=model.facet_tags)
-        forms = {"kinetic": 0.5 * model.rho * ufl.inner(u_dot, u_dot) * model.dx,
-                 "strain": 0.5 * elasticity(u, u, s.E, s.nu, model.dx),
-                 "interface": model.c_n * d ** (model.m_n + 1) / (model.m_n + 1)
-                 * model.ds_contact,
-                 "load": -ufl.inner(model.gravity, u) * model.dx
-                 - ufl.inner(model.top_traction, u) * ds(TOP)}
-        model._functionals["energy"] = {k: _compat.form(model.thickness * f)
-                                        for k, f in forms.items()}
-    comm = model.msh.comm
-    values = {k: comm.allreduce(fem.assemble_scalar(f), op=MPI.SUM)
-              for k, f in model._functionals["energy"].items()}
-    force = model.spring.force(u)
-    values["spring"] = 0.5 * force**2 / model.spring.stiffness
+    values = _evaluate(model, "energy", _energy_forms)
+    values["spring"] = _spring_energy(model, model.spring.force(model.residual.u))
     values["total"] = sum(values.values())
     return Energies(**values)
 
@@ -162,56 +254,47 @@ def powers(model: BlockModel) -> Powers:
     """Power of the friction and normal-damping tractions on the body: the residual's own
     terms (:func:`~fenicsfriction.forms.friction`, :func:`~fenicsfriction.forms.normal_damping`)
     with the velocity u̇ as test function, sign reversed."""
-    if "power" not in model._functionals:
-        R, n, law = model.residual, model.normal, model.scene.law
-        forms = {"friction": -friction(R.u, R.u_dot, R.u_dot, n, model.friction_c_T,
-                                       model.m_T, model.gap, model.belt_velocity, model.eps,
-                                       model.ds_contact, law.regularisation)
-                 if model.with_friction else None,
-                 "damping": -normal_damping(R.u, R.u_dot, R.u_dot, n, law.b_n, law.l_n,
-                                            model.gap, model.ds_contact)
-                 if law.b_n > 0 else None}
-        model._functionals["power"] = {k: _compat.form(model.thickness * f)
-                                       for k, f in forms.items() if f is not None}
-    comm = model.msh.comm
     values = {"friction": 0.0, "damping": 0.0}
-    values.update({k: comm.allreduce(fem.assemble_scalar(f), op=MPI.SUM)
-                   for k, f in model._functionals["power"].items()})
+    if model.with_friction or model.scene.b_n > 0:
+        values.update(_evaluate(model, "power", _power_forms))
     return Powers(**values)
 
 
-def contact_states(model: BlockModel) -> ContactStates:
-    """Counts of open, sticking and slipping contact nodes (see :class:`ContactStates`)."""
+def _contact_counts(model: BlockModel) -> np.ndarray:
+    """This rank's counts of open, sticking and slipping contact nodes."""
     y = model._contact_y
     d = np.maximum(-model.residual.u.x.array[y] - model.scene.g, 0.0)
     slip = np.abs(model.residual.u_dot.x.array[y - 1] - model.scene.belt_direction
                   * model.scene.belt_speed)
     closed = d > 0
     stick = closed & (slip < float(model.eps.value))
-    counts = np.array([np.sum(~closed), np.sum(stick), np.sum(closed & ~stick)])
-    n_open, n_stick, n_slip = model.msh.comm.allreduce(counts, op=MPI.SUM)
+    return np.array([np.sum(~closed), np.sum(stick), np.sum(closed & ~stick)], dtype=float)
+
+
+def contact_states(model: BlockModel) -> ContactStates:
+    """Counts of open, sticking and slipping contact nodes (see :class:`ContactStates`)."""
+    counts = _contact_counts(model)
+    model.msh.comm.Allreduce(MPI.IN_PLACE, counts, op=MPI.SUM)
+    n_open, n_stick, n_slip = counts
     return ContactStates(n_open=int(n_open), n_stick=int(n_stick), n_slip=int(n_slip))
+
+
+def _centre(model: BlockModel, values: dict[str, float]) -> CentreOfMass:
+    dim = model.scene.dim
+    area = values["area"]
+    return CentreOfMass(u_G=np.array([values[f"u{i}"] for i in range(dim)]) / area,
+                        v_G=np.array([values[f"v{i}"] for i in range(dim)]) / area,
+                        theta=values["curl"] / area)
 
 
 def centre_of_mass(model: BlockModel) -> CentreOfMass:
     """Motion of the centre of mass and mean rotation (see :class:`CentreOfMass`)."""
-    if "centre" not in model._functionals:
-        R, dx = model.residual, model.dx
-        forms = [f * dx for f in (*R.u, *R.u_dot)]
-        curl = 0.5 * (R.u[1].dx(0) - R.u[0].dx(1))
-        model._functionals["centre"] = [_compat.form(f) for f in (
-            *forms, curl * dx, fem.Constant(model.msh, 1.0) * dx)]
-    comm = model.msh.comm
-    values = np.array([comm.allreduce(fem.assemble_scalar(f), op=MPI.SUM)
-                       for f in model._functionals["centre"]])
-    mean = values[:-1] / values[-1]
-    dim = model.scene.dim
-    return CentreOfMass(u_G=mean[:dim], v_G=mean[dim:2 * dim], theta=float(mean[-1]))
+    return _centre(model, _evaluate(model, "centre", _centre_forms))
 
 
-def _nodal_c_T(model: BlockModel) -> typing.Any:
+def _nodal_c_T(model: BlockModel, law: laws.InterfaceLaw) -> typing.Any:
     """c_T of the friction term as a NumPy value or a NumPy function of the slip speed."""
-    law, s = model.scene.law, model.scene
+    s = model.scene
     if not model.with_friction:
         return 0.0
     if s.friction_coefficient is not None:
@@ -220,12 +303,8 @@ def _nodal_c_T(model: BlockModel) -> typing.Any:
     return float(model.mu.value) * law.c_n
 
 
-def probe(model: BlockModel, x: float) -> ProbeValues:
-    """Nodal values at the contact node nearest to abscissa ``x`` (same on every rank).
-
-    The tractions are those of :mod:`fenicsfriction.laws` at the node's penetration and slip,
-    with the model's friction coefficient (velocity-dependent μ(|slip|) included).
-    """
+def _probe_node(model: BlockModel, x: float) -> tuple[int, int, float]:
+    """(owning rank, local y-dof, abscissa) of the contact node nearest to ``x`` (cached)."""
     cache = model._functionals
     if "probe" not in cache or cache["probe"][0] != x:
         coords = model.V.tabulate_dof_coordinates()
@@ -237,45 +316,66 @@ def probe(model: BlockModel, x: float) -> ProbeValues:
         _, owner = comm.allreduce((float(distance[best]), comm.rank), op=MPI.MINLOC)
         cache["probe"] = (x, owner, int(y[best]) if y.size else -1,
                           float(coords[nodes[best], 0]) if y.size else 0.0)
-    _, owner, dof, node_x = cache["probe"]
-    s, law, comm = model.scene, model.scene.law, model.msh.comm
-    values = None
-    if comm.rank == owner:
-        u, v = model.residual.u.x.array, model.residual.u_dot.x.array
-        d = max(-u[dof] - s.g, 0.0)
-        slip = v[dof - 1] - s.belt_direction * s.belt_speed
-        rate = -v[dof] if d > 0 else 0.0
-        pressure = laws.normal_traction(d, law.c_n, law.m_n, rate, law.b_n, law.l_n)
-        traction = laws.friction_traction(d, np.array([slip]), _nodal_c_T(model), law.m_T,
-                                          float(model.eps.value), s.regularisation)[0]
-        values = ProbeValues(x=node_x, u_y=float(u[dof]), v_x=float(v[dof - 1]),
-                             v_y=float(v[dof]), slip=float(slip), pressure=float(pressure),
-                             friction=float(traction))
+    return cache["probe"][1:]
+
+
+def _probe_values(model: BlockModel, dof: int, node_x: float, law: laws.InterfaceLaw
+                  ) -> ProbeValues:
+    """The probe's values, on the rank that owns its node."""
+    s = model.scene
+    u, v = model.residual.u.x.array, model.residual.u_dot.x.array
+    d = max(-u[dof] - s.g, 0.0)
+    slip = v[dof - 1] - s.belt_direction * s.belt_speed
+    rate = -v[dof] if d > 0 else 0.0
+    pressure = laws.normal_traction(d, law.c_n, law.m_n, rate, law.b_n, law.l_n)
+    traction = laws.friction_traction(d, np.array([slip]), _nodal_c_T(model, law), law.m_T,
+                                      float(model.eps.value), s.regularisation)[0]
+    return ProbeValues(x=node_x, u_y=float(u[dof]), v_x=float(v[dof - 1]), v_y=float(v[dof]),
+                       slip=float(slip), pressure=float(pressure), friction=float(traction))
+
+
+def probe(model: BlockModel, x: float) -> ProbeValues:
+    """Nodal values at the contact node nearest to abscissa ``x`` (same on every rank).
+
+    The tractions are those of :mod:`fenicsfriction.laws` at the node's penetration and slip,
+    with the model's friction coefficient (velocity-dependent μ(|slip|) included).
+    """
+    owner, dof, node_x = _probe_node(model, x)
+    comm = model.msh.comm
+    values = _probe_values(model, dof, node_x, model.scene.law) if comm.rank == owner else None
     return comm.bcast(values, root=owner)
+
+
+def _penetration_extremes(model: BlockModel) -> np.ndarray:
+    """This rank's (max d, -min d) over its contact nodes (-inf, -inf without any)."""
+    d = np.maximum(-model.residual.u.x.array[model._contact_y] - model.scene.g, 0.0)
+    return np.array([d.max(), -d.min()]) if d.size else np.full(2, -np.inf)
+
+
+def _quantities(model: BlockModel, values: dict[str, float], spring_force: float,
+                extremes: np.ndarray) -> BlockQuantities:
+    elastic = values["normal_elastic"]
+    return BlockQuantities(
+        mu=float(model.mu.value), normal_force=elastic + values.get("normal_damping", 0.0),
+        normal_force_elastic=elastic, friction_force=values.get("friction", 0.0),
+        spring_force=spring_force,
+        centre_of_pressure=values["moment"] / elastic if elastic > 0 else float("nan"),
+        min_penetration=float(-extremes[1]), max_penetration=float(extremes[0]))
 
 
 def quantities(model: BlockModel) -> BlockQuantities:
     """Resultants and penetration extremes of the current state (see :class:`BlockQuantities`)."""
-    elastic = _integral(model, "normal", model.pressure)
-    normal = elastic
-    law = model.scene.law
-    if law.b_n > 0:  # the damping part of the normal traction (zero at rest)
-        normal += _integral(model, "damping", lambda: laws.normal_damping_pressure(
-            model.penetration(), normal_part(model.residual.u_dot, model.normal), law.b_n,
-            law.l_n))
-    moment = _integral(model, "moment", lambda: (ufl.SpatialCoordinate(model.msh)[0]
-                                                 - model.scene.L / 2) * model.pressure())
-    friction_force = _integral(model, "friction", lambda: model.friction_traction()[0]) \
-        if model.with_friction else 0.0
-    uy = model.residual.u.x.array[model._contact_y]
-    d = np.maximum(-uy - model.scene.g, 0.0)
-    comm = model.msh.comm
-    return BlockQuantities(
-        mu=float(model.mu.value), normal_force=normal, normal_force_elastic=elastic,
-        friction_force=friction_force, spring_force=model.spring.force(model.residual.u),
-        centre_of_pressure=moment / elastic if elastic > 0 else float("nan"),
-        min_penetration=comm.allreduce(d.min() if d.size else np.inf, op=MPI.MIN),
-        max_penetration=comm.allreduce(d.max() if d.size else -np.inf, op=MPI.MAX))
+    extremes = _penetration_extremes(model)
+    model.msh.comm.Allreduce(MPI.IN_PLACE, extremes, op=MPI.MAX)
+    return _quantities(model, _evaluate(model, "quantities", _quantity_forms),
+                       model.spring.force(model.residual.u), extremes)
+
+
+def _local_spring_force(model: BlockModel) -> float:
+    spring = model.spring
+    if spring.local_dof < 0:
+        return 0.0
+    return -spring.stiffness * (model.residual.u.x.array[spring.local_dof] - spring.anchor)
 
 
 def dynamics_observer(model: BlockModel, probe_x: float | None = None
@@ -290,6 +390,9 @@ def dynamics_observer(model: BlockModel, probe_x: float | None = None
     (trapezoidal rule over the observed steps): zero for the exact solution, its drift measures
     the time error.
 
+    All the integrals of a row are assembled in one pass (:class:`Functionals`) and, with the
+    nodal values, reduced over the ranks in two collective calls.
+
     Args:
         model: the built block.
         probe_x: abscissa of the probe node [cm] (None: L/2).
@@ -298,12 +401,48 @@ def dynamics_observer(model: BlockModel, probe_x: float | None = None
         ``observe(t) -> dict``.
     """
     x = model.scene.L / 2 if probe_x is None else probe_x
-    energy0 = energies(model).total
+    groups = {"q": _quantity_forms(model), "e": _energy_forms(model),
+              "p": _power_forms(model), "c": _centre_forms(model)}
+    functionals = Functionals(model.msh, {f"{g}.{k}": f for g, forms in groups.items()
+                                          for k, f in forms.items()})
+    law = model.scene.law
+    owner, dof, node_x = _probe_node(model, x)
+    comm = model.msh.comm
+    probe_fields = [f.name for f in dataclasses.fields(ProbeValues)]
+    n_integrals = len(functionals.names)
     last: dict[str, float] = {}
 
+    def state() -> tuple[dict[str, dict[str, float]], float, np.ndarray, ProbeValues,
+                         np.ndarray]:
+        """Integrals by group, spring force, contact counts, probe, penetration extremes."""
+        node = np.zeros(len(probe_fields))
+        if comm.rank == owner:
+            node[:] = dataclasses.astuple(_probe_values(model, dof, node_x, law))
+        total = np.concatenate([functionals.local(), [_local_spring_force(model)],
+                                _contact_counts(model), node])
+        extremes = _penetration_extremes(model)
+        comm.Allreduce(MPI.IN_PLACE, total, op=MPI.SUM)
+        comm.Allreduce(MPI.IN_PLACE, extremes, op=MPI.MAX)
+        values: dict[str, dict[str, float]] = {g: {} for g in groups}
+        for name, v in zip(functionals.names, total[:n_integrals], strict=True):
+            group, key = name.split(".", 1)
+            values[group][key] = float(v)
+        rest = total[n_integrals:]
+        return (values, float(rest[0]), rest[1:4],
+                ProbeValues(**dict(zip(probe_fields, map(float, rest[4:]), strict=True))),
+                extremes)
+
+    def total_energy(values: dict[str, float], spring_force: float) -> float:
+        return sum(values.values()) + _spring_energy(model, spring_force)
+
+    values, spring_force, _, _, _ = state()
+    energy0 = total_energy(values["e"], spring_force)
+
     def observe(t: float) -> dict[str, typing.Any]:
-        q, power, energy = quantities(model), powers(model), energies(model)
-        centre, node = centre_of_mass(model), probe(model, x)
+        values, spring_force, counts, node, extremes = state()
+        q = _quantities(model, values["q"], spring_force, extremes)
+        centre = _centre(model, values["c"])
+        power = Powers(**{"friction": 0.0, "damping": 0.0, **values["p"]})
         total_power = power.friction + power.damping
         work = last.get("work", 0.0)
         if last:
@@ -316,10 +455,10 @@ def dynamics_observer(model: BlockModel, probe_x: float | None = None
                 "spring_elongation": -q.spring_force / model.scene.K_x,
                 "u_yG": float(centre.u_G[1]), "v_yG": float(centre.v_G[1]),
                 "v_xG": float(centre.v_G[0]), "theta": centre.theta,
-                **dataclasses.asdict(contact_states(model)),
+                "n_open": int(counts[0]), "n_stick": int(counts[1]), "n_slip": int(counts[2]),
                 **{f"probe_{k}": v for k, v in dataclasses.asdict(node).items()},
-                "kinetic_energy": energy.kinetic, "friction_power": power.friction,
+                "kinetic_energy": values["e"]["kinetic"], "friction_power": power.friction,
                 "damping_power": power.damping,
-                "energy_error": energy.total - energy0 - work}
+                "energy_error": total_energy(values["e"], spring_force) - energy0 - work}
 
     return observe
