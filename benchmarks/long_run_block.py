@@ -13,10 +13,11 @@ This script reads the time series of the finite element run (the CLI's ``timeser
         --t-end 20 --dt 1e-5 --stride 20000 --out DIR
 
 integrates the rigid block (:class:`~fenicsfriction.reduced.RigidBlock`, same data, same ε,
-same integrator and step; about 15 min for 20 s) unless ``--rigid-csv`` gives its time series
-from an earlier run, and prints, for both, per window of ``--window`` seconds: the apparent
-coefficient F̄/N̄, the range of N, the spring elongation, the share of the time some base point
-sticks and the whole base sticks, and the longest whole-base stick; then the verdict.
+same integrator and step; 32 min for 20 s on 2 shared cores) unless ``--rigid-csv`` gives
+its time series from an earlier run, and prints, for both, per window of ``--window``
+seconds: the apparent coefficient F̄/N̄, the range of N, the spring elongation, the share of
+the time some base point sticks and the whole base sticks, and the longest whole-base stick;
+then the verdict.
 
 **The block sticks** when the whole base sticks — every base node of the finite element block
 in contact and within ε of the belt speed (``n_stick`` = all contact nodes, ``n_open`` = 0),
