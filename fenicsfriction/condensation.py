@@ -119,6 +119,8 @@ class InterfaceCondensation:
         size: |Γ|, the number of interface dofs.
         setup_time_s: time spent factorising K_II and forming C.
         factorisations: how many times the bulk was factorised.
+        option_defaults: option defaults under ``prefix`` (the solver's ``options``), in
+            place when the factorisations read the options database.
         whole: serial with MUMPS: J itself is factorised with Γ last, MUMPS's Schur complement
             gives C, and each Newton system is one solve with that factor (its Schur
             complement replaced by J_ΓΓ(u) − C); otherwise K_II is factorised and C formed by
@@ -141,6 +143,7 @@ class InterfaceCondensation:
         self.stale = False
         self._lu: tuple | None = None
         self.whole = False
+        self.option_defaults: dict = {}
 
     def _index_sets(self, J: PETSc.Mat) -> None:
         lo, hi = J.getOwnershipRange()
@@ -155,7 +158,7 @@ class InterfaceCondensation:
         t0 = time.perf_counter()
         if self.ksp is None:
             self._index_sets(J)
-            self.ksp = lu_solver(self.comm, f"{self.prefix}condensed_")
+            self.ksp = lu_solver(self.comm, self.prefix, "condensed_", self.option_defaults)
             pc = self.ksp.getPC()
             self._mumps_schur = (mumps_schur.available()
                                  and pc.getFactorSolverType() == "mumps")
@@ -183,7 +186,7 @@ class InterfaceCondensation:
         """C from MUMPS's Schur complement of J with Γ on rank 0 (a second, parallel
         factorisation, dropped afterwards: PETSc solves with a Schur factor in serial only),
         broadcast to every rank."""
-        ksp = lu_solver(self.comm, f"{self.prefix}condensed_")
+        ksp = lu_solver(self.comm, self.prefix, "condensed_", self.option_defaults)
         ksp.setOperators(J)
         pc = ksp.getPC()
         pc.setFactorSetUpSolverType()

@@ -24,21 +24,26 @@ from __future__ import annotations
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from fenicsfriction.petsc_options import options_with_defaults
+
 __all__ = ["ReusedFactorisation", "factorise_and_keep", "lu_solver"]
 
 #: the default Krylov count above which the next Newton iteration factorises anew
 REFACTORISE_AFTER = 12
 
 
-def lu_solver(comm: MPI.Comm, prefix: str) -> PETSc.KSP:
-    """A ``preonly`` KSP with a MUMPS LU under ``prefix``, the options database read."""
+def lu_solver(comm: MPI.Comm, prefix: str, inner: str,
+              defaults: dict | None = None) -> PETSc.KSP:
+    """A ``preonly`` KSP with a MUMPS LU under ``prefix + inner``, the options database read
+    with ``defaults`` (keys under ``prefix``, e.g. the solver's ``options``) in place."""
     ksp = PETSc.KSP().create(comm)
-    ksp.setOptionsPrefix(prefix)
+    ksp.setOptionsPrefix(prefix + inner)
     ksp.setType("preonly")
     pc = ksp.getPC()
     pc.setType("lu")
     pc.setFactorSolverType("mumps")
-    ksp.setFromOptions()
+    with options_with_defaults(prefix, defaults or {}):
+        ksp.setFromOptions()
     return ksp
 
 
@@ -67,6 +72,8 @@ class ReusedFactorisation:
 
     Attributes:
         factorisations: how many times the Jacobian was factorised.
+        option_defaults: option defaults under ``prefix`` (the solver's ``options``), in
+            place when the factorisation reads the options database.
         stale: set to factorise anew at the next set-up (the solver sets it from the Krylov
             count).
         ksp: the inner ``preonly`` KSP holding the factorisation.
@@ -80,11 +87,12 @@ class ReusedFactorisation:
         self.ksp: PETSc.KSP = None
         self.factorisations = 0
         self.stale = False
+        self.option_defaults: dict = {}
 
     def setUp(self, pc: PETSc.PC) -> None:  # petsc4py's name
         J = pc.getOperators()[0]
         if self.ksp is None:
-            self.ksp = lu_solver(self.comm, f"{self.prefix}reused_")
+            self.ksp = lu_solver(self.comm, self.prefix, "reused_", self.option_defaults)
         elif not self.stale:
             return
         factorise_and_keep(self.ksp, J)

@@ -194,6 +194,8 @@ class SteadySolver:
         pc = self.snes.getKSP().getPC()
         self._bulk = None
         if self.preconditioner is not None and pc.getType() == "python":
+            # its factorisations are set up at the first solve, after the defaults are gone
+            self.preconditioner.option_defaults = dict(options or {})
             pc.setPythonContext(self.preconditioner)
             self.linear_solver = ("condensed" if isinstance(self.preconditioner,
                                                            InterfaceCondensation)

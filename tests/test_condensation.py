@@ -90,14 +90,15 @@ def test_without_mumps_the_schur_complement_is_formed_by_solves():
     _, mumps, with_mumps = _continuation("condensed")
     model = ff.BlockOnBelt(refine=2).build(MPI.COMM_WORLD, with_friction=True)
     model.initial_guess()
-    solver = ff.SteadySolver(model.residual, prefix="condslu_", options=model.solver_options(),
-                             linear_solver="condensed")
-    options = PETSc.Options()
-    options["condslu_condensed_pc_factor_mat_solver_type"] = "superlu_dist"  # as a user would
-    try:
-        with_superlu = ff.continuation(solver, model.mu, MU, observe=model.quantities)
-    finally:
-        options.delValue("condslu_condensed_pc_factor_mat_solver_type")
+    # the inner factorisation's options reach it through the solver's own (set up at the
+    # first solve, after the solver's defaults have left the options database)
+    solver = ff.SteadySolver(
+        model.residual, prefix="condslu_",
+        options={**model.solver_options(),
+                 "condensed_pc_factor_mat_solver_type": "superlu_dist"},
+        linear_solver="condensed")
+    with_superlu = ff.continuation(solver, model.mu, MU, observe=model.quantities)
+    assert not PETSc.Options().hasName("condslu_condensed_pc_factor_mat_solver_type")
     assert mumps.condensation._mumps_schur and not solver.condensation._mumps_schur
     assert not solver.condensation.whole
     assert ([r["newton_iterations"] for r in with_superlu]
