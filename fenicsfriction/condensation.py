@@ -117,7 +117,7 @@ class InterfaceCondensation:
 
     Attributes:
         size: |Γ|, the number of interface dofs.
-        setup_time_s: time spent factorising K_II and forming C.
+        setup_time_s: time spent factorising and forming C.
         factorisations: how many times the bulk was factorised.
         option_defaults: option defaults under ``prefix`` (the solver's ``options``), in
             place when the factorisations read the options database.
@@ -128,6 +128,7 @@ class InterfaceCondensation:
             by one solve per interface dof).
         stale: set to factorise anew at the next set-up (the solver does it when the bulk
             changed, :meth:`krylov_count` when the Krylov count says it no longer matches).
+        refactorise_after: that Krylov count (the condensation is exact: it takes 1).
     """
 
     def __init__(self, interface: np.ndarray, comm: MPI.Comm, prefix: str = ""):
@@ -144,6 +145,7 @@ class InterfaceCondensation:
         self._lu: tuple | None = None
         self.whole = False
         self.option_defaults: dict = {}
+        self.refactorise_after = REFACTORISE_AFTER_ITERATIONS
 
     def _index_sets(self, J: PETSc.Mat) -> None:
         lo, hi = J.getOwnershipRange()
@@ -238,9 +240,9 @@ class InterfaceCondensation:
         return np.vstack(self.comm.allgather(rows))
 
     def krylov_count(self, iterations: int) -> None:
-        """Told the Krylov count of the last Newton iteration: more than one means the bulk no
+        """Told the Krylov count of the last Newton iteration: a high one means the bulk no
         longer matches its factorisation, so factorise anew."""
-        if iterations > REFACTORISE_AFTER_ITERATIONS:
+        if iterations > self.refactorise_after:
             self.stale = True
 
     # --- PCPYTHON interface -------------------------------------------------------------------

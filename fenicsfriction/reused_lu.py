@@ -8,9 +8,10 @@ elastic bulk's on any mesh fine enough to matter (c_n m_n d^{m_n-1} ≈ 10⁴ pe
 block's contact pressure, against E/h ≳ 10⁶). Preconditioned by the LU of an earlier Jacobian
 J₀, flexible GMRES sees J J₀⁻¹ = I + (J − J₀) J₀⁻¹, a small perturbation of the identity, and
 converges in a few iterations, each one triangular solve. Where a sparse factorisation costs
-a hundred solves or more (3D meshes: 20 s against 0.2 s at 1.4e5 dofs), that beats both a
-factorisation per iteration and condensing the bulk onto a large interface
-(:mod:`fenicsfriction.condensation`, which needs one solve per interface dof).
+a hundred solves or more (the 3D block at 1.4e5 dofs: 27 s against 0.2-0.4 s), that beats both
+a factorisation per iteration and condensing the bulk onto a large interface
+(:mod:`fenicsfriction.condensation`, whose dense Schur complement then rivals the sparse
+factor).
 
 Nothing rests on the factorisation being current: GMRES converges to the true Newton step
 (right preconditioning: the test is on the true residual) and a count above

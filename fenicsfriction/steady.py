@@ -162,14 +162,14 @@ class SteadySolver:
         self.u = residual.u
         t0 = time.perf_counter()
         self.L = _compat.form(residual.steady(), jit_cache_dir)
-        self.a_ufl = residual.steady_jacobian()
-        self.a = _compat.form(self.a_ufl, jit_cache_dir)
+        jacobian = residual.steady_jacobian()
+        self.a = _compat.form(jacobian, jit_cache_dir)
         self.jit_time_s = time.perf_counter() - t0
         self.b = dolfinx.fem.petsc.create_vector(self.L)
         self.A = dolfinx.fem.petsc.create_matrix(self.a)
         self.x = self.b.duplicate()
         comm = self.u.function_space.mesh.comm
-        split = None if linear_solver == "lu" else interface_split(self.a_ufl, self.u)
+        split = None if linear_solver == "lu" else interface_split(jacobian, self.u)
         self.preconditioner: InterfaceCondensation | ReusedFactorisation | None = None
         if split is not None and linear_solver in ("auto", "condensed"):
             nonzeros = self.A.getInfo(PETSc.Mat.InfoType.GLOBAL_SUM)["nz_allocated"]
