@@ -10,7 +10,8 @@ OUT ?= results
 APT_PACKAGES := python3-dolfinx python3-petsc4py python3-slepc4py python3-mpi4py python3-ufl \
     python3-basix python3-ffcx python3-numpy python3-scipy python3-matplotlib python3-pytest \
     python3-pytest-mpi python3-pytest-timeout python3-venv python3-pip python3-setuptools \
-    python3-wheel python3-dev openmpi-bin build-essential pkg-config libopenblas0-serial
+    python3-wheel python3-dev openmpi-bin build-essential pkg-config libopenblas0-serial \
+    python3-gmsh
 # the peer library of benchmarks/bench_getfem.py, installed by `make benchmark` only
 BENCH_PACKAGES := python3-getfem
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
