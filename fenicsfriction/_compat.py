@@ -8,6 +8,8 @@ arguments (``scale``/``alpha``, ``diagonal``/``diag``) are passed positionally.
 
 from __future__ import annotations
 
+import logging
+import math
 import typing
 
 from mpi4py import MPI
@@ -22,11 +24,14 @@ __all__ = [
     "assemble_matrix_into",
     "colliding_cells",
     "create_box",
+    "create_simplex_mesh",
     "evaluate_expression",
     "create_rectangle",
     "dg0_vector_space",
     "interpolation_points",
     "jit_options",
+    "lagrange_vector_space",
+    "nodal_quadrature",
     "petsc_vec",
     "scalar_function_space",
     "vector_function_space",
@@ -54,6 +59,32 @@ def dg0_vector_space(msh: mesh.Mesh, components: int) -> fem.FunctionSpace:
     return fem.VectorFunctionSpace(msh, ("DG", 0), dim=components)
 
 
+def lagrange_vector_space(msh: mesh.Mesh, degree: int, components: int) -> fem.FunctionSpace:
+    """Lagrange vectors with ``components`` entries (any number, not only ``gdim``)."""
+    if hasattr(fem, "functionspace"):
+        return fem.functionspace(msh, ("Lagrange", degree, (components,)))
+    return fem.VectorFunctionSpace(msh, ("Lagrange", degree), dim=components)
+
+
+class _QuietArrayMetadata(logging.Filter):
+    """UFL warns that it stringifies array-valued metadata for the form's signature; the
+    nodal rule's points are a few exact small numbers, for which ``str`` is exact."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return "metadata value of type ndarray" not in record.getMessage()
+
+
+def nodal_quadrature(facet_dim: int) -> dict:
+    """Integral metadata of the nodal (trapezoidal) rule on facets: the facet's vertices with
+    equal weights. FFCx's ``"vertex"`` rule is for cell integrals only, so the points are given
+    as a ``"custom"`` rule on the reference facet (an interval or a triangle)."""
+    logging.getLogger("UFL").addFilter(_QuietArrayMetadata())
+    points = np.vstack([np.zeros(facet_dim), np.eye(facet_dim)])
+    weights = np.full(facet_dim + 1, 1.0 / math.factorial(facet_dim) / (facet_dim + 1))
+    return {"quadrature_rule": "custom", "quadrature_degree": 1,
+            "quadrature_points": points, "quadrature_weights": weights}
+
+
 def petsc_vec(u: fem.Function) -> PETSc.Vec:
     """The PETSc vector that shares memory with a Function's dof array."""
     x = u.x
@@ -74,6 +105,20 @@ def create_box(comm: MPI.Comm, corner0: typing.Sequence[float], corner1: typing.
     points = [np.asarray(corner0, dtype=float), np.asarray(corner1, dtype=float)]
     return mesh.create_box(comm=comm, points=points, n=list(n),
                            cell_type=mesh.CellType.hexahedron)
+
+
+def create_simplex_mesh(comm: MPI.Comm, cells: np.ndarray, x: np.ndarray) -> mesh.Mesh:
+    """A mesh of triangles (2D) or tetrahedra (3D) from arrays (given on any ranks, e.g. all on
+    rank 0 and empty elsewhere), partitioned by dolfinx. The coordinate element is a UFL
+    ``VectorElement`` up to 0.6 and a Basix element from 0.7."""
+    gdim = x.shape[1]
+    cell = "triangle" if gdim == 2 else "tetrahedron"
+    try:
+        import basix.ufl
+        element = basix.ufl.element("Lagrange", cell, 1, shape=(gdim,))
+    except (ImportError, AttributeError):
+        element = ufl.VectorElement("Lagrange", cell, 1)
+    return mesh.create_mesh(comm, cells.astype(np.int64), x, ufl.Mesh(element))
 
 
 def colliding_cells(msh: mesh.Mesh, points: np.ndarray) -> typing.Any:

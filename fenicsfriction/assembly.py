@@ -16,14 +16,18 @@ from dolfinx import fem
 
 from fenicsfriction import _compat
 
-__all__ = ["assemble_jacobian", "assemble_residual"]
+__all__ = ["assemble_coupled_jacobian", "assemble_jacobian", "assemble_residual"]
 
 
 def assemble_residual(b: PETSc.Vec, L: fem.FormMetaClass, a: fem.FormMetaClass, bcs: list,
-                      x: PETSc.Vec, springs: typing.Sequence = ()) -> None:
+                      x: PETSc.Vec, springs: typing.Sequence = (),
+                      couplings: typing.Sequence = ()) -> None:
     """b = R(x) with Dirichlet rows set to (x - g) scaled by -1, springs included.
 
     ``x`` must already hold the state the coefficients of ``L`` see (ghosts updated).
+    ``couplings`` are compiled terms that are not integrals of ``L`` (two-body contact,
+    :class:`fenicsfriction.contact.ContactOperator`): each adds its part with
+    ``add_to_residual(b)``.
     """
     with b.localForm() as b_local:
         b_local.set(0.0)
@@ -35,6 +39,8 @@ def assemble_residual(b: PETSc.Vec, L: fem.FormMetaClass, a: fem.FormMetaClass, 
         b_array, x_array = b.getArray(), x.getArray(readonly=True)
         for spring in springs:
             spring.add_to_residual(b_array, x_array)
+    for coupling in couplings:
+        coupling.add_to_residual(b)
     if bcs:
         dolfinx.fem.petsc.set_bc(b, bcs, x, -1.0)
 
@@ -63,3 +69,19 @@ def assemble_jacobian(A: PETSc.Mat, a: fem.FormMetaClass, bcs: list,
     for spring in springs:
         spring.add_to_matrix(A)
     A.assemble()
+
+
+def assemble_coupled_jacobian(A: PETSc.Mat, bulk: PETSc.Mat, a: fem.FormMetaClass, bcs: list,
+                              springs: typing.Sequence = (), couplings: typing.Sequence = (),
+                              diagonal: float = 1.0) -> None:
+    """A = dR/du with terms that couple distant dofs (two-body contact) added.
+
+    ``bulk`` (created by dolfinx for ``a``) receives the integrals and springs, A their sum
+    with each coupling's ``add_to_matrix(A, bcs)``. A is a separate matrix because the
+    couplings' pattern (e.g. the contact pairing) changes from one call to the next and
+    dolfinx can assemble only into the pattern it created.
+    """
+    assemble_jacobian(bulk, a, bcs, springs, diagonal)
+    bulk.copy(A, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+    for coupling in couplings:
+        coupling.add_to_matrix(A, bcs)

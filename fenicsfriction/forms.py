@@ -215,6 +215,9 @@ class Residual:
         v: the test function of ``form``.
         bcs: Dirichlet conditions on V (homogeneous; may be empty).
         springs: nodal springs added to R outside UFL (see :class:`NodalSpring`).
+        couplings: terms between two points of the mesh that no integral of ``form`` holds,
+            e.g. two-body contact (:class:`fenicsfriction.contact.NodeToSegment`): UFL forms
+            of their own, chained into R and its derivatives by the solvers.
     """
 
     form: ufl.Form
@@ -224,6 +227,7 @@ class Residual:
     v: ufl.Argument
     bcs: list = dataclasses.field(default_factory=list)
     springs: list = dataclasses.field(default_factory=list)
+    couplings: list = dataclasses.field(default_factory=list)
 
     @property
     def V(self) -> fem.FunctionSpace:

@@ -35,7 +35,11 @@ import ufl
 from dolfinx import fem
 
 from fenicsfriction import _compat
-from fenicsfriction.assembly import assemble_jacobian, assemble_residual
+from fenicsfriction.assembly import (
+    assemble_coupled_jacobian,
+    assemble_jacobian,
+    assemble_residual,
+)
 from fenicsfriction.condensation import (
     InterfaceCondensation,
     condensation_for,
@@ -168,8 +172,16 @@ class SteadySolver:
         self.b = dolfinx.fem.petsc.create_vector(self.L)
         self.A = dolfinx.fem.petsc.create_matrix(self.a)
         self.x = self.b.duplicate()
+        # the contact couplings' steady residual and its derivative in u; with them the
+        # integrals are assembled apart (dolfinx assembles only into its own pattern)
+        self.couplings = [c.operator({self.u: 1.0}, rest=[residual.u_dot], jit_cache_dir=
+                                     jit_cache_dir) for c in residual.couplings]
+        if self.couplings:
+            self._uncoupled, self.A = self.A, self.A.duplicate()
+            self.A.assemble()
         comm = self.u.function_space.mesh.comm
-        split = None if linear_solver == "lu" else interface_split(jacobian, self.u)
+        split = (None if linear_solver == "lu" or self.couplings
+                 else interface_split(jacobian, self.u))
         self.preconditioner: InterfaceCondensation | ReusedFactorisation | None = None
         if split is not None and linear_solver in ("auto", "condensed"):
             nonzeros = self.A.getInfo(PETSc.Mat.InfoType.GLOBAL_SUM)["nz_allocated"]
@@ -177,6 +189,9 @@ class SteadySolver:
                 split, self.u.function_space, prefix,
                 **({"max_interface": int(np.sqrt(AUTO_CONDENSE_MAX_FILL * nonzeros))}
                    if linear_solver == "auto" else {}))
+        if linear_solver == "reused-lu" and self.couplings:
+            raise ValueError("linear_solver='reused-lu' is not available with contact "
+                             "couplings (their pattern changes with the pairing); use 'lu'")
         if linear_solver == "reused-lu" or (linear_solver == "auto" and split is not None
                                              and self.preconditioner is None):
             self.preconditioner = ReusedFactorisation(comm, prefix)
@@ -224,7 +239,8 @@ class SteadySolver:
 
     def _F(self, snes, x, b):
         self._update(x)
-        assemble_residual(b, self.L, self.a, self.residual.bcs, x, self.residual.springs)
+        assemble_residual(b, self.L, self.a, self.residual.bcs, x, self.residual.springs,
+                          self.couplings)
 
     def _bulk_values(self) -> list[np.ndarray]:
         return [np.array(c.value if hasattr(c, "value") else c.x.array)
@@ -250,6 +266,9 @@ class SteadySolver:
                 assert self.preconditioner is not None
                 self.preconditioner.stale = True
             assemble_jacobian(A, self._a_interface, self.residual.bcs, base=self._bulk)
+        elif self.couplings:
+            assemble_coupled_jacobian(A, self._uncoupled, self.a, self.residual.bcs,
+                                      self.residual.springs, self.couplings)
         else:
             assemble_jacobian(A, self.a, self.residual.bcs, self.residual.springs)
         self.convergence.jacobian_assembled(A)

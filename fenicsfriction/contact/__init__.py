@@ -1,0 +1,9 @@
+"""Two deformable bodies in frictional contact (Pop 1997): node-to-segment contact elements
+carrying the interface law of Martins & Oden (1987) between a slave surface and a master one,
+in the same residual as the bulk terms (:mod:`fenicsfriction.forms`)."""
+
+from fenicsfriction.contact.kinematics import Projection, project
+from fenicsfriction.contact.node_to_segment import ContactOperator, NodeToSegment
+from fenicsfriction.contact.pairing import Pairing, facet_nodes
+
+__all__ = ["ContactOperator", "NodeToSegment", "Pairing", "Projection", "facet_nodes", "project"]

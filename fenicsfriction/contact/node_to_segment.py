@@ -1,0 +1,284 @@
+r"""The interface law between two deformable bodies: node-to-segment contact elements.
+
+Pop (1997) puts the law of Martins & Oden (1987) — normal compliance, normal damping,
+regularised friction — between a slave node :math:`s` and its closest point on the master
+surface, in contact elements of one slave node and the two (2D) or three (3D) nodes of the
+master facet. With the projection of :mod:`fenicsfriction.contact.kinematics`
+(:math:`N_a(\xi)`, :math:`n`, :math:`g`), the penetration is :math:`d = (-g)_+` and the
+relative velocity :math:`w = \dot u_s - (U_T + \sum_a N_a \dot u_a)` (``transport`` :math:`U_T`:
+a rigid velocity of the master body, e.g. a belt's); the force on the slave node is
+
+.. math:: f = \big(c_n d^{m_n} + b_n d^{l_n} \dot d\big)\, n + t_T(d, w_T), \qquad
+          \dot d = -w\cdot n,
+
+:math:`t_T` the regularised friction traction of :func:`fenicsfriction.laws.friction_traction`
+on the tangential part :math:`w_T`, and :math:`-f` goes to the master nodes with the weights
+:math:`N_a(\xi)`. Its virtual power is
+
+.. math:: R_c(v) = -\int_{\Gamma_s} f\cdot\Big(v_s - \sum_a N_a(\xi)\, v_a\Big)\, ds_h,
+
+:math:`ds_h` the nodal (trapezoidal) rule on the slave facets, so that each slave node carries
+its tributary length/area. The master nodes' displacements (velocities, ...) enter as fields
+of a space ``W`` at the slave nodes, :math:`U = Q u`, ``Q`` the pairing of
+:mod:`fenicsfriction.contact.pairing`. So the term is two UFL forms, ``F`` (test functions of
+``V``) and ``G`` (of ``W``), and the residual and Jacobian are
+
+.. math:: R = F + Q^T G, \qquad
+          \frac{dR}{du} = F_{,u} + F_{,U} Q + Q^T G_{,u} + Q^T G_{,U} Q,
+
+every block an :func:`ufl.derivative` (the closest point's motion along the facet included),
+chained through ``Q`` with PETSc's sparse products. The pairing is searched again at every
+residual evaluation (finite sliding); ``frozen=True`` keeps it (for derivative tests).
+"""
+
+from __future__ import annotations
+
+import typing
+
+from petsc4py import PETSc
+
+import dolfinx.fem.petsc
+import numpy as np
+import ufl
+from dolfinx import fem, mesh
+
+from fenicsfriction import _compat, laws
+from fenicsfriction.contact.kinematics import Projection, project
+from fenicsfriction.contact.pairing import Pairing, facet_nodes
+
+__all__ = ["ContactOperator", "NodeToSegment"]
+
+Value = typing.Any
+
+
+class NodeToSegment:
+    """Slave nodes of one tagged surface against the facets of another, same residual.
+
+    Args:
+        u: the displacement (degree-1 Lagrange vectors on the mesh holding both bodies).
+        facet_tags: the mesh's facet tags.
+        slave, master: the tags of the slave and master surfaces.
+        c_n, m_n, c_T, m_T, b_n, l_n, eps, regularisation: the interface law
+            (:class:`fenicsfriction.laws.InterfaceLaw`'s parameters: numbers or
+            ``fem.Constant``), ``c_T = 0`` (default) for frictionless contact, whose residual
+            then has no friction term.
+        velocity: the slave velocity, a UFL vector of Functions of ``V`` (``u_dot`` in
+            dynamics, ``(u - u_old) / dt`` in a quasi-static increment); ``None``: no velocity
+            (frictionless statics).
+        fields: the Functions of ``V`` that ``velocity`` depends on, besides ``u``; each gets
+            a mirror in ``W`` (its values at the master nodes), replacing it on the master side.
+        transport: the master body's rigid velocity :math:`U_T` (a vector; default zero).
+        weight: the factor of the term (1/2 for each pass of two-pass contact).
+        frozen: keep the pairing of the first search (derivative tests).
+
+    Attributes:
+        V, W: the displacement space and the space of master quantities at slave nodes.
+        pairing: the :class:`~fenicsfriction.contact.pairing.Pairing`.
+        mirrors: the W Function of each V field (``mirrors[u]`` is ``Q u``).
+        F, G: the slave- and master-side forms of the contact's virtual power.
+        projection: the UFL projection (shape functions, normal, gap).
+        pressure, traction: the normal pressure and tangential traction (UFL) at slave nodes.
+    """
+
+    def __init__(self, u: fem.Function, facet_tags: mesh.MeshTags, slave: int, master: int,
+                 c_n: Value, m_n: Value, c_T: Value = 0.0, m_T: Value | None = None,
+                 b_n: Value = 0.0, l_n: Value | None = None, eps: Value = 1e-3,
+                 regularisation: str = "c1", velocity: typing.Any = None,
+                 fields: typing.Sequence[fem.Function] = (), transport: typing.Any = None,
+                 weight: float = 1.0, frozen: bool = False):
+        V = u.function_space
+        msh = V.mesh
+        dim = msh.geometry.dim
+        laws.check("V", V.ufl_element().degree(), V.ufl_element().degree() == 1,
+                   "node-to-segment contact needs a degree-1 Lagrange displacement space")
+        for name, tag in (("slave", slave), ("master", master)):
+            count = msh.comm.allreduce(int(np.count_nonzero(facet_tags.values == tag)))
+            laws.check(name, tag, count > 0, "a facet tag present in facet_tags")
+        laws.check("regularisation", regularisation, regularisation in laws.REGULARISATIONS,
+                   f"one of {sorted(laws.REGULARISATIONS)}")
+        self.u, self.V = u, V
+        self.dim = dim
+        self.frozen = frozen
+        self.W = _compat.lagrange_vector_space(msh, 1, dim * dim)
+        slave_nodes = np.unique(facet_nodes(V, facet_tags, slave, outward=False))
+        owned = slave_nodes[slave_nodes < V.dofmap.index_map.size_local]
+        self.pairing = Pairing(V, self.W, owned, facet_nodes(V, facet_tags, master))
+        self.mirrors: dict[fem.Function, fem.Function] = {
+            f: fem.Function(self.W, name=f"master_{f.name}") for f in (u, *fields)}
+        self.ds = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags,
+                              subdomain_id=slave, metadata=_compat.nodal_quadrature(dim - 1))
+        self.searched = False
+
+        X = ufl.SpatialCoordinate(msh)
+        x_master = [self._node(self.pairing.reference, a) + self._node(self.mirrors[u], a)
+                    for a in range(dim)]
+        self.projection: Projection = project(X + u, x_master)
+        n = self.projection.normal
+        d = laws.penetration(-self.projection.gap)
+        w = None
+        if velocity is not None:
+            w = velocity - self._master_value(velocity, fields)
+            if transport is not None:
+                w = w - ufl.as_vector(transport)
+        approach = -ufl.dot(w, n) if w is not None else 0.0
+        self.pressure = laws.normal_traction(d, c_n, m_n, approach, b_n,
+                                             m_n if l_n is None else l_n)
+        force = self.pressure * n
+        self.traction = None
+        if not (isinstance(c_T, (int, float)) and c_T == 0):
+            laws.check("velocity", velocity, w is not None,
+                       "friction (c_T != 0) needs the slave velocity")
+            w_T = w - ufl.dot(w, n) * n
+            self.traction = laws.friction_traction(d, w_T, c_T, m_n if m_T is None else m_T,
+                                                   eps, regularisation)
+            force = force + self.traction
+        v, omega = ufl.TestFunction(V), ufl.TestFunction(self.W)
+        master_test = self.projection.interpolate([self._node(omega, a) for a in range(dim)])
+        self.F = -weight * ufl.inner(force, v) * self.ds
+        self.G = weight * ufl.inner(force, master_test) * self.ds
+
+    def _node(self, packed: typing.Any, a: int) -> typing.Any:
+        """The vector of master node ``a`` in a packed W quantity."""
+        d = self.dim
+        return ufl.as_vector([packed[a * d + k] for k in range(d)])
+
+    def _master_value(self, expr: typing.Any, fields: typing.Sequence[fem.Function]) -> typing.Any:
+        """``expr`` (a UFL vector of V fields) at the closest point of the master facet."""
+        nodal = [ufl.replace(expr, {f: self._node(self.mirrors[f], a)
+                                    for f in (self.u, *fields)})
+                 for a in range(self.dim)]
+        return self.projection.interpolate(nodal)
+
+    def update(self, search: bool = True) -> None:
+        """Pair the slave nodes at the current ``u`` (unless frozen) and refresh the mirrors."""
+        if search and not (self.frozen and self.searched):
+            self.pairing.search(self.u)
+            self.searched = True
+        Q = self.pairing.Q
+        assert Q is not None, "search before the first use"
+        for f, mirror in self.mirrors.items():
+            Q.mult(_compat.petsc_vec(f), _compat.petsc_vec(mirror))
+            mirror.x.scatter_forward()
+
+    def operator(self, derivatives: dict[fem.Function, Value],
+                 rest: typing.Sequence[fem.Function] = (),
+                 jit_cache_dir: str | None = None) -> ContactOperator:
+        """The compiled residual and Jacobian of this contact.
+
+        Args:
+            derivatives: the fields to differentiate with and each one's weight (``{u: 1}``
+                for a stiffness, ``{u: 1, u_dot: shift}`` for a time step's Jacobian).
+            rest: fields set to zero first, with their mirrors (``u_dot`` in steady sliding).
+        """
+        zero = ufl.zero(*self.u.ufl_shape)
+        at_rest = {}
+        for f in rest:
+            at_rest[f] = zero
+            if f in self.mirrors:
+                at_rest[self.mirrors[f]] = ufl.zero(*self.mirrors[f].ufl_shape)
+        F = ufl.replace(self.F, at_rest) if at_rest else self.F
+        G = ufl.replace(self.G, at_rest) if at_rest else self.G
+        return ContactOperator(self, F, G, derivatives, jit_cache_dir)
+
+
+def _derivative(form: ufl.Form, pairs: list[tuple[fem.Function, Value]],
+                space: fem.FunctionSpace) -> ufl.Form | None:
+    """Σ weight · ∂form/∂field (trial functions of ``space``), or None if it vanishes."""
+    trial = ufl.TrialFunction(space)
+    terms = [weight * ufl.derivative(form, f, trial) for f, weight in pairs
+             if f in form.coefficients()]
+    if not terms:
+        return None
+    total = ufl.algorithms.expand_derivatives(sum(terms[1:], terms[0]))
+    return None if total.empty() else total
+
+
+class ContactOperator:
+    """A :class:`NodeToSegment`'s residual ``F + Q^T G`` and Jacobian, compiled.
+
+    It is called by :func:`fenicsfriction.assembly.assemble_residual` and
+    :func:`~fenicsfriction.assembly.assemble_jacobian` (``couplings=``): the residual searches
+    the pairing at the current state, the Jacobian chains the four blocks through ``Q``.
+    """
+
+    def __init__(self, contact: NodeToSegment, F: ufl.Form, G: ufl.Form,
+                 derivatives: dict[fem.Function, Value], jit_cache_dir: str | None = None):
+        self.contact = contact
+        compile_ = lambda form: None if form is None else _compat.form(form, jit_cache_dir)  # noqa: E731
+        self.F, self.G = compile_(F), compile_(G)
+        own = list(derivatives.items())
+        mirrored = [(contact.mirrors[f], w) for f, w in derivatives.items()
+                    if f in contact.mirrors]
+        V, W = contact.V, contact.W
+        self.blocks = {key: compile_(_derivative(form, pairs, space))
+                       for key, form, pairs, space in (
+                           ("VV", F, own, V), ("VW", F, mirrored, W),
+                           ("WV", G, own, V), ("WW", G, mirrored, W))}
+        self.b_F = dolfinx.fem.petsc.create_vector(self.F)
+        self.b_G = dolfinx.fem.petsc.create_vector(self.G)
+        self.matrices = {key: dolfinx.fem.petsc.create_matrix(a)
+                         for key, a in self.blocks.items() if a is not None}
+
+    def add_to_residual(self, b: PETSc.Vec) -> None:
+        """``b += F + Q^T G`` at the current state (pairing searched first)."""
+        self.contact.update()
+        for vector, form in ((self.b_F, self.F), (self.b_G, self.G)):
+            with vector.localForm() as local:
+                local.set(0.0)
+            dolfinx.fem.petsc.assemble_vector(vector, form)
+            vector.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        b.axpy(1.0, self.b_F)
+        Q = self.contact.pairing.Q
+        assert Q is not None
+        Q.multTransposeAdd(self.b_G, b, b)
+
+    def matrix(self, bcs: typing.Sequence[fem.DirichletBC] = ()) -> PETSc.Mat:
+        """The chained Jacobian of the contact (rows and columns of ``bcs`` zeroed)."""
+        self.contact.update(search=not self.contact.searched)
+        Q = self.contact.pairing.Q
+        assert Q is not None
+        for key, A in self.matrices.items():
+            A.zeroEntries()
+            dolfinx.fem.petsc.assemble_matrix(A, self.blocks[key])
+            A.assemble()
+        m = self.matrices
+        parts = []
+        if "VV" in m:
+            parts.append(m["VV"])
+        if "VW" in m:
+            parts.append(m["VW"].matMult(Q))
+        if "WV" in m:
+            parts.append(Q.transposeMatMult(m["WV"]))
+        if "WW" in m:
+            parts.append(m["WW"].PtAP(Q))
+        if not parts:
+            return None
+        J = parts[0].copy()
+        for part in parts[1:]:
+            J.axpy(1.0, part, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        rows = _constrained_rows(self.contact.V, bcs)
+        J.zeroRowsColumns(rows, diag=0.0)
+        for part in parts[1:]:
+            part.destroy()
+        return J
+
+    def add_to_matrix(self, A: PETSc.Mat, bcs: typing.Sequence[fem.DirichletBC] = ()) -> None:
+        """``A += dR_c/du``; A's pattern grows to the contact's couplings, so A must not be a
+        matrix dolfinx assembles into (see
+        :func:`fenicsfriction.assembly.assemble_coupled_jacobian`)."""
+        J = self.matrix(bcs)
+        if J is not None:
+            A.axpy(1.0, J, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+            J.destroy()
+
+
+def _constrained_rows(V: fem.FunctionSpace, bcs: typing.Sequence[fem.DirichletBC]) -> np.ndarray:
+    """Global indices of the owned dofs of ``V`` constrained by ``bcs``."""
+    bs = V.dofmap.index_map_bs
+    index_map = V.dofmap.index_map
+    rows = [np.zeros(0, dtype=np.int64)]
+    for bc in bcs:
+        dofs, first_ghost = bc.dof_indices()
+        owned = dofs[:first_ghost]
+        rows.append(index_map.local_to_global(owned // bs).astype(np.int64) * bs + owned % bs)
+    return np.unique(np.concatenate(rows)).astype(PETSc.IntType)

@@ -1,0 +1,256 @@
+"""Contact search: each slave node paired with its closest master facet, in parallel.
+
+The master surface is gathered on every rank (node global indices, reference and current
+coordinates of its facets, a few numbers per facet), so a slave node and its master facet may
+live on different ranks; each rank then pairs its own slave nodes with a k-d tree of the master
+facets' centroids (SciPy), checking the exact point-to-facet distance of the nearest few. The
+pairing is the sparse 0/1 operator ``Q`` that carries the displacements of the master nodes
+of each slave node's facet to the slave node (rows: the node's ``dim * nodes_per_facet``
+components in the space ``W``; columns: the master dofs of ``V``), a PETSc matrix whose
+columns may belong to any rank.
+
+Cost per search: an all-gather of the master surface (O(master facets)), one k-d tree build
+(O(m log m)) and O(s log m) queries for s slave nodes, against the O(n) assembly of the bulk.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import numpy as np
+from dolfinx import fem, mesh
+from scipy.spatial import cKDTree
+
+__all__ = ["Pairing", "facet_nodes", "point_facet_distance", "surface_coordinates"]
+
+#: how many master facets (by centroid distance) are checked exactly for each slave node
+CANDIDATES = 12
+
+#: a slave node keeps its facet while its projection's shape functions are all >= -this
+KEEP_TOLERANCE = 1e-2
+
+
+def facet_nodes(V: fem.FunctionSpace, facet_tags: mesh.MeshTags, tag: int,
+                outward: bool = True) -> np.ndarray:
+    """The local node indices of the vertices of the facets tagged ``tag``, one row per facet.
+
+    With ``outward`` the nodes of each row are ordered so that the normal of
+    :func:`fenicsfriction.contact.kinematics.project` points out of the body the facet bounds.
+    ``V`` must be a degree-1 Lagrange space.
+    """
+    msh = V.mesh
+    tdim = msh.topology.dim
+    msh.topology.create_connectivity(tdim - 1, tdim)
+    msh.topology.create_connectivity(tdim, tdim - 1)
+    f_to_c = msh.topology.connectivity(tdim - 1, tdim)
+    c_to_f = msh.topology.connectivity(tdim, tdim - 1)
+    layout = V.dofmap.dof_layout
+    x = V.tabulate_dof_coordinates()[:, :tdim]
+    facets = facet_tags.indices[facet_tags.values == tag]
+    rows = np.empty((len(facets), tdim), dtype=np.int32)
+    for i, facet in enumerate(facets):
+        cell = f_to_c.links(facet)[0]
+        local = int(np.flatnonzero(c_to_f.links(cell) == facet)[0])
+        cell_nodes = V.dofmap.cell_dofs(cell)
+        nodes = cell_nodes[layout.entity_closure_dofs(tdim - 1, local)]
+        if outward:
+            inside = x[cell_nodes].mean(axis=0)
+            if np.dot(_normal(x[nodes]), x[nodes].mean(axis=0) - inside) < 0:
+                nodes = nodes[[0, 2, 1]] if tdim == 3 else nodes[::-1]
+        rows[i] = nodes
+    return rows
+
+
+def _normal(x: np.ndarray) -> np.ndarray:
+    """Unnormalised normal of the facet(s) through ``x[..., a, :]`` (kinematics' convention)."""
+    t = x[..., 1, :] - x[..., 0, :]
+    if x.shape[-2] == 2:
+        return np.stack([-t[..., 1], t[..., 0]], axis=-1)
+    return np.cross(t, x[..., 2, :] - x[..., 0, :])
+
+
+def point_facet_distance(p: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Distance of points ``p[..., :]`` to the closed segments/triangles ``x[..., a, :]``."""
+    if x.shape[-2] == 2:
+        return _point_segment_distance(p, x[..., 0, :], x[..., 1, :])
+    x1, x2, x3 = x[..., 0, :], x[..., 1, :], x[..., 2, :]
+    t1, t2, r = x2 - x1, x3 - x1, p - x1
+    a11, a12, a22 = (t1 * t1).sum(-1), (t1 * t2).sum(-1), (t2 * t2).sum(-1)
+    r1, r2 = (r * t1).sum(-1), (r * t2).sum(-1)
+    det = a11 * a22 - a12 * a12
+    xi1, xi2 = (a22 * r1 - a12 * r2) / det, (a11 * r2 - a12 * r1) / det
+    inside = (xi1 >= 0) & (xi2 >= 0) & (xi1 + xi2 <= 1)
+    plane = np.linalg.norm(r - xi1[..., None] * t1 - xi2[..., None] * t2, axis=-1)
+    edges = np.minimum(np.minimum(_point_segment_distance(p, x1, x2),
+                                  _point_segment_distance(p, x2, x3)),
+                       _point_segment_distance(p, x3, x1))
+    return np.where(inside, plane, edges)
+
+
+def surface_coordinates(p: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """The shape functions N_a(ξ) of the projections of points ``p[..., :]`` on the lines or
+    planes of the facets ``x[..., a, :]`` (all in [0, 1] when the projection is on the facet)."""
+    x1 = x[..., 0, :]
+    r, t = p - x1, x[..., 1:, :] - x1[..., None, :]
+    metric = np.einsum("...ak,...bk->...ab", t, t)
+    xi = np.linalg.solve(metric, np.einsum("...ak,...k->...a", t, r)[..., None])[..., 0]
+    return np.concatenate([1 - xi.sum(axis=-1, keepdims=True), xi], axis=-1)
+
+
+def _point_segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    t = b - a
+    s = np.clip(((p - a) * t).sum(-1) / (t * t).sum(-1), 0.0, 1.0)
+    return np.linalg.norm(p - a - s[..., None] * t, axis=-1)
+
+
+@dataclasses.dataclass
+class _MasterSurface:
+    """The master facets of all ranks: global node indices and coordinates, per facet."""
+
+    global_nodes: np.ndarray  # (m, nen) int64
+    reference: np.ndarray  # (m, nen, dim)
+    current: np.ndarray  # (m, nen, dim)
+
+
+class Pairing:
+    """Slave nodes of one surface paired with the facets of another, and the operator Q.
+
+    Args:
+        V: the displacement space (degree-1 Lagrange vectors) of the mesh holding both bodies.
+        W: vectors of ``dim * nodes_per_facet`` components on the same mesh and nodes, where
+            the master facet's nodal quantities are stored at each slave node.
+        slave_nodes: the local indices of the slave nodes this rank pairs (owned ones).
+        master_facets: (facets, nodes per facet) local node indices of this rank's master
+            facets, ordered outward (:func:`facet_nodes`).
+
+    Attributes:
+        Q: the pairing operator, a PETSc matrix W x V (``None`` before :meth:`search`).
+        facet: for each slave node, the index of its master facet in the gathered surface.
+        reference: a Function of W: the reference coordinates of each slave node's master
+            nodes (the current ones are these plus ``Q u``).
+        searches, changes: how many searches ran, how many changed the pairing.
+    """
+
+    def __init__(self, V: fem.FunctionSpace, W: fem.FunctionSpace, slave_nodes: np.ndarray,
+                 master_facets: np.ndarray):
+        self.V, self.W = V, W
+        self.comm: MPI.Comm = V.mesh.comm
+        self.dim = V.mesh.geometry.dim
+        self.nodes_per_facet = master_facets.shape[1] if master_facets.ndim == 2 else self.dim
+        self.slave_nodes = np.asarray(slave_nodes, dtype=np.int32)
+        self.master_facets = master_facets.reshape(-1, self.nodes_per_facet)
+        self.x_nodes = V.tabulate_dof_coordinates()[:, :self.dim]
+        self.Q: PETSc.Mat | None = None
+        self.facet = np.full(len(self.slave_nodes), -1, dtype=np.int64)
+        self.reference = fem.Function(W, name="master_reference")
+        self.searches = 0
+        self.changes = 0
+        self._surface: _MasterSurface | None = None
+
+    def gather(self, u: fem.Function) -> _MasterSurface:
+        """The master surface of every rank at displacement ``u`` (an all-gather)."""
+        d, nen = self.dim, self.nodes_per_facet
+        nodes = self.master_facets
+        index_map = self.V.dofmap.index_map
+        global_nodes = index_map.local_to_global(nodes.ravel()).reshape(nodes.shape)
+        reference = self.x_nodes[nodes]
+        displacement = u.x.array.reshape(-1, d)[nodes]
+        pieces = self.comm.allgather((global_nodes.astype(np.int64), reference,
+                                      reference + displacement))
+        g = np.concatenate([p[0] for p in pieces]).reshape(-1, nen)
+        ref = np.concatenate([p[1] for p in pieces]).reshape(-1, nen, d)
+        cur = np.concatenate([p[2] for p in pieces]).reshape(-1, nen, d)
+        # a facet on a process boundary may be listed by two ranks: keep one copy
+        _, first = np.unique(np.sort(g, axis=1), axis=0, return_index=True)
+        first = np.sort(first)
+        return _MasterSurface(g[first], ref[first], cur[first])
+
+    def search(self, u: fem.Function) -> bool:
+        """Pair every slave node with its closest master facet at displacement ``u``.
+
+        Returns True if the pairing changed (``Q`` and ``reference`` are then rebuilt).
+        """
+        surface = self.gather(u)
+        self.searches += 1
+        d = self.dim
+        x_slave = self.x_nodes[self.slave_nodes] + u.x.array.reshape(-1, d)[self.slave_nodes]
+        facet = np.zeros(len(self.slave_nodes), dtype=np.int64)
+        m = len(surface.global_nodes)
+        if m == 0:
+            raise RuntimeError("contact search: the master surface has no facets on any rank")
+        if len(x_slave):
+            k = min(CANDIDATES, m)
+            _, candidates = cKDTree(surface.current.mean(axis=1)).query(x_slave, k=k)
+            candidates = candidates.reshape(len(x_slave), k)
+            distance = point_facet_distance(x_slave[:, None, :], surface.current[candidates])
+            best = np.argmin(distance, axis=1)
+            facet = candidates[np.arange(len(x_slave)), best]
+            if self._surface is not None:
+                facet = self._keep_ties(facet, x_slave, surface)
+        changed = self.Q is None or not np.array_equal(
+            surface.global_nodes[facet], self._paired_nodes())
+        self._surface = surface
+        changed = bool(self.comm.allreduce(changed, op=MPI.LOR))
+        if changed:
+            self.changes += 1
+            self.facet = facet
+            self._build(surface)
+        else:
+            self.facet = facet
+        return changed
+
+    def _keep_ties(self, facet: np.ndarray, x_slave: np.ndarray,
+                   surface: _MasterSurface) -> np.ndarray:
+        """Keep a slave node's facet while its projection stays on it (surface coordinates in
+        the facet, to :data:`KEEP_TOLERANCE`): a node over a master edge or vertex is about as
+        close to every facet there, and switching between them at each residual evaluation
+        would stall Newton on the kink of the master surface."""
+        index = {tuple(row): i for i, row in enumerate(np.sort(surface.global_nodes, axis=1))}
+        previous = np.array([index.get(tuple(row), -1)
+                             for row in np.sort(self._paired_nodes(), axis=1)], dtype=np.int64)
+        found = previous >= 0
+        if not found.any():
+            return facet
+        shape = surface_coordinates(x_slave[found], surface.current[previous[found]])
+        keep = np.zeros(len(facet), dtype=bool)
+        keep[found] = np.all(shape >= -KEEP_TOLERANCE, axis=1)
+        return np.where(keep, previous, facet)
+
+    def _paired_nodes(self) -> np.ndarray:
+        assert self._surface is not None
+        return self._surface.global_nodes[self.facet]
+
+    def _build(self, surface: _MasterSurface) -> None:
+        """Q and the master reference coordinates for the current ``facet``."""
+        d, nen = self.dim, self.nodes_per_facet
+        bs_w = d * nen
+        reference = self.reference.x.array.reshape(-1, bs_w)
+        reference[:] = 0.0
+        reference[self.slave_nodes] = surface.reference[self.facet].reshape(-1, bs_w)
+        self.reference.x.scatter_forward()
+        w_map, v_map = self.W.dofmap.index_map, self.V.dofmap.index_map
+        # one entry per row of a slave node's components, none elsewhere: CSR of the local rows
+        rows = (self.slave_nodes.astype(np.int64)[:, None] * bs_w + np.arange(bs_w)).ravel()
+        cols = (surface.global_nodes[self.facet][:, :, None] * d + np.arange(d)).ravel()
+        order = np.argsort(rows)
+        counts = np.zeros(w_map.size_local * bs_w, dtype=np.int32)
+        counts[rows] = 1
+        indptr = np.concatenate([[0], np.cumsum(counts)]).astype(PETSc.IntType)
+        if self.Q is not None:
+            self.Q.destroy()
+        Q = PETSc.Mat().createAIJ(
+            ((w_map.size_local * bs_w, w_map.size_global * bs_w),
+             (v_map.size_local * d, v_map.size_global * d)),
+            csr=(indptr, cols[order].astype(PETSc.IntType), np.ones(len(rows))),
+            comm=self.comm)
+        self.Q = Q
+
+    def gap_to_surface(self, u: fem.Function) -> np.ndarray:
+        """Distance of each slave node to its paired facet (current configuration)."""
+        assert self._surface is not None
+        d = self.dim
+        x_slave = self.x_nodes[self.slave_nodes] + u.x.array.reshape(-1, d)[self.slave_nodes]
+        return point_facet_distance(x_slave, self._surface.current[self.facet])
