@@ -83,7 +83,16 @@ class DynamicsSolver(Alpha2Integrator):
         # once in full, which fixes the matrix's nonzero structure for the sums below
         assemble_jacobian(self.A, self.a, residual.bcs, residual.springs)
         self._bulk = _ConstantJacobian(fixed, self.A, residual) if fixed[0] else None
-        self.a_varying = _compat.form(ufl.Form(varying)) if self._bulk else self.a
+        # None: every integral is constant (the state enters through couplings only)
+        self.a_varying = (self.a if self._bulk is None
+                          else _compat.form(ufl.Form(varying)) if varying else None)
+        # contact couplings: residual and shifted Jacobian of their own, added to a matrix
+        # apart from the one dolfinx assembles into (their pattern follows the pairing)
+        self.couplings = [c.operator({residual.u: 1.0, residual.u_dot: self.shift_v})
+                          for c in residual.couplings]
+        self._uncoupled = self.A
+        if self.couplings:
+            self.A = self._uncoupled.duplicate(copy=True)
         super().__init__(msh.comm, prefix, self.b, self.A, options, atol, predictor)
 
     def _state(self) -> tuple[PETSc.Vec, PETSc.Vec]:
@@ -99,16 +108,26 @@ class DynamicsSolver(Alpha2Integrator):
 
     def _F(self, ts, t, x, xdot, xddot, F):
         self._load(x, xdot, xddot)
-        assemble_residual(F, self.L, self.a, self.residual.bcs, x, self.residual.springs)
+        assemble_residual(F, self.L, self.a, self.residual.bcs, x, self.residual.springs,
+                          self.couplings)
 
     def _J(self, ts, t, x, xdot, xddot, shift_v, shift_a, J, P):
         self.shift_v.value = shift_v
         self.shift_a.value = shift_a
+        bcs = self.residual.bcs
+        target = self._uncoupled if self.couplings else J
         if self._bulk is None:
-            assemble_jacobian(J, self.a, self.residual.bcs, self.residual.springs)
+            assemble_jacobian(target, self.a, bcs, self.residual.springs)
+        elif self.a_varying is None:
+            self._bulk.matrix(shift_v, shift_a).copy(
+                target, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         else:
-            assemble_jacobian(J, self.a_varying, self.residual.bcs,
+            assemble_jacobian(target, self.a_varying, bcs,
                               base=self._bulk.matrix(shift_v, shift_a))
+        if self.couplings:
+            target.copy(J, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+            for coupling in self.couplings:
+                coupling.add_to_matrix(J, bcs)
         self.convergence.jacobian_assembled(J)
 
 

@@ -114,6 +114,19 @@ class StabilitySolver:
         self.M = dolfinx.fem.petsc.create_matrix(self._forms["M"])
         self.C = (dolfinx.fem.petsc.create_matrix(self._forms["C"]) if self._forms["C"]
                   else self.M.duplicate())
+        # contact couplings: their K̄ and C parts (derivatives in u and u̇ about u̇ = 0) are
+        # added to matrices of the pencil apart from the ones dolfinx assembles into
+        u, u_dot = residual.u, residual.u_dot
+        self._couplings = {
+            "K": [c.operator({u: 1.0}, rest=[u_dot]) for c in residual.couplings],
+            "C": [c.operator({u_dot: 1.0}, rest=[u_dot]) for c in residual.couplings]}
+        self._uncoupled = {}
+        if residual.couplings:
+            for name in ("K", "C"):
+                self._uncoupled[name] = getattr(self, name)
+                coupled = self._uncoupled[name].duplicate()
+                coupled.assemble()
+                setattr(self, name, coupled)
         self.pep = SLEPc.PEP().create(self.comm)
         self.pep.setOptionsPrefix(prefix)
         self.pep.setOperators([self.K, self.C, self.M])
@@ -130,13 +143,19 @@ class StabilitySolver:
     def assemble(self) -> None:
         """Assemble K̄ (nodal springs included), C and M at the residual's current state."""
         bcs = self.residual.bcs
-        assemble_jacobian(self.K, self._forms["K"], bcs, self.residual.springs, 1.0)
         assemble_jacobian(self.M, self._forms["M"], bcs, (), 0.0)
-        if self._forms["C"] is not None:
-            assemble_jacobian(self.C, self._forms["C"], bcs, (), 0.0)
-        else:
-            self.C.zeroEntries()
-            self.C.assemble()
+        for name, springs, diagonal in (("K", self.residual.springs, 1.0), ("C", (), 0.0)):
+            uncoupled = self._uncoupled.get(name, getattr(self, name))
+            if self._forms[name] is not None:
+                assemble_jacobian(uncoupled, self._forms[name], bcs, springs, diagonal)
+            else:
+                uncoupled.zeroEntries()
+                uncoupled.assemble()
+            if name in self._uncoupled:
+                coupled = getattr(self, name)
+                uncoupled.copy(coupled, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+                for coupling in self._couplings[name]:
+                    coupling.add_to_matrix(coupled, bcs)
         self._norms = tuple(A.norm(PETSc.NormType.INFINITY) for A in (self.K, self.C, self.M))
 
     def _relative_residual(self, lam: complex, xr: PETSc.Vec, xi: PETSc.Vec) -> float:

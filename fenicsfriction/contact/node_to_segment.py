@@ -168,7 +168,8 @@ class NodeToSegment:
         Args:
             derivatives: the fields to differentiate with and each one's weight (``{u: 1}``
                 for a stiffness, ``{u: 1, u_dot: shift}`` for a time step's Jacobian).
-            rest: fields set to zero first, with their mirrors (``u_dot`` in steady sliding).
+            rest: fields set to zero, with their mirrors, after differentiating (``u_dot`` in
+                steady sliding and in the linearisation about it).
         """
         zero = ufl.zero(*self.u.ufl_shape)
         at_rest = {}
@@ -176,21 +177,24 @@ class NodeToSegment:
             at_rest[f] = zero
             if f in self.mirrors:
                 at_rest[self.mirrors[f]] = ufl.zero(*self.mirrors[f].ufl_shape)
-        F = ufl.replace(self.F, at_rest) if at_rest else self.F
-        G = ufl.replace(self.G, at_rest) if at_rest else self.G
-        return ContactOperator(self, F, G, derivatives, jit_cache_dir)
+        return ContactOperator(self, derivatives, at_rest, jit_cache_dir)
 
 
 def _derivative(form: ufl.Form, pairs: list[tuple[fem.Function, Value]],
-                space: fem.FunctionSpace) -> ufl.Form | None:
-    """Σ weight · ∂form/∂field (trial functions of ``space``), or None if it vanishes."""
+                space: fem.FunctionSpace, at_rest: dict) -> ufl.Form | None:
+    """Σ weight · ∂form/∂field (trial functions of ``space``) with ``at_rest`` substituted
+    after differentiating, or None if it vanishes."""
     trial = ufl.TrialFunction(space)
     terms = [weight * ufl.derivative(form, f, trial) for f, weight in pairs
              if f in form.coefficients()]
     if not terms:
         return None
-    total = ufl.algorithms.expand_derivatives(sum(terms[1:], terms[0]))
+    total = _substitute(ufl.algorithms.expand_derivatives(sum(terms[1:], terms[0])), at_rest)
     return None if total.empty() else total
+
+
+def _substitute(form: ufl.Form, mapping: dict) -> ufl.Form:
+    return ufl.replace(form, mapping) if mapping else form
 
 
 class ContactOperator:
@@ -201,16 +205,17 @@ class ContactOperator:
     the pairing at the current state, the Jacobian chains the four blocks through ``Q``.
     """
 
-    def __init__(self, contact: NodeToSegment, F: ufl.Form, G: ufl.Form,
-                 derivatives: dict[fem.Function, Value], jit_cache_dir: str | None = None):
+    def __init__(self, contact: NodeToSegment, derivatives: dict[fem.Function, Value],
+                 at_rest: dict, jit_cache_dir: str | None = None):
         self.contact = contact
         compile_ = lambda form: None if form is None else _compat.form(form, jit_cache_dir)  # noqa: E731
-        self.F, self.G = compile_(F), compile_(G)
+        F, G = contact.F, contact.G
+        self.F, self.G = compile_(_substitute(F, at_rest)), compile_(_substitute(G, at_rest))
         own = list(derivatives.items())
         mirrored = [(contact.mirrors[f], w) for f, w in derivatives.items()
                     if f in contact.mirrors]
         V, W = contact.V, contact.W
-        self.blocks = {key: compile_(_derivative(form, pairs, space))
+        self.blocks = {key: compile_(_derivative(form, pairs, space, at_rest))
                        for key, form, pairs, space in (
                            ("VV", F, own, V), ("VW", F, mirrored, W),
                            ("WV", G, own, V), ("WW", G, mirrored, W))}
