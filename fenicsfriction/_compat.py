@@ -31,6 +31,7 @@ __all__ = [
     "interpolation_points",
     "jit_options",
     "lagrange_vector_space",
+    "model_to_mesh",
     "nodal_quadrature",
     "petsc_vec",
     "scalar_function_space",
@@ -169,6 +170,27 @@ def assemble_matrix_into(A: PETSc.Mat, a: fem.FormMetaClass, bcs: list,
     if zero:
         A.zeroEntries()
     dolfinx.fem.petsc.assemble_matrix(A, a, bcs, diagonal)
+
+
+def model_to_mesh(model: typing.Any, comm: MPI.Comm, rank: int,
+                  gdim: int) -> tuple[mesh.Mesh, mesh.MeshTagsMetaClass, mesh.MeshTagsMetaClass]:
+    """A gmsh model (built on ``rank`` only) as a distributed mesh with its cell and facet tags.
+
+    Only the physical groups of the two highest dimensions are read. The reader is
+    ``dolfinx.io.gmshio.model_to_mesh`` up to 0.9 (a tuple) and ``dolfinx.io.gmsh.model_to_mesh``
+    from 0.10 (a ``MeshData`` with ``mesh``, ``cell_tags``, ``facet_tags``). Imported here, not at
+    the top, so that the package works where gmsh is not installed.
+    """
+    import importlib
+    try:
+        reader = importlib.import_module("dolfinx.io.gmsh")  # dolfinx >= 0.10
+    except ImportError:
+        reader = importlib.import_module("dolfinx.io.gmshio")
+    data = reader.model_to_mesh(model, comm, rank, gdim=gdim)
+    if hasattr(data, "mesh"):
+        return data.mesh, data.cell_tags, data.facet_tags
+    msh, cell_tags, facet_tags = data
+    return msh, cell_tags, facet_tags
 
 
 def form(expr: ufl.Form, cache_dir: str | None = None) -> fem.FormMetaClass:

@@ -1,6 +1,7 @@
 """Two deformable bodies in frictional contact (Pop 1997): node-to-segment contact elements
 carrying the interface law of Martins & Oden (1987) between a slave surface and a master one,
-in the same residual as the bulk terms (:mod:`fenicsfriction.forms`)."""
+in the same residual as the bulk terms (:mod:`fenicsfriction.forms`); the gmsh geometries of
+the two-body scenes (:mod:`fenicsfriction.contact.geometry`)."""
 
 from fenicsfriction.contact.kinematics import Projection, project
 from fenicsfriction.contact.node_to_segment import ContactOperator, NodeToSegment
