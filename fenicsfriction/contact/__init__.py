@@ -4,7 +4,8 @@ in the same residual as the bulk terms (:mod:`fenicsfriction.forms`); the gmsh g
 the two-body scenes (:mod:`fenicsfriction.contact.geometry`)."""
 
 from fenicsfriction.contact.kinematics import Projection, project
-from fenicsfriction.contact.node_to_segment import ContactOperator, NodeToSegment
+from fenicsfriction.contact.node_to_segment import ContactOperator, NodeToSegment, solve_with_search
 from fenicsfriction.contact.pairing import Pairing, facet_nodes
 
-__all__ = ["ContactOperator", "NodeToSegment", "Pairing", "Projection", "facet_nodes", "project"]
+__all__ = ["ContactOperator", "NodeToSegment", "Pairing", "Projection", "facet_nodes", "project",
+           "solve_with_search"]

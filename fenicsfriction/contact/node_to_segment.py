@@ -46,7 +46,7 @@ from fenicsfriction import _compat, laws
 from fenicsfriction.contact.kinematics import Projection, project
 from fenicsfriction.contact.pairing import Pairing, facet_nodes
 
-__all__ = ["ContactOperator", "NodeToSegment"]
+__all__ = ["ContactOperator", "NodeToSegment", "solve_with_search"]
 
 Value = typing.Any
 
@@ -70,6 +70,11 @@ class NodeToSegment:
         transport: the master body's rigid velocity :math:`U_T` (a vector; default zero).
         weight: the factor of the term (1/2 for each pass of two-pass contact).
         frozen: keep the pairing of the first search (derivative tests).
+        search: when the pairing is searched again: ``"solve"`` (default) once at the start
+            of each Newton solve or time step (:func:`solve_with_search` repeats a solve until
+            its converged state keeps its pairing), ``"residual"`` at every residual
+            evaluation (the pairing then moves within Newton's iterations, which can stall
+            them where many slave nodes cross master facet edges).
 
     Attributes:
         V, W: the displacement space and the space of master quantities at slave nodes.
@@ -85,7 +90,7 @@ class NodeToSegment:
                  b_n: Value = 0.0, l_n: Value | None = None, eps: Value = 1e-3,
                  regularisation: str = "c1", velocity: typing.Any = None,
                  fields: typing.Sequence[fem.Function] = (), transport: typing.Any = None,
-                 weight: float = 1.0, frozen: bool = False):
+                 weight: float = 1.0, frozen: bool = False, search: str = "solve"):
         V = u.function_space
         msh = V.mesh
         dim = msh.geometry.dim
@@ -96,9 +101,12 @@ class NodeToSegment:
             laws.check(name, tag, count > 0, "a facet tag present in facet_tags")
         laws.check("regularisation", regularisation, regularisation in laws.REGULARISATIONS,
                    f"one of {sorted(laws.REGULARISATIONS)}")
+        laws.check("search", search, search in ("solve", "residual"), "'solve' or 'residual'")
         self.u, self.V = u, V
         self.dim = dim
         self.frozen = frozen
+        self.search_every_residual = search == "residual"
+        self.search_pending = True
         self.W = _compat.lagrange_vector_space(msh, 1, dim * dim)
         slave_nodes = np.unique(facet_nodes(V, facet_tags, slave, outward=False))
         owned = slave_nodes[slave_nodes < V.dofmap.index_map.size_local]
@@ -154,6 +162,7 @@ class NodeToSegment:
         if search and not (self.frozen and self.searched):
             self.pairing.search(self.u)
             self.searched = True
+            self.search_pending = False
         Q = self.pairing.Q
         assert Q is not None, "search before the first use"
         for f, mirror in self.mirrors.items():
@@ -225,8 +234,10 @@ class ContactOperator:
                          for key, a in self.blocks.items() if a is not None}
 
     def add_to_residual(self, b: PETSc.Vec) -> None:
-        """``b += F + Q^T G`` at the current state (pairing searched first)."""
-        self.contact.update()
+        """``b += F + Q^T G`` at the current state (the pairing searched first if due)."""
+        contact = self.contact
+        contact.update(search=contact.search_pending or contact.search_every_residual
+                       or not contact.searched)
         for vector, form in ((self.b_F, self.F), (self.b_G, self.G)):
             with vector.localForm() as local:
                 local.set(0.0)
@@ -287,3 +298,35 @@ def _constrained_rows(V: fem.FunctionSpace, bcs: typing.Sequence[fem.DirichletBC
         owned = dofs[:first_ghost]
         rows.append(index_map.local_to_global(owned // bs).astype(np.int64) * bs + owned % bs)
     return np.unique(np.concatenate(rows)).astype(PETSc.IntType)
+
+
+def solve_with_search(solver: typing.Any, contacts: typing.Sequence[NodeToSegment],
+                      max_rounds: int = 10) -> typing.Any:
+    """Newton solves with the pairing searched between them, until a converged state keeps
+    the pairing it was solved with (a fixed point of the contact search).
+
+    Args:
+        solver: a solver whose ``solve()`` returns a report (e.g. ``SteadySolver``).
+        contacts: the couplings of its residual.
+        max_rounds: how many solves may be tried.
+
+    Returns:
+        The last solve's report, with ``iterations`` summed over the rounds and ``rounds``
+        added.
+
+    Raises:
+        RuntimeError: the pairing still changed after ``max_rounds`` solves.
+    """
+    iterations = 0
+    for rounds in range(1, max_rounds + 1):
+        for contact in contacts:
+            contact.search_pending = True
+        report = solver.solve()
+        iterations += report.iterations
+        changed = [contact.pairing.search(contact.u) for contact in contacts]
+        if not any(changed):
+            report.iterations = iterations
+            report.rounds = rounds
+            return report
+    raise RuntimeError(f"contact search: the pairing still changed after {max_rounds} "
+                       "Newton solves (max_rounds); the state of the last solve is kept")

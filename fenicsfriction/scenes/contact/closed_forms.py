@@ -1,0 +1,69 @@
+r"""The closed forms the two-body scenes are checked against (Johnson 1985, *Contact
+Mechanics*, chapters 4 and 7; Hertz 1882; Cattaneo 1938, Mindlin 1949).
+
+Two elastic bodies of moduli :math:`E_i`, Poisson ratios :math:`\nu_i` act as one of effective
+modulus :math:`1/E^* = (1-\nu_1^2)/E_1 + (1-\nu_2^2)/E_2` against a rigid flat.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from fenicsfriction.laws import check
+
+__all__ = ["cattaneo_stick_half_width", "cattaneo_traction", "effective_modulus",
+           "hertz_line_contact", "hertz_point_contact", "hertz_pressure"]
+
+
+def effective_modulus(E1: float, nu1: float, E2: float, nu2: float) -> float:
+    """:math:`E^*` of two elastic bodies (plane strain in 2D)."""
+    for name, value in (("E1", E1), ("E2", E2)):
+        check(name, value, value > 0, "Young's modulus must be > 0")
+    for name, value in (("nu1", nu1), ("nu2", nu2)):
+        check(name, value, -1 < value < 0.5, "Poisson's ratio must be in (-1, 0.5)")
+    return 1.0 / ((1 - nu1**2) / E1 + (1 - nu2**2) / E2)
+
+
+def hertz_line_contact(load: float, radius: float, E_star: float) -> tuple[float, float]:
+    """Cylinder on a flat, plane strain (Johnson 1985, eqs. 4.43-4.45): the half-width
+    :math:`a = \\sqrt{4 P R / (\\pi E^*)}` and peak pressure :math:`p_0 = 2 P / (\\pi a)` under
+    the load ``load`` = P per unit length."""
+    check("load", load, load > 0, "the load must be > 0")
+    check("radius", radius, radius > 0, "the radius must be > 0")
+    a = math.sqrt(4 * load * radius / (math.pi * E_star))
+    return a, 2 * load / (math.pi * a)
+
+
+def hertz_point_contact(load: float, radius: float, E_star: float) -> tuple[float, float]:
+    """Sphere on a flat (Johnson 1985, eqs. 4.22-4.23): contact radius
+    :math:`a = (3 F R / (4 E^*))^{1/3}` and peak pressure :math:`p_0 = 3 F / (2 \\pi a^2)`
+    under the total force ``load`` = F."""
+    check("load", load, load > 0, "the load must be > 0")
+    check("radius", radius, radius > 0, "the radius must be > 0")
+    a = (3 * load * radius / (4 * E_star)) ** (1 / 3)
+    return a, 3 * load / (2 * math.pi * a**2)
+
+
+def hertz_pressure(r: np.ndarray, a: float, p0: float) -> np.ndarray:
+    """:math:`p(r) = p_0\\sqrt{1 - r^2/a^2}` inside the contact, 0 outside."""
+    return p0 * np.sqrt(np.clip(1 - (np.asarray(r) / a) ** 2, 0.0, None))
+
+
+def cattaneo_stick_half_width(a: float, q_ratio: float) -> float:
+    """Stick half-width :math:`c = a\\sqrt{1 - Q/(\\mu P)}` under a tangential force Q rising
+    monotonically to ``q_ratio`` = Q/(μP) < 1 (Johnson 1985, eq. 7.28)."""
+    check("q_ratio", q_ratio, 0 <= q_ratio < 1, "Q/(mu P) must be in [0, 1)")
+    return a * math.sqrt(1 - q_ratio)
+
+
+def cattaneo_traction(x: np.ndarray, a: float, p0: float, mu: float,
+                      q_ratio: float) -> np.ndarray:
+    """Tangential traction of the cylinders (Johnson 1985, eqs. 7.26-7.27): μ p(x) in the slip
+    zones c ≤ |x| ≤ a, minus :math:`\\mu p_0 (c/a)\\sqrt{1 - x^2/c^2}` in the stick zone."""
+    c = cattaneo_stick_half_width(a, q_ratio)
+    q = mu * hertz_pressure(x, a, p0)
+    if c > 0:
+        q = q - mu * p0 * (c / a) * np.sqrt(np.clip(1 - (np.asarray(x) / c) ** 2, 0.0, None))
+    return q

@@ -1,0 +1,318 @@
+r"""Two elastic bodies pressed together: the finite element model of the contact scenes.
+
+Both bodies live in one mesh (:class:`fenicsfriction.contact.geometry.TwoBodyMesh`), each with
+its own Hooke's law; the interface law acts between the slave surface (body 1) and the master
+surface (body 2) through node-to-segment contact (:class:`fenicsfriction.contact.NodeToSegment`),
+optionally in two passes (each surface slave in turn, each pass with weight 1/2).
+
+Friction in a quasi-static scene follows Pop (1997)'s incremental formulation: the slave
+velocity of the regularised law is the increment :math:`(u - u_{old})/\Delta t` of a pseudo time
+step (``dt``, 1 by default, so ε is a slip increment), and each load increment is one Newton
+solve started from the last.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import typing
+
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import dolfinx.fem.petsc
+import numpy as np
+import ufl
+from dolfinx import fem, mesh
+
+from fenicsfriction import _compat, forms
+from fenicsfriction.contact import NodeToSegment, facet_nodes, solve_with_search
+from fenicsfriction.contact.geometry import (
+    BODY1,
+    BODY2,
+    FIXED,
+    LOAD,
+    MASTER,
+    SLAVE,
+    SYMMETRY_X,
+    SYMMETRY_Y,
+    TwoBodyMesh,
+)
+from fenicsfriction.laws import check
+from fenicsfriction.steady import SteadySolver
+
+__all__ = ["Material", "SurfaceValues", "TwoBodyModel"]
+
+log = logging.getLogger(__name__)
+
+
+@dataclasses.dataclass(frozen=True)
+class Material:
+    """Isotropic linear elasticity: Young's modulus ``E`` [force/length²], Poisson's ``nu``."""
+
+    E: float
+    nu: float
+
+    def __post_init__(self) -> None:
+        check("E", self.E, self.E > 0, "Young's modulus must be > 0")
+        check("nu", self.nu, -1 < self.nu < 0.5, "Poisson's ratio must be in (-1, 0.5)")
+
+
+@dataclasses.dataclass
+class SurfaceValues:
+    """Nodal values on the slave surface, gathered on every rank, sorted by ``x[:, 0]``.
+
+    Attributes:
+        x: reference coordinates of the slave nodes (n, dim).
+        weight: each node's tributary length (2D) or area (3D).
+        gap: the normal gap to the master surface (< 0: penetration).
+        pressure: the contact pressure of the law at the node.
+        traction: the tangential traction vector (zeros when frictionless), (n, dim).
+        force: the contact force on the node from all passes (n, dim) per unit weight.
+    """
+
+    x: np.ndarray
+    weight: np.ndarray
+    gap: np.ndarray
+    pressure: np.ndarray
+    traction: np.ndarray
+    force: np.ndarray
+
+
+class TwoBodyModel:
+    """Body 1 (slave) on body 2 (master), a traction on body 1's :data:`LOAD` face.
+
+    Args:
+        geometry: the mesh and its tags.
+        materials: body 1's and body 2's :class:`Material`.
+        c_n, m_n: normal compliance (pressure c_n d^m_n) [force/length^(2+m_n)], [-].
+        mu: friction coefficient (0: frictionless, no friction term).
+        eps: regularisation of the slip increment [length per pseudo-time].
+        passes: 1 (body 1's surface is the slave) or 2 (each surface in turn).
+        clamp: body 2's :data:`FIXED` face clamped (True) or on rollers (normal component
+            fixed only: a patch test's free lateral expansion).
+        fix_load_face: also fix the tangential displacement of the :data:`LOAD` face
+            (removes the sliding mode of a frictionless body 1 in a full model); else the
+            face carries the tangential traction ``shear``.
+
+    The normal load is applied through the approach: the :data:`LOAD` face is moved by
+    ``approach`` towards body 2 (a rigid platen), and :meth:`solve_for_load` finds the approach
+    whose contact force is the load asked for. Under a prescribed force instead, body 1 would
+    float on its contact springs, whose stiffness vanishes where the contact zone is small,
+    and Newton would creep along the contact's active set.
+
+    Attributes:
+        V, u, u_old: the displacement space, the displacement, the last increment's.
+        approach: the normal displacement of the LOAD face towards body 2 (``fem.Constant``).
+        shear: the tangential traction on the LOAD face (a vector ``fem.Constant``).
+        contacts: the node-to-segment couplings (one per pass).
+        residual, solver: the residual and its :class:`~fenicsfriction.steady.SteadySolver`.
+    """
+
+    def __init__(self, geometry: TwoBodyMesh, materials: tuple[Material, Material],
+                 c_n: float, m_n: float = 1.0, mu: float = 0.0, eps: float = 1e-6,
+                 passes: int = 1, fix_load_face: bool = False,
+                 regularisation: str = "c1", clamp: bool = True):
+        check("passes", passes, passes in (1, 2), "1 or 2")
+        check("c_n", c_n, c_n > 0, "the normal compliance coefficient must be > 0")
+        check("m_n", m_n, m_n >= 1, "the normal exponent must be >= 1")
+        check("mu", mu, mu >= 0, "the friction coefficient must be >= 0")
+        check("eps", eps, eps > 0, "the regularisation parameter must be > 0")
+        self.geometry = geometry
+        msh, cell_tags, facet_tags = geometry.mesh, geometry.cell_tags, geometry.facet_tags
+        self.comm: MPI.Comm = msh.comm
+        self.dim = dim = msh.geometry.dim
+        self.V = V = _compat.vector_function_space(msh, 1)
+        self.u = fem.Function(V, name="displacement")
+        self.u_old = fem.Function(V, name="previous_displacement")
+        u_dot, u_ddot = fem.Function(V, name="velocity"), fem.Function(V, name="acceleration")
+        v = ufl.TestFunction(V)
+        dx = ufl.Measure("dx", domain=msh, subdomain_data=cell_tags)
+        ds = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags)
+        self.approach = fem.Constant(msh, 0.0)
+        self.shear = fem.Constant(msh, np.zeros(dim))
+        form = forms.surface_traction(self.shear, v, ds(LOAD))
+        for tag, material in zip((BODY1, BODY2), materials, strict=True):
+            form += forms.elasticity(self.u, v, material.E, material.nu, dx(tag))
+        self.mu = fem.Constant(msh, float(mu))
+        self.eps = fem.Constant(msh, float(eps))
+        self.dt = fem.Constant(msh, 1.0)
+        friction = {}
+        if mu > 0:
+            friction = {"c_T": self.mu * c_n, "m_T": m_n, "eps": self.eps,
+                        "regularisation": regularisation,
+                        "velocity": (self.u - self.u_old) / self.dt, "fields": [self.u_old]}
+        pairs = [(SLAVE, MASTER), (MASTER, SLAVE)][:passes]
+        self.contacts = [NodeToSegment(self.u, facet_tags, slave, master, c_n=c_n, m_n=m_n,
+                                       weight=1.0 / passes, **friction)
+                         for slave, master in pairs]
+        self.residual = forms.Residual(form, self.u, u_dot, u_ddot, v,
+                                       bcs=self._bcs(fix_load_face, clamp),
+                                       couplings=self.contacts)
+        self.solver = SteadySolver(self.residual, prefix="contact_", linear_solver="lu")
+        cells = cell_tags.indices[cell_tags.values == BODY1]
+        nodes = fem.locate_dofs_topological(
+            _compat.scalar_function_space(msh, "Lagrange", 1), dim, cells)
+        self._body1_rows = nodes[nodes < V.dofmap.index_map.size_local]
+        self._body1_dofs = nodes * dim + dim - 1  # their normal components (local, ghosts too)
+
+    def _bcs(self, fix_load_face: bool, clamp: bool) -> list:
+        V, facet_tags, fdim = self.V, self.geometry.facet_tags, self.dim - 1
+        fixed = facet_tags.indices[facet_tags.values == FIXED]
+        if clamp:
+            bcs = [fem.dirichletbc(np.zeros(self.dim),
+                                   fem.locate_dofs_topological(V, fdim, fixed), V)]
+        else:
+            bcs = [self._component_bc(self.dim - 1, fixed)]
+        for axis, tag in ((0, SYMMETRY_X), (1, SYMMETRY_Y)):
+            facets = facet_tags.indices[facet_tags.values == tag]
+            if self.comm.allreduce(len(facets)) > 0:
+                bcs.append(self._component_bc(axis, facets))
+        load_face = facet_tags.indices[facet_tags.values == LOAD]
+        self._platen = fem.Constant(self.geometry.mesh, 0.0)  # -approach
+        bcs.append(self._component_bc(self.dim - 1, load_face, self._platen))
+        if fix_load_face:
+            bcs += [self._component_bc(axis, load_face) for axis in range(self.dim - 1)]
+        return bcs
+
+    def _component_bc(self, axis: int, facets: np.ndarray,
+                      value: typing.Any = 0.0) -> fem.DirichletBC:
+        dofs = fem.locate_dofs_topological(self.V.sub(axis), self.dim - 1, facets)
+        return fem.dirichletbc(value, dofs, self.V.sub(axis))
+
+    def rollers(self, axes: typing.Sequence[int]) -> None:
+        """Add rollers on the planes x_axis = 0 of both bodies (patch tests: no rigid motion
+        in the plane, free lateral expansion)."""
+        for axis in axes:
+            facets = mesh.locate_entities_boundary(
+                self.geometry.mesh, self.dim - 1, lambda x, a=axis: np.isclose(x[a], 0.0))
+            self.residual.bcs.append(self._component_bc(axis, facets))
+
+    def solve_at(self, approach: float) -> typing.Any:
+        """Equilibrium with the LOAD face moved by ``approach`` towards body 2 (Newton from the
+        current state, the pairing searched again until it holds); returns the report."""
+        # the initial guess moves body 1 rigidly with its face: the contact zone of a rigid
+        # indentation is wider than the elastic one, and Newton's active set shrinks to it in
+        # a few iterations (growing it takes about one node per iteration)
+        self.u.x.array[self._body1_dofs] -= approach - float(self.approach.value)
+        self.u.x.scatter_forward()
+        self._platen.value = -approach
+        self.approach.value = approach
+        return solve_with_search(self.solver, self.contacts)
+
+    def normal_force(self) -> float:
+        """The contact force on body 1 along the approach (all passes, all ranks): the load."""
+        return self.comm.allreduce(float(self._contact_force()[self._body1_rows, -1].sum()))
+
+    def solve_for_load(self, load: float, guess: float, rtol: float = 1e-6,
+                       max_solves: int = 30) -> dict:
+        """The approach whose contact force is ``load`` (total in 3D, per unit length in 2D).
+
+        The force grows like a power of the approach (δ^{3/2} for Hertz in 3D, about δ in 2D),
+        so the approach is found by secant steps on log force against log approach, from
+        ``guess`` (any approach that makes contact). Returns ``approach``, ``load`` (reached),
+        ``newton_iterations`` (all solves) and ``solves``.
+        """
+        check("load", load, load > 0, "the load must be > 0")
+        check("guess", guess, guess > 0, "the first approach must be > 0")
+        history: list[tuple[float, float]] = []
+        iterations, delta = 0, guess
+        for solves in range(1, max_solves + 1):
+            report = self.solve_at(delta)
+            iterations += report.iterations
+            force = self.normal_force()
+            log.debug("approach %.6g: contact force %.6g (load %.6g), %d Newton iterations",
+                      delta, force, load, report.iterations)
+            if force > 0:
+                history.append((np.log(delta), np.log(force)))
+            if abs(force / load - 1) < rtol:
+                return {"approach": delta, "load": force, "newton_iterations": iterations,
+                        "solves": solves}
+            if len(history) < 2:
+                delta *= 2.0 if force <= 0 else (load / force) ** 0.7
+                continue
+            (x0, y0), (x1, y1) = history[-2], history[-1]
+            slope = (y1 - y0) / (x1 - x0) if x1 != x0 else 1.0
+            delta = float(np.exp(x1 + (np.log(load) - y1) / max(slope, 0.3)))
+        raise RuntimeError(f"solve_for_load: the contact force {force:.6g} did not reach the "
+                           f"load {load:.6g} within {max_solves} solves (max_solves)")
+
+    def surface_values(self) -> SurfaceValues:
+        """Nodal values on the slave surface of the first pass (see :class:`SurfaceValues`)."""
+        contact = self.contacts[0]
+        contact.update()
+        S = _compat.scalar_function_space(self.geometry.mesh, "Lagrange", 1)
+        q = ufl.TestFunction(S)
+
+        def nodal(expr: typing.Any) -> np.ndarray:
+            vec = dolfinx.fem.petsc.assemble_vector(_compat.form(expr * q * contact.ds))
+            vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+            values = vec.getArray().copy()
+            vec.destroy()
+            return values
+
+        weight = nodal(1.0)
+        values = [nodal(contact.projection.gap), nodal(contact.pressure)]
+        traction = contact.traction
+        values += [nodal(traction[k]) if traction is not None else np.zeros_like(weight)
+                   for k in range(self.dim)]
+        force = self._contact_force()
+        owned = np.flatnonzero(weight > 0)
+        x = S.tabulate_dof_coordinates()[owned, :self.dim]
+        local = np.column_stack([x, weight[owned],
+                                 *(v[owned] / weight[owned] for v in values),
+                                 force[owned] / weight[owned, None]])
+        rows = np.vstack(self.comm.allgather(local))
+        rows = rows[np.argsort(rows[:, 0], kind="stable")]
+        d = self.dim
+        return SurfaceValues(x=rows[:, :d], weight=rows[:, d], gap=rows[:, d + 1],
+                             pressure=rows[:, d + 2], traction=rows[:, d + 3:2 * d + 3],
+                             force=rows[:, 2 * d + 3:])
+
+    def contact_edge(self) -> np.ndarray:
+        """Points where the gap changes sign along the slave facets' edges (linear
+        interpolation of the nodal gaps), gathered on every rank: the contact zone's boundary
+        (its two ends in 2D, a ring in 3D), second-order accurate where the gap is smooth."""
+        contact = self.contacts[0]
+        contact.update()
+        S = _compat.scalar_function_space(self.geometry.mesh, "Lagrange", 1)
+        q = ufl.TestFunction(S)
+        gap = fem.Function(S)
+        for expr, target in ((contact.projection.gap, gap.x.array), (1.0, None)):
+            vec = dolfinx.fem.petsc.assemble_vector(_compat.form(expr * q * contact.ds))
+            vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+            if target is not None:
+                values = vec.getArray().copy()
+            else:
+                weight = vec.getArray()
+                size = len(weight)
+                target = gap.x.array
+                target[:size] = np.divide(values, weight, out=np.zeros(size), where=weight > 0)
+            vec.destroy()
+        gap.x.scatter_forward()
+        facets = facet_nodes(self.V, self.geometry.facet_tags, SLAVE, outward=False)
+        edges = np.vstack([facets[:, [i, j]] for i in range(self.dim)
+                           for j in range(i + 1, self.dim)]).reshape(-1, 2)
+        g = gap.x.array[edges]
+        crossing = g[:, 0] * g[:, 1] < 0
+        x = S.tabulate_dof_coordinates()[:, :self.dim]
+        a, b = edges[crossing, 0], edges[crossing, 1]
+        t = (g[crossing, 0] / (g[crossing, 0] - g[crossing, 1]))[:, None]
+        points = x[a] + t * (x[b] - x[a])
+        return np.vstack(self.comm.allgather(points))
+
+    def _contact_force(self) -> np.ndarray:
+        """The contact force of every pass on each node (owned nodes, (n, dim))."""
+        b = dolfinx.fem.petsc.create_vector(self.solver.L)
+        b.set(0.0)
+        for operator in self.solver.couplings:
+            operator.add_to_residual(b)
+        force = -b.getArray().reshape(-1, self.dim).copy()
+        b.destroy()
+        return force
+
+    @property
+    def dofs(self) -> int:
+        """Number of displacement unknowns."""
+        index_map = self.V.dofmap.index_map
+        return index_map.size_global * self.V.dofmap.index_map_bs
