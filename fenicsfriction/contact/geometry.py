@@ -22,10 +22,15 @@ Other boundary facets (the blocks' far sides, the patch bodies' lateral faces) a
 The Hertz scenes put a node of each body at the origin, where they touch (zero initial gap
 there); the patch scenes' bodies touch along the whole plane y = 0 (2D) or z = 0 (3D).
 
-The builders own the gmsh session: they initialise gmsh (unless a gmsh that can say so reports
-it initialised already, gmsh >= 4.9), set ``Mesh.*`` options, and finalise it (or remove their
-model). Geometry is P1: the cylinder's arc and the sphere are approximated by the chords and
-flat triangles of their boundary facets, whose vertices lie on the exact surface.
+The builders own the gmsh session: they initialise gmsh without the user's configuration
+files, set ``Mesh.*`` options, and finalise it; where gmsh has ``isInitialized`` (not 4.8) and
+reports a session open already, they use it and remove only their own model. Geometry is P1:
+the cylinder's arc and the sphere are approximated by the chords and flat triangles of their
+boundary facets, whose vertices lie on the exact surface.
+
+In parallel the mesh is partitioned by dolfinx's default graph partitioner, which sees two
+disconnected bodies: on two ranks it puts (nearly) all of body 1 on one rank and body 2 on the
+other, so that slave nodes and their master facets sit on different ranks.
 """
 
 from __future__ import annotations
@@ -102,7 +107,8 @@ class TwoBodyMesh:
 # --- input checks ------------------------------------------------------------------------------
 
 def _check_int(name: str, value: typing.Any, lowest: int) -> None:
-    ok = isinstance(value, numbers.Integral) and not isinstance(value, bool) and value >= lowest
+    ok = isinstance(value, numbers.Integral) and not isinstance(value, bool) \
+        and int(value) >= lowest
     laws.check(name, value, ok, f"must be an integer >= {lowest}")
 
 
@@ -133,17 +139,19 @@ def _build(comm: MPI.Comm, name: str, gdim: int, construct: typing.Callable[[typ
     """
     root = 0
     model = None
-    owns_session = False
+    owns_session = True
     error = None
-    gmsh: typing.Any = None
+    session: typing.Any = None  # the gmsh module, once there is something to close (rank 0)
     if comm.rank == root:
         try:
             import gmsh
             owns_session = not getattr(gmsh, "isInitialized", lambda: False)()
-            if owns_session:
-                gmsh.initialize()
+            if owns_session:  # without the user's gmshrc: the same mesh everywhere
+                gmsh.initialize(readConfigFiles=False)
+                session = gmsh
             gmsh.option.setNumber("General.Terminal", 0)
             gmsh.model.add(f"fenicsfriction-{name}-{next(_model_numbers)}")
+            session = gmsh  # to be closed (finalised, or our model removed)
             construct(gmsh)
             gmsh.model.mesh.generate(gdim)
             if msh_file is not None:
@@ -157,11 +165,11 @@ def _build(comm: MPI.Comm, name: str, gdim: int, construct: typing.Callable[[typ
             raise RuntimeError(error)
         msh, cell_tags, facet_tags = _compat.model_to_mesh(model, comm, root, gdim)
     finally:
-        if gmsh is not None and comm.rank == root:
+        if session is not None:
             if owns_session:
-                gmsh.finalize()
+                session.finalize()
             else:
-                gmsh.model.remove()
+                session.model.remove()
     return TwoBodyMesh(msh, cell_tags, facet_tags, {"geometry": name, **parameters})
 
 
