@@ -130,7 +130,13 @@ def abs_c1(w: typing.Any, eps: Scalar) -> Scalar:
 
 def abs_c1_derivative(w: typing.Any, eps: Scalar) -> typing.Any:
     """:math:`\\phi_\\varepsilon'(w) = w / \\max(|w|, \\varepsilon)` (a vector like ``w``)."""
-    return w / _max(_norm(w), eps)
+    r = _norm(w)
+    if _is_ufl(r, eps):
+        # a conditional, not max_value: UFL differentiates max(a, b) as c a' + (1 - c) b', and
+        # at w = 0 (stick, a body at rest) the unused a' = w/|w| is 0/0, which the product
+        # turns into a NaN Jacobian; a conditional's unused branch is not multiplied
+        return ufl.conditional(ufl.lt(r, eps), w / eps, w / r)
+    return w / _max(r, eps)
 
 
 def abs_c1_second_derivative(w: Scalar, eps: Scalar) -> Scalar:

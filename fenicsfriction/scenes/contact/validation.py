@@ -1,0 +1,288 @@
+r"""The validation scenes of two-body contact, each against its closed form.
+
+* :class:`Hertz` — an elastic cylinder (2D, plane strain) or sphere (3D, quarter model) pressed
+  on an elastic block: contact half-width/radius and peak pressure against Hertz's
+  (:mod:`~fenicsfriction.scenes.contact.closed_forms`), converging as the mesh is refined and
+  as the compliance stiffens (c_n → ∞: the Signorini limit).
+* :class:`Patch` — two blocks with non-matching meshes under a uniform pressure must transmit
+  it uniformly (Taylor & Papadopoulos 1991's contact patch test), one pass or two.
+* :class:`Cattaneo` — the 2D cylinder, then a tangential force rising to Q = q μP in
+  increments (Pop 1997's incremental formulation): the stick zone and the tangential traction
+  against Cattaneo-Mindlin's, with Kalker's sequential ε → 0.
+
+Units are the user's (consistent); the defaults are dimensionless: R = 1, E = 1, and the load
+giving a contact half-width (radius) of R/10.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+import typing
+
+from mpi4py import MPI
+
+import numpy as np
+
+from fenicsfriction.contact import geometry
+from fenicsfriction.laws import check
+from fenicsfriction.scenes.contact import closed_forms
+from fenicsfriction.scenes.contact.model import Material, SurfaceValues, TwoBodyModel
+
+__all__ = ["Cattaneo", "Hertz", "Patch"]
+
+#: the regularisation during Cattaneo's normal loading, relative to the contact half-width
+NORMAL_LOADING_EPS = 1e-2
+
+
+@dataclasses.dataclass
+class _Bodies:
+    """Two elastic bodies and their interface law (shared by the scenes).
+
+    Args:
+        E1, nu1: body 1's (cylinder, sphere, upper block) Young's modulus [force/length²] and
+            Poisson's ratio.
+        E2, nu2: body 2's (the block below).
+        c_n: normal compliance coefficient [force/length^(2+m_n)]; pressure c_n d^m_n.
+        m_n: normal compliance exponent (1: a linear penalty).
+        passes: 1 (body 1's surface is the slave) or 2 (each surface slave in turn).
+    """
+
+    E1: float = 1.0
+    nu1: float = 0.3
+    E2: float = 1.0
+    nu2: float = 0.3
+    c_n: float = 1e4
+    m_n: float = 1.0
+    passes: int = 1
+
+    def __post_init__(self) -> None:
+        self.materials  # noqa: B018  (validates E, nu)
+        check("c_n", self.c_n, self.c_n > 0, "the normal compliance coefficient must be > 0")
+        check("m_n", self.m_n, self.m_n >= 1, "the normal exponent must be >= 1")
+        check("passes", self.passes, self.passes in (1, 2), "1 or 2")
+
+    @property
+    def materials(self) -> tuple[Material, Material]:
+        return Material(self.E1, self.nu1), Material(self.E2, self.nu2)
+
+    @property
+    def E_star(self) -> float:
+        """The effective modulus :math:`E^*` (plane strain)."""
+        return closed_forms.effective_modulus(self.E1, self.nu1, self.E2, self.nu2)
+
+
+@dataclasses.dataclass
+class Hertz(_Bodies):
+    """A cylinder (``dim=2``) or sphere (``dim=3``) of radius ``radius`` on a block.
+
+    Args:
+        dim: 2 (plane strain, load per unit length) or 3 (a quarter model, total load).
+        load: P [force/length] in 2D, F [force] in 3D; ``None``: the load giving a = R/10.
+        radius: R [length].
+        refine: the mesh's refinement level (each halves the element size).
+    """
+
+    dim: int = 2
+    load: float | None = None
+    radius: float = 1.0
+    refine: int = 0
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check("dim", self.dim, self.dim in (2, 3), "2 or 3")
+        check("radius", self.radius, self.radius > 0, "the radius must be > 0")
+        check("refine", self.refine, isinstance(self.refine, int) and self.refine >= 0,
+              "an integer >= 0")
+        if self.load is None:
+            a = self.radius / 10
+            self.load = (a**2 * math.pi * self.E_star / (4 * self.radius) if self.dim == 2
+                         else 4 * self.E_star * a**3 / (3 * self.radius))
+        check("load", self.load, self.load > 0, "the load must be > 0")
+
+    def closed_form(self) -> tuple[float, float]:
+        """Hertz's half-width (2D) or contact radius (3D) and peak pressure."""
+        assert self.load is not None
+        solution = (closed_forms.hertz_line_contact if self.dim == 2
+                    else closed_forms.hertz_point_contact)
+        return solution(self.load, self.radius, self.E_star)
+
+    def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
+        mesh = (geometry.hertz_2d if self.dim == 2 else geometry.hertz_3d)(
+            comm, R=self.radius, refine=self.refine)
+        # the 2D cylinder's sliding is stopped at its loaded face; the quarter sphere's by the
+        # symmetry planes
+        return TwoBodyModel(mesh, self.materials, self.c_n, self.m_n, passes=self.passes,
+                            fix_load_face=self.dim == 2)
+
+    def run(self, comm: MPI.Comm = MPI.COMM_WORLD, model: TwoBodyModel | None = None
+            ) -> tuple[dict, TwoBodyModel]:
+        """Solve and compare; returns the summary (see ``docs/cli.md``) and the model."""
+        t0 = time.perf_counter()
+        model = model or self.build(comm)
+        assert self.load is not None
+        a, p0 = self.closed_form()
+        # the quarter model carries a quarter of the load
+        share = 1.0 if self.dim == 2 else 0.25
+        solved = model.solve_for_load(share * self.load, guess=a**2 / self.radius, rtol=1e-5)
+        edge = model.contact_edge()
+        values = model.surface_values()
+        measured = (np.ptp(edge[:, 0]) / 2 if self.dim == 2
+                    else float(np.mean(np.linalg.norm(edge[:, :2], axis=1))))
+        width = "half_width" if self.dim == 2 else "contact_radius"
+        summary = {
+            "scene": "hertz", "dim": self.dim, "load": solved["load"] / share,
+            "parameters": {"radius": self.radius, "E1": self.E1, "nu1": self.nu1,
+                           "E2": self.E2, "nu2": self.nu2, "c_n": self.c_n, "m_n": self.m_n,
+                           "refine": self.refine, "passes": self.passes,
+                           "h_contact": model.geometry.parameters["h_contact"]},
+            "dofs": model.dofs, "ranks": comm.size,
+            width: measured, f"hertz_{width}": a,
+            "max_pressure": float(values.pressure.max()), "hertz_max_pressure": p0,
+            f"{width}_error": measured / a - 1,
+            "max_pressure_error": float(values.pressure.max()) / p0 - 1,
+            "approach": solved["approach"], "newton_iterations": solved["newton_iterations"],
+            "solves": solved["solves"], "wall_time_s": time.perf_counter() - t0,
+        }
+        return summary, model
+
+
+@dataclasses.dataclass
+class Patch(_Bodies):
+    """Two stacked blocks (non-matching meshes) under a uniform pressure.
+
+    Args:
+        dim: 2 or 3.
+        pressure: the pressure applied (through the platen's approach) [force/length²].
+        n_upper, n_lower: elements across the upper and the lower block (coprime: the
+            interface nodes then coincide only at the ends).
+    """
+
+    dim: int = 2
+    pressure: float = 0.01
+    n_upper: int = 5
+    n_lower: int = 7
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check("dim", self.dim, self.dim in (2, 3), "2 or 3")
+        check("pressure", self.pressure, self.pressure > 0, "the pressure must be > 0")
+
+    def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
+        mesh = (geometry.patch_2d if self.dim == 2 else geometry.patch_3d)(
+            comm, n_upper=self.n_upper, n_lower=self.n_lower)
+        model = TwoBodyModel(mesh, self.materials, self.c_n, self.m_n, passes=self.passes,
+                             clamp=False)
+        model.rollers(range(self.dim - 1))
+        return model
+
+    def run(self, comm: MPI.Comm = MPI.COMM_WORLD) -> tuple[dict, TwoBodyModel]:
+        """The pressure transmitted at the slave nodes (all passes' forces per tributary
+        length/area) and its largest deviation from the pressure applied."""
+        t0 = time.perf_counter()
+        model = self.build(comm)
+        guess = (self.pressure / self.c_n) ** (1 / self.m_n) + self.pressure / self.E1
+        solved = model.solve_for_load(self.pressure, guess=guess, rtol=1e-10)
+        values = model.surface_values()
+        transmitted = values.force[:, -1]
+        summary = {
+            "scene": "patch", "dim": self.dim, "load": self.pressure,
+            "parameters": {"E1": self.E1, "nu1": self.nu1, "E2": self.E2, "nu2": self.nu2,
+                           "c_n": self.c_n, "m_n": self.m_n, "passes": self.passes,
+                           "n_upper": self.n_upper, "n_lower": self.n_lower},
+            "dofs": model.dofs, "ranks": comm.size,
+            "pressure_deviation": float(np.max(np.abs(transmitted / self.pressure - 1))),
+            "newton_iterations": solved["newton_iterations"],
+            "wall_time_s": time.perf_counter() - t0,
+        }
+        return summary, model
+
+
+@dataclasses.dataclass
+class Cattaneo(Hertz):
+    """The 2D Hertz cylinder with friction, then a tangential force Q rising to ``q_ratio`` μP.
+
+    Args:
+        mu: friction coefficient.
+        q_ratio: Q / (μ P), in [0, 1).
+        increments: load increments of Q (the quasi-static path; the stick zone only shrinks).
+        eps: the regularisation of the slip increment [length] (c1: Pop 1997, eq. 15); a
+            sequence ε_k → 0 is Kalker's sequential process (:meth:`run_sequence`).
+    """
+
+    mu: float = 0.3
+    q_ratio: float = 0.5
+    increments: int = 10
+    eps: float = 1e-6
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check("dim", self.dim, self.dim == 2, "Cattaneo-Mindlin is built in 2D")
+        check("mu", self.mu, self.mu > 0, "the friction coefficient must be > 0")
+        check("q_ratio", self.q_ratio, 0 <= self.q_ratio < 1, "Q/(mu P) in [0, 1)")
+        check("increments", self.increments,
+              isinstance(self.increments, int) and self.increments >= 1, "an integer >= 1")
+        check("eps", self.eps, self.eps > 0, "the regularisation must be > 0")
+
+    def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
+        mesh = geometry.hertz_2d(comm, R=self.radius, refine=self.refine)
+        return TwoBodyModel(mesh, self.materials, self.c_n, self.m_n, mu=self.mu,
+                            eps=self.eps, passes=self.passes)
+
+    def stick_zone(self, values: SurfaceValues, tol: float = 1e-3) -> tuple[float, float]:
+        """(stick half-width, slip half-width): the extent of the contact nodes whose traction
+        is below the friction bound by more than ``tol`` (stick) and of all contact nodes."""
+        contact = values.pressure > 0
+        utilisation = np.linalg.norm(values.traction, axis=1) / np.where(
+            contact, self.mu * values.pressure, 1.0)
+        stick = contact & (utilisation < 1 - tol)
+        x = values.x[:, 0]
+        return (float(np.ptp(x[stick]) / 2) if stick.any() else 0.0,
+                float(np.ptp(x[contact]) / 2) if contact.any() else 0.0)
+
+    def run(self, comm: MPI.Comm = MPI.COMM_WORLD, model: TwoBodyModel | None = None,
+            on_increment: typing.Callable[[dict], None] | None = None
+            ) -> tuple[dict, TwoBodyModel]:
+        """Normal load, then Q in increments; the summary adds ``q_ratio``,
+        ``stick_half_width`` (and Cattaneo's), the traction error and one row per
+        increment."""
+        t0 = time.perf_counter()
+        model = model or self.build(comm)
+        assert self.load is not None
+        a, p0 = self.closed_form()
+        # the normal load with a wide regularisation: identical bodies do not slip under it
+        # (Johnson 1985, section 5.4), and the friction only holds the cylinder's sliding mode
+        model.eps.value = NORMAL_LOADING_EPS * a
+        summary, model = Hertz.run(self, comm, model)
+        model.eps.value = self.eps
+        rows = []
+        for k in range(1, self.increments + 1):
+            model.u_old.x.array[:] = model.u.x.array
+            q = self.q_ratio * k / self.increments
+            model.shear.value = np.array([q * self.mu * self.load / (2 * self.radius), 0.0])
+            report = model.solve_at(float(model.approach.value))
+            values = model.surface_values()
+            stick, _ = self.stick_zone(values)
+            row = {"q_ratio": q, "stick_half_width": stick,
+                   "cattaneo_stick_half_width": closed_forms.cattaneo_stick_half_width(a, q),
+                   "newton_iterations": report.iterations}
+            rows.append(row)
+            if on_increment is not None:
+                on_increment(row)
+        values = model.surface_values()
+        x = values.x[:, 0]
+        exact = closed_forms.cattaneo_traction(x, a, p0, self.mu, self.q_ratio)
+        # the traction on the cylinder opposes Q: its x component is -q(x)
+        error = float(np.sqrt(np.sum(values.weight * (-values.traction[:, 0] - exact) ** 2)
+                              / np.sum(values.weight * exact**2)))
+        summary.update({
+            "scene": "cattaneo", "q_ratio": self.q_ratio, "mu": self.mu, "eps": self.eps,
+            "stick_half_width": rows[-1]["stick_half_width"],
+            "cattaneo_stick_half_width": rows[-1]["cattaneo_stick_half_width"],
+            "traction_error_l2": error, "increments": rows,
+            "newton_iterations": summary["newton_iterations"]
+            + sum(r["newton_iterations"] for r in rows),
+            "wall_time_s": time.perf_counter() - t0})
+        summary["parameters"].update({"mu": self.mu, "eps": self.eps})
+        return summary, model
