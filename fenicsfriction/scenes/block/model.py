@@ -114,7 +114,9 @@ class BlockModel:
         tol = 1e-10 * max(s.L, s.H)
         ds = ufl.Measure("ds", domain=msh, subdomain_data=self.facet_tags)
         self.dx = self._block_measure()
-        self.ds_contact = ds(CONTACT, metadata=QUADRATURE[s.contact_quadrature](s.degree)[1])
+        self.ds_contact = ds(CONTACT, metadata=(
+            _compat.nodal_quadrature(msh.topology.dim - 1) if s.contact_quadrature == "nodal"
+            else QUADRATURE[s.contact_quadrature](s.degree)[1]))
 
         def constant(value: float) -> fem.Constant:
             return fem.Constant(msh, np.float64(value))

@@ -26,7 +26,8 @@ Modelling choices, changeable through the fields where they are numbers:
   each block corner), ``slab_density`` = the block's (M / (L H B0)).
 * **The block is degree 1 with the nodal contact rule.** Node-to-segment contact needs
   degree-1 Lagrange elements; the slave side integrates with the nodal (trapezoidal) rule,
-  so the one-body reference is ``BlockOnBelt(degree=1, contact_quadrature="gll")``.
+  so the one-body reference is ``BlockOnBelt(degree=1, contact_quadrature="nodal")`` (not
+  ``"gll"``, which FFCx evaluates with five points per facet on Q1).
 * **Mesh.** Both bodies are quadrilaterals of one mesh, disjoint (the block's bottom and the
   slab's top both at y = 0, with their own nodes). Under the block the slab's columns have the
   block's width L / (4 r); beyond it ``ceil(overhang / (2 h))`` columns of about twice that;
@@ -70,7 +71,7 @@ class BlockOnSlab(BlockOnBelt):
     """
 
     degree: int = 1
-    contact_quadrature: str = "gll"
+    contact_quadrature: str = "nodal"
     slab_E: float = None  # type: ignore[assignment]  # None: set by __post_init__
     slab_nu: float = None  # type: ignore[assignment]
     slab_thickness: float = 10.0
@@ -93,6 +94,9 @@ class BlockOnSlab(BlockOnBelt):
         check("degree", self.degree, self.degree == 1,
               "must be 1: node-to-segment contact needs degree-1 elements")
         check("dim", self.dim, self.dim == 2, "must be 2 (the slab scene is plane strain)")
+        check("contact_quadrature", self.contact_quadrature,
+              self.contact_quadrature == "nodal",
+              "must be nodal: node-to-segment contact integrates the slave surface so")
         for name in ("slab_E", "slab_thickness", "slab_density"):
             value = getattr(self, name)
             check(name, value, bool(np.isfinite(value)) and value > 0,
