@@ -13,8 +13,8 @@ import importlib
 import pathlib
 import typing
 
-__all__ = ["SLAB_FLAGS", "LazyChoices", "Parser", "add_block_parsers", "add_oscillator_parsers", "floats",
-           "omega_range"]
+__all__ = ["SLAB_FLAGS", "LazyChoices", "Parser", "add_block_parsers", "add_oscillator_parsers",
+           "floats", "omega_range"]
 
 
 class Parser(argparse.ArgumentParser):
@@ -80,7 +80,8 @@ def _scene_flags() -> argparse.ArgumentParser:
     flags.add_argument("--eps", type=float, help="regularisation ε [cm/s] (1e-3)")
     flags.add_argument("--regularisation", help="c1 or smooth (c1)")
     flags.add_argument("--contact-quadrature",
-                       help="gauss, gll or nodal (block: gauss; block-on-slab: nodal, the only one)")
+                       help="gauss, gll or nodal (block: gauss; block-on-slab: nodal, its only "
+                            "rule)")
     _slab_flags(flags)
     flags.add_argument("--max-halvings", type=int, default=8,
                        help="step halvings allowed when a continuation step fails")
