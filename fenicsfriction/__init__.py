@@ -44,6 +44,7 @@ _EXPORTS: dict[str, str] = {
     "StopSignals": "signals", "Interrupted": "signals",
     # scenes
     "BlockData": "scenes", "BlockOnBelt": "scenes", "BlockModel": "scenes",
+    "BlockOnSlab": "scenes", "SlabModel": "scenes",
     "BlockQuantities": "scenes.block", "Energies": "scenes.block", "Powers": "scenes.block",
     "ContactStates": "scenes.block", "CentreOfMass": "scenes.block",
     "ProbeValues": "scenes.block",
@@ -108,7 +109,7 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers and IDEs
     from fenicsfriction.reduced.rigid_block import RigidLoci, rigid_loci
     from fenicsfriction.reduced.slider import AveragedStability, FloquetStability, StabilityMap
     from fenicsfriction.results import CsvRows, Record, get_logger, write_json
-    from fenicsfriction.scenes import BlockData, BlockModel, BlockOnBelt
+    from fenicsfriction.scenes import BlockData, BlockModel, BlockOnBelt, BlockOnSlab, SlabModel
     from fenicsfriction.scenes.block import (
         BlockQuantities,
         CentreOfMass,

@@ -24,6 +24,7 @@ __all__ = [
     "assemble_matrix_into",
     "colliding_cells",
     "create_box",
+    "create_mesh_from_arrays",
     "create_simplex_mesh",
     "evaluate_expression",
     "create_rectangle",
@@ -196,3 +197,20 @@ def model_to_mesh(model: typing.Any, comm: MPI.Comm, rank: int,
 def form(expr: ufl.Form, cache_dir: str | None = None) -> fem.FormMetaClass:
     """Compile a UFL form with the package's JIT options (``cache_dir``: where FFCx caches)."""
     return fem.form(expr, **jit_options(cache_dir))
+
+
+def create_mesh_from_arrays(comm: MPI.Comm, cells: np.ndarray, x: np.ndarray,
+                            cell_type: str) -> mesh.Mesh:
+    """A mesh of degree-1 cells of ``cell_type`` ("triangle", "quadrilateral", "tetrahedron",
+    "hexahedron") from arrays (given on any ranks, e.g. all on rank 0 and empty elsewhere),
+    partitioned by dolfinx. Quadrilateral and hexahedron vertices are in dolfinx's
+    tensor-product order (a quadrilateral's 0, 1, 2, 3 at (0,0), (1,0), (0,1), (1,1)), not
+    counter-clockwise. The coordinate element is a UFL ``VectorElement`` up to 0.6 and a
+    Basix element from 0.7."""
+    gdim = x.shape[1]
+    try:
+        import basix.ufl
+        element = basix.ufl.element("Lagrange", cell_type, 1, shape=(gdim,))
+    except (ImportError, AttributeError):
+        element = ufl.VectorElement("Lagrange", cell_type, 1)
+    return mesh.create_mesh(comm, cells.astype(np.int64), x, ufl.Mesh(element))

@@ -13,8 +13,8 @@ import importlib
 import pathlib
 import typing
 
-__all__ = ["LazyChoices", "Parser", "add_block_parsers", "add_oscillator_parsers", "floats",
-           "omega_range"]
+__all__ = ["SLAB_FLAGS", "LazyChoices", "Parser", "add_block_parsers", "add_oscillator_parsers",
+           "floats", "omega_range"]
 
 
 class Parser(argparse.ArgumentParser):
@@ -63,12 +63,14 @@ class LazyChoices:
 def _scene_flags() -> argparse.ArgumentParser:
     """Flags shared by the commands that follow the steady state in μ (None: scene default)."""
     flags = Parser(add_help=False)
-    flags.add_argument("scene", choices=["block"], help="scene to run")
+    flags.add_argument("scene", choices=LazyChoices("fenicsfriction.scenes", "SCENES"),
+                       help="scene to run: block (rigid belt) or block-on-slab (elastic slab)")
     flags.add_argument("--mu-max", type=float, required=True, help="last friction coefficient")
     flags.add_argument("--steps", type=int, default=30, help="continuation increments (NINCT)")
     flags.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
     flags.add_argument("--refine", type=int, default=1, help="mesh refinement (4r × 3r cells)")
-    flags.add_argument("--degree", type=int, default=2, help="Lagrange degree (2: Q2)")
+    flags.add_argument("--degree", type=int,
+                       help="Lagrange degree (block: 2, Q2; block-on-slab: 1, the only one)")
     flags.add_argument("--E", type=float, help="Young's modulus [10³ kg cm⁻¹ s⁻²] (1.4e6)")
     flags.add_argument("--B0", type=float, help="breadth out of the plane [cm] (30.5)")
     flags.add_argument("--K-x", type=float, dest="K_x", help="driver spring [10³ kg s⁻²] (11.1)")
@@ -77,10 +79,29 @@ def _scene_flags() -> argparse.ArgumentParser:
     flags.add_argument("--belt-direction", type=int, help="+1 or -1 (+1)")
     flags.add_argument("--eps", type=float, help="regularisation ε [cm/s] (1e-3)")
     flags.add_argument("--regularisation", help="c1 or smooth (c1)")
-    flags.add_argument("--contact-quadrature", help="gauss or gll (gauss)")
+    flags.add_argument("--contact-quadrature",
+                       help="gauss, gll or nodal (block: gauss; block-on-slab: nodal, its only "
+                            "rule)")
+    _slab_flags(flags)
     flags.add_argument("--max-halvings", type=int, default=8,
                        help="step halvings allowed when a continuation step fails")
     return flags
+
+
+def _slab_flags(parser: argparse.ArgumentParser) -> None:
+    """The slab's fields of the scene block-on-slab (None: the scene's defaults)."""
+    slab = parser.add_argument_group("block-on-slab (the elastic belt)")
+    slab.add_argument("--slab-E", type=float, dest="slab_E",
+                      help="the slab's Young's modulus [10³ kg cm⁻¹ s⁻²] (the block's E)")
+    slab.add_argument("--slab-nu", type=float, help="the slab's Poisson's ratio (the block's ν)")
+    slab.add_argument("--slab-thickness", type=float, help="the slab's thickness [cm] (10)")
+    slab.add_argument("--slab-length", type=float, help="the slab's length [cm] (3 L)")
+    slab.add_argument("--slab-density", type=float,
+                      help="the slab's density [10³ kg cm⁻³] (the block's)")
+
+
+#: the flags of :func:`_slab_flags`, which only the scene block-on-slab accepts
+SLAB_FLAGS = ("slab_E", "slab_nu", "slab_thickness", "slab_length", "slab_density")
 
 
 def add_block_parsers(commands: typing.Any) -> None:
@@ -109,7 +130,8 @@ def add_block_parsers(commands: typing.Any) -> None:
         description="Generalized-α (TSALPHA2) integration from the steady sliding state at --mu "
                     "plus a normal velocity perturbation; TS/SNES options as -dynamics_<option> "
                     "after the flags (e.g. -dynamics_ts_adapt_type basic).")
-    dynamics.add_argument("scene", choices=["block"], help="scene to run")
+    dynamics.add_argument("scene", choices=LazyChoices("fenicsfriction.scenes", "SCENES"),
+                          help="scene to run: block (rigid belt) or block-on-slab")
     dynamics.add_argument("--mu", type=float, required=True, help="friction coefficient")
     dynamics.add_argument("--t-end", type=float, required=True, help="final time [s]")
     dynamics.add_argument("--dt", type=float, default=1e-5, help="(initial) time step [s]")
@@ -132,6 +154,7 @@ def add_block_parsers(commands: typing.Any) -> None:
             ("--eps", "eps", float, "regularisation ε [cm/s] (1e-3)"),
             ("--regularisation", "regularisation", str, "c1 or smooth (c1)")):
         dynamics.add_argument(flag, dest=dest, type=kind, help=text)
+    _slab_flags(dynamics)
 
 
 def add_oscillator_parsers(commands: typing.Any) -> None:

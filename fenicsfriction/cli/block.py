@@ -1,4 +1,5 @@
-"""``fenicsfriction steady|stability|dynamics block``: the finite element block on a belt.
+"""``fenicsfriction steady|stability|dynamics block|block-on-slab``: the finite element block
+on a rigid belt or on an elastic slab.
 
 Each command writes what it computes as it goes (``steady.json``/``stability.json`` rewritten
 after every μ step, ``timeseries.csv`` one row per time step) and, stopped by a signal or a
@@ -35,8 +36,14 @@ __all__ = ["run_dynamics", "run_stability", "run_steady"]
 
 def _scene(args: argparse.Namespace, **fixed: typing.Any) -> BlockOnBelt:
     """The scene from the flags that name its fields (unset flags keep its defaults)."""
+    from fenicsfriction.cli.arguments import SLAB_FLAGS
+
     scene_cls = SCENES[args.scene]
     names = {f.name for f in dataclasses.fields(scene_cls)} - set(fixed)
+    for name in SLAB_FLAGS:
+        given = getattr(args, name, None)
+        check("--" + name.replace("_", "-"), given, given is None or name in names,
+              f"the scene {args.scene} has no slab (use block-on-slab)")
     return scene_cls(**fixed, **{k: v for k, v in vars(args).items()
                                  if k in names and v is not None})
 
@@ -231,6 +238,9 @@ def run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
     check("--dt", args.dt, 0 < args.dt <= args.t_end, "must lie in (0, t-end]")
     check("--stride", args.stride, args.stride >= 1, "must be >= 1")
     scene = _scene(args, mu=args.mu)
+    check("--scheme", args.scheme, args.scheme == "alpha2" or args.scene == "block",
+          f"the scene {args.scene} needs alpha2 (central differences have no contact "
+          "couplings)")
     out = output_folder(args.out)
     model = scene.build(comm)
     model.initial_guess()

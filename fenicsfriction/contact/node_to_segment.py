@@ -83,6 +83,8 @@ class NodeToSegment:
         F, G: the slave- and master-side forms of the contact's virtual power.
         projection: the UFL projection (shape functions, normal, gap).
         pressure, traction: the normal pressure and tangential traction (UFL) at slave nodes.
+        relative_velocity: :math:`w`, the slave velocity less the master's at the closest point
+            (UFL; None without ``velocity``).
     """
 
     def __init__(self, u: fem.Function, facet_tags: mesh.MeshTags, slave: int, master: int,
@@ -128,6 +130,7 @@ class NodeToSegment:
             w = velocity - self._master_value(velocity, fields)
             if transport is not None:
                 w = w - ufl.as_vector(transport)
+        self.relative_velocity = w
         approach = -ufl.dot(w, n) if w is not None else 0.0
         self.pressure = laws.normal_traction(d, c_n, m_n, approach, b_n,
                                              m_n if l_n is None else l_n)

@@ -108,34 +108,15 @@ class BlockModel:
         if with_friction is None:
             with_friction = s.mu > 0 or s.friction_coefficient is not None
         self.with_friction = with_friction
-        nx, ny = 4 * s.refine, 3 * s.refine
-        if s.dim == 2:
-            msh = _compat.create_rectangle(comm, (0.0, 0.0), (s.L, s.H), (nx, ny))
-        else:
-            msh = _compat.create_box(comm, (0.0, 0.0, 0.0), (s.L, s.H, s.B0),
-                                     (nx, ny, s.nz * s.refine))
+        msh, self.facet_tags, self.cell_tags = self._mesh(comm)
         self.msh = msh
-        rows = _vertex_rows(ny, s.degree, s.H, s.spring_height)
-        msh.geometry.x[:, 1] = np.interp(msh.geometry.x[:, 1], np.linspace(0, s.H, ny + 1), rows)
         self.V = V = _compat.vector_function_space(msh, s.degree)
-
-        fdim = msh.topology.dim - 1
         tol = 1e-10 * max(s.L, s.H)
-        marked = [(CONTACT, lambda x: np.isclose(x[1], 0.0, atol=tol)),
-                  (TOP, lambda x: np.isclose(x[1], s.H, atol=tol)),
-                  (LEFT, lambda x: np.isclose(x[0], 0.0, atol=tol)),
-                  (RIGHT, lambda x: np.isclose(x[0], s.L, atol=tol))]
-        facets, values = [], []
-        for tag, where in marked:
-            f = mesh.locate_entities_boundary(msh, fdim, where)
-            facets.append(f)
-            values.append(np.full(len(f), tag, dtype=np.int32))
-        indices, tags = np.concatenate(facets), np.concatenate(values)
-        order = np.argsort(indices)
-        self.facet_tags = mesh.meshtags(msh, fdim, indices[order], tags[order])
         ds = ufl.Measure("ds", domain=msh, subdomain_data=self.facet_tags)
-        self.ds_contact = ds(CONTACT, metadata=QUADRATURE[s.contact_quadrature](s.degree)[1])
-        self.dx = ufl.Measure("dx", domain=msh)
+        self.dx = self._block_measure()
+        self.ds_contact = ds(CONTACT, metadata=(
+            _compat.nodal_quadrature(msh.topology.dim - 1) if s.contact_quadrature == "nodal"
+            else QUADRATURE[s.contact_quadrature](s.degree)[1]))
 
         def constant(value: float) -> fem.Constant:
             return fem.Constant(msh, np.float64(value))
@@ -167,18 +148,14 @@ class BlockModel:
 
         u, u_dot, u_ddot = fem.Function(V, name="displacement"), fem.Function(V), fem.Function(V)
         v = ufl.TestFunction(V)
-        n, ds_c = self.normal, self.ds_contact
         terms = inertia(self.rho, u_ddot, v, self.dx) \
             + elasticity(u, v, s.E, s.nu, self.dx) \
-            + body_force(self.gravity, v, self.dx) \
-            + normal_compliance(u, v, n, self.c_n, self.m_n, self.gap, ds_c)
+            + body_force(self.gravity, v, self.dx)
         if s.top_pressure > 0:
             terms += surface_traction(self.top_traction, v, ds(TOP))
-        if law.b_n > 0:
-            terms += normal_damping(u, u_dot, v, n, law.b_n, law.l_n, self.gap, ds_c)
-        if with_friction:
-            terms += friction(u, u_dot, v, n, self.friction_c_T, self.m_T, self.gap,
-                              self.belt_velocity, self.eps, ds_c, law.regularisation)
+        interface, couplings = self._interface(u, u_dot, u_ddot, v)
+        if interface is not None:
+            terms += interface
         self.spring = NodalSpring.at_point(V, (0.0, s.spring_height, s.B0 / 2)[:s.dim], 0, s.K_x)
         bcs = []
         if s.dim == 3:
@@ -187,12 +164,105 @@ class BlockModel:
                 (V.sub(2), Vz), lambda x: np.isclose(x[2], s.B0 / 2, atol=tol))
             zero = fem.Function(Vz)
             bcs.append(fem.dirichletbc(zero, mid, V.sub(2)))
+        bcs += self._supports()
         self.residual = Residual(form=self.thickness * terms, u=u, u_dot=u_dot, u_ddot=u_ddot,
-                                 v=v, bcs=bcs, springs=[self.spring])
+                                 v=v, bcs=bcs, springs=[self.spring], couplings=couplings)
         self._functionals: dict = {}
-        contact_dofs = fem.locate_dofs_topological(
-            V.sub(1), fdim, self.facet_tags.find(CONTACT))
-        self._contact_y = contact_dofs[contact_dofs < V.dofmap.index_map.size_local * s.dim]
+        self._contact_y = self._contact_dofs()
+
+    # --- what a scene on another foundation overrides (see scenes.block_on_slab) ------------
+    def _mesh(self, comm: MPI.Comm) -> tuple[mesh.Mesh, mesh.MeshTags, mesh.MeshTags | None]:
+        """(mesh, facet tags, cell tags or None): the block alone, its faces tagged CONTACT
+        (y = 0), TOP, LEFT and RIGHT; vertex rows shifted so a node is at the spring height."""
+        s = self.scene
+        nx, ny = 4 * s.refine, 3 * s.refine
+        if s.dim == 2:
+            msh = _compat.create_rectangle(comm, (0.0, 0.0), (s.L, s.H), (nx, ny))
+        else:
+            msh = _compat.create_box(comm, (0.0, 0.0, 0.0), (s.L, s.H, s.B0),
+                                     (nx, ny, s.nz * s.refine))
+        rows = _vertex_rows(ny, s.degree, s.H, s.spring_height)
+        msh.geometry.x[:, 1] = np.interp(msh.geometry.x[:, 1], np.linspace(0, s.H, ny + 1), rows)
+        fdim = msh.topology.dim - 1
+        tol = 1e-10 * max(s.L, s.H)
+        marked = [(CONTACT, lambda x: np.isclose(x[1], 0.0, atol=tol)),
+                  (TOP, lambda x: np.isclose(x[1], s.H, atol=tol)),
+                  (LEFT, lambda x: np.isclose(x[0], 0.0, atol=tol)),
+                  (RIGHT, lambda x: np.isclose(x[0], s.L, atol=tol))]
+        facets, values = [], []
+        for tag, where in marked:
+            f = mesh.locate_entities_boundary(msh, fdim, where)
+            facets.append(f)
+            values.append(np.full(len(f), tag, dtype=np.int32))
+        indices, tags = np.concatenate(facets), np.concatenate(values)
+        order = np.argsort(indices)
+        return msh, mesh.meshtags(msh, fdim, indices[order], tags[order]), None
+
+    def _block_measure(self) -> ufl.Measure:
+        """The volume measure of the block (the whole mesh here)."""
+        return ufl.Measure("dx", domain=self.msh)
+
+    def _interface(self, u: fem.Function, u_dot: fem.Function, u_ddot: fem.Function,
+                   v: ufl.Argument) -> tuple[ufl.Form | None, list]:
+        """(UFL terms per unit breadth, couplings) of the contact and of any other body: here
+        normal compliance, normal damping and friction against the rigid belt on Γ_C."""
+        s, law = self.scene, self.scene.law
+        n, ds_c = self.normal, self.ds_contact
+        terms = normal_compliance(u, v, n, self.c_n, self.m_n, self.gap, ds_c)
+        if law.b_n > 0:
+            terms += normal_damping(u, u_dot, v, n, law.b_n, law.l_n, self.gap, ds_c)
+        if self.with_friction:
+            terms += friction(u, u_dot, v, n, self.friction_c_T, self.m_T, self.gap,
+                              self.belt_velocity, self.eps, ds_c, s.regularisation)
+        return terms, []
+
+    def _supports(self) -> list[fem.DirichletBC]:
+        """Dirichlet conditions besides the 3D mid-plane's (none: the belt holds the block
+        through the contact only)."""
+        return []
+
+    def _contact_dofs(self) -> np.ndarray:
+        """The owned y-dofs of the contact nodes, where :meth:`nodal_contact` is evaluated."""
+        V, fdim = self.V, self.msh.topology.dim - 1
+        dofs = fem.locate_dofs_topological(V.sub(1), fdim, self.facet_tags.find(CONTACT))
+        return dofs[dofs < V.dofmap.index_map.size_local * self.scene.dim]
+
+    def nodal_contact(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(penetration d, tangential slip u̇_x - U_T, approach rate ḋ where d > 0) at the
+        contact nodes this rank owns (the y-dofs ``_contact_y``). Collective in scenes whose
+        contact is searched (call it on every rank)."""
+        s = self.scene
+        u, v = self.residual.u.x.array, self.residual.u_dot.x.array
+        y = self._contact_y
+        d = np.maximum(-u[y] - s.g, 0.0)
+        slip = v[y - 1] - s.belt_direction * s.belt_speed
+        return d, slip, np.where(d > 0, -v[y], 0.0)
+
+    def damping_pressure(self) -> typing.Any:
+        """UFL normal damping pressure b_n d^{l_n} ḋ on Γ_C (zero at rest)."""
+        law = self.scene.law
+        return laws.normal_damping_pressure(
+            self.penetration(), normal_part(self.residual.u_dot, self.normal), law.b_n, law.l_n)
+
+    def energy_forms(self) -> dict[str, ufl.Form]:
+        """Kinetic and strain energies per unit breadth (UFL) of every body of the model."""
+        u, u_dot = self.residual.u, self.residual.u_dot
+        return {"kinetic": 0.5 * self.rho * ufl.inner(u_dot, u_dot) * self.dx,
+                "strain": 0.5 * elasticity(u, u, self.scene.E, self.scene.nu, self.dx)}
+
+    def interface_power_forms(self) -> dict[str, ufl.Form]:
+        """Power per unit breadth (UFL) of the friction and normal-damping tractions on the
+        bodies: the residual's own terms with the velocity as test function, sign reversed."""
+        R, n, law = self.residual, self.normal, self.scene.law
+        forms = {}
+        if self.with_friction:
+            forms["friction"] = -friction(R.u, R.u_dot, R.u_dot, n, self.friction_c_T, self.m_T,
+                                          self.gap, self.belt_velocity, self.eps,
+                                          self.ds_contact, law.regularisation)
+        if law.b_n > 0:
+            forms["damping"] = -normal_damping(R.u, R.u_dot, R.u_dot, n, law.b_n, law.l_n,
+                                               self.gap, self.ds_contact)
+        return forms
 
     @property
     def friction_c_T(self) -> typing.Any:

@@ -26,7 +26,6 @@ import ufl
 from dolfinx import fem
 
 from fenicsfriction import _compat, laws
-from fenicsfriction.forms import elasticity, friction, normal_damping, normal_part
 from fenicsfriction.results import Record
 from fenicsfriction.scenes.block.data import TOP
 
@@ -177,9 +176,7 @@ def _quantity_forms(model: BlockModel) -> dict[str, ufl.Form]:
     forms = {"normal_elastic": _contact(model, model.pressure())}
     law = model.scene.law
     if law.b_n > 0:  # the damping part of the normal traction (zero at rest)
-        forms["normal_damping"] = _contact(model, laws.normal_damping_pressure(
-            model.penetration(), normal_part(model.residual.u_dot, model.normal), law.b_n,
-            law.l_n))
+        forms["normal_damping"] = _contact(model, model.damping_pressure())
     forms["moment"] = _contact(model, (ufl.SpatialCoordinate(model.msh)[0]
                                        - model.scene.L / 2) * model.pressure())
     if model.with_friction:
@@ -189,12 +186,10 @@ def _quantity_forms(model: BlockModel) -> dict[str, ufl.Form]:
 
 def _energy_forms(model: BlockModel) -> dict[str, ufl.Form]:
     """Kinetic, strain, interface and load-potential energies (:func:`energies`)."""
-    s, R = model.scene, model.residual
-    u, u_dot = R.u, R.u_dot
+    u = model.residual.u
     d = model.penetration()
     ds = ufl.Measure("ds", domain=model.msh, subdomain_data=model.facet_tags)
-    forms = {"kinetic": 0.5 * model.rho * ufl.inner(u_dot, u_dot) * model.dx,
-             "strain": 0.5 * elasticity(u, u, s.E, s.nu, model.dx),
+    forms = {**model.energy_forms(),
              "interface": model.c_n * d ** (model.m_n + 1) / (model.m_n + 1) * model.ds_contact,
              "load": -ufl.inner(model.gravity, u) * model.dx
              - ufl.inner(model.top_traction, u) * ds(TOP)}
@@ -204,16 +199,7 @@ def _energy_forms(model: BlockModel) -> dict[str, ufl.Form]:
 def _power_forms(model: BlockModel) -> dict[str, ufl.Form]:
     """Power of friction and normal damping (:func:`powers`): the residual's own terms with the
     velocity as test function, sign reversed."""
-    R, n, law = model.residual, model.normal, model.scene.law
-    forms = {}
-    if model.with_friction:
-        forms["friction"] = -friction(R.u, R.u_dot, R.u_dot, n, model.friction_c_T, model.m_T,
-                                      model.gap, model.belt_velocity, model.eps,
-                                      model.ds_contact, law.regularisation)
-    if law.b_n > 0:
-        forms["damping"] = -normal_damping(R.u, R.u_dot, R.u_dot, n, law.b_n, law.l_n,
-                                           model.gap, model.ds_contact)
-    return {k: model.thickness * f for k, f in forms.items()}
+    return {k: model.thickness * f for k, f in model.interface_power_forms().items()}
 
 
 def _centre_forms(model: BlockModel) -> dict[str, ufl.Form]:
@@ -260,12 +246,10 @@ def powers(model: BlockModel) -> Powers:
     return Powers(**values)
 
 
-def _contact_counts(model: BlockModel) -> np.ndarray:
+def _contact_counts(model: BlockModel, nodal: tuple | None = None) -> np.ndarray:
     """This rank's counts of open, sticking and slipping contact nodes."""
-    y = model._contact_y
-    d = np.maximum(-model.residual.u.x.array[y] - model.scene.g, 0.0)
-    slip = np.abs(model.residual.u_dot.x.array[y - 1] - model.scene.belt_direction
-                  * model.scene.belt_speed)
+    d, slip, _ = model.nodal_contact() if nodal is None else nodal
+    slip = np.abs(slip)
     closed = d > 0
     stick = closed & (slip < float(model.eps.value))
     return np.array([np.sum(~closed), np.sum(stick), np.sum(closed & ~stick)], dtype=float)
@@ -319,14 +303,14 @@ def _probe_node(model: BlockModel, x: float) -> tuple[int, int, float]:
     return cache["probe"][1:]
 
 
-def _probe_values(model: BlockModel, dof: int, node_x: float, law: laws.InterfaceLaw
-                  ) -> ProbeValues:
-    """The probe's values, on the rank that owns its node."""
+def _probe_values(model: BlockModel, dof: int, node_x: float, law: laws.InterfaceLaw,
+                  nodal: tuple) -> ProbeValues:
+    """The probe's values, on the rank that owns its node (``nodal``: this rank's
+    :meth:`~fenicsfriction.scenes.block.model.BlockModel.nodal_contact`)."""
     s = model.scene
     u, v = model.residual.u.x.array, model.residual.u_dot.x.array
-    d = max(-u[dof] - s.g, 0.0)
-    slip = v[dof - 1] - s.belt_direction * s.belt_speed
-    rate = -v[dof] if d > 0 else 0.0
+    k = int(np.flatnonzero(model._contact_y == dof)[0])
+    d, slip, rate = (float(a[k]) for a in nodal)
     pressure = laws.normal_traction(d, law.c_n, law.m_n, rate, law.b_n, law.l_n)
     traction = laws.friction_traction(d, np.array([slip]), _nodal_c_T(model, law), law.m_T,
                                       float(model.eps.value), s.regularisation)[0]
@@ -342,13 +326,15 @@ def probe(model: BlockModel, x: float) -> ProbeValues:
     """
     owner, dof, node_x = _probe_node(model, x)
     comm = model.msh.comm
-    values = _probe_values(model, dof, node_x, model.scene.law) if comm.rank == owner else None
+    nodal = model.nodal_contact()  # collective
+    values = (_probe_values(model, dof, node_x, model.scene.law, nodal)
+              if comm.rank == owner else None)
     return comm.bcast(values, root=owner)
 
 
-def _penetration_extremes(model: BlockModel) -> np.ndarray:
+def _penetration_extremes(model: BlockModel, nodal: tuple | None = None) -> np.ndarray:
     """This rank's (max d, -min d) over its contact nodes (-inf, -inf without any)."""
-    d = np.maximum(-model.residual.u.x.array[model._contact_y] - model.scene.g, 0.0)
+    d = (model.nodal_contact() if nodal is None else nodal)[0]
     return np.array([d.max(), -d.min()]) if d.size else np.full(2, -np.inf)
 
 
@@ -415,12 +401,13 @@ def dynamics_observer(model: BlockModel, probe_x: float | None = None
     def state() -> tuple[dict[str, dict[str, float]], float, np.ndarray, ProbeValues,
                          np.ndarray]:
         """Integrals by group, spring force, contact counts, probe, penetration extremes."""
+        nodal = model.nodal_contact()  # collective: before the integrals, which use its search
         node = np.zeros(len(probe_fields))
         if comm.rank == owner:
-            node[:] = dataclasses.astuple(_probe_values(model, dof, node_x, law))
+            node[:] = dataclasses.astuple(_probe_values(model, dof, node_x, law, nodal))
         total = np.concatenate([functionals.local(), [_local_spring_force(model)],
-                                _contact_counts(model), node])
-        extremes = _penetration_extremes(model)
+                                _contact_counts(model, nodal), node])
+        extremes = _penetration_extremes(model, nodal)
         comm.Allreduce(MPI.IN_PLACE, total, op=MPI.SUM)
         comm.Allreduce(MPI.IN_PLACE, extremes, op=MPI.MAX)
         values: dict[str, dict[str, float]] = {g: {} for g in groups}
