@@ -33,6 +33,7 @@ residual evaluation (finite sliding); ``frozen=True`` keeps it (for derivative t
 
 from __future__ import annotations
 
+import time
 import typing
 
 from petsc4py import PETSc
@@ -235,12 +236,16 @@ class ContactOperator:
         self.b_G = dolfinx.fem.petsc.create_vector(self.G)
         self.matrices = {key: dolfinx.fem.petsc.create_matrix(a)
                          for key, a in self.blocks.items() if a is not None}
+        #: seconds spent assembling the residual (``"residual"``: search excluded) and the
+        #: chained Jacobian (``"jacobian"``: blocks, products, addition), summed over calls
+        self.time_s = {"residual": 0.0, "jacobian": 0.0}
 
     def add_to_residual(self, b: PETSc.Vec) -> None:
         """``b += F + Q^T G`` at the current state (the pairing searched first if due)."""
         contact = self.contact
         contact.update(search=contact.search_pending or contact.search_every_residual
                        or not contact.searched)
+        t0 = time.perf_counter()
         for vector, form in ((self.b_F, self.F), (self.b_G, self.G)):
             with vector.localForm() as local:
                 local.set(0.0)
@@ -250,6 +255,7 @@ class ContactOperator:
         Q = self.contact.pairing.Q
         assert Q is not None
         Q.multTransposeAdd(self.b_G, b, b)
+        self.time_s["residual"] += time.perf_counter() - t0
 
     def matrix(self, bcs: typing.Sequence[fem.DirichletBC] = ()) -> PETSc.Mat:
         """The chained Jacobian of the contact (rows and columns of ``bcs`` zeroed)."""
@@ -285,10 +291,12 @@ class ContactOperator:
         """``A += dR_c/du``; A's pattern grows to the contact's couplings, so A must not be a
         matrix dolfinx assembles into (see
         :func:`fenicsfriction.assembly.assemble_coupled_jacobian`)."""
+        t0 = time.perf_counter()
         J = self.matrix(bcs)
         if J is not None:
             A.axpy(1.0, J, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
             J.destroy()
+        self.time_s["jacobian"] += time.perf_counter() - t0
 
 
 def _constrained_rows(V: fem.FunctionSpace, bcs: typing.Sequence[fem.DirichletBC]) -> np.ndarray:

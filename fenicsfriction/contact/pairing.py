@@ -16,6 +16,7 @@ Cost per search: an all-gather of the master surface (O(master facets)), one k-d
 from __future__ import annotations
 
 import dataclasses
+import time
 
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -132,6 +133,8 @@ class Pairing:
         reference: a Function of W: the reference coordinates of each slave node's master
             nodes (the current ones are these plus ``Q u``).
         searches, changes: how many searches ran, how many changed the pairing.
+        time_s: seconds spent in ``"search"`` (gather, k-d tree, distances) and ``"build"``
+            (the operator Q), summed over calls.
     """
 
     def __init__(self, V: fem.FunctionSpace, W: fem.FunctionSpace, slave_nodes: np.ndarray,
@@ -148,6 +151,7 @@ class Pairing:
         self.reference = fem.Function(W, name="master_reference")
         self.searches = 0
         self.changes = 0
+        self.time_s = {"search": 0.0, "build": 0.0}
         self._surface: _MasterSurface | None = None
 
     def gather(self, u: fem.Function) -> _MasterSurface:
@@ -173,6 +177,7 @@ class Pairing:
 
         Returns True if the pairing changed (``Q`` and ``reference`` are then rebuilt).
         """
+        t0 = time.perf_counter()
         surface = self.gather(u)
         self.searches += 1
         d = self.dim
@@ -194,12 +199,13 @@ class Pairing:
             surface.global_nodes[facet], self._paired_nodes())
         self._surface = surface
         changed = bool(self.comm.allreduce(changed, op=MPI.LOR))
+        self.facet = facet
+        t1 = time.perf_counter()
+        self.time_s["search"] += t1 - t0
         if changed:
             self.changes += 1
-            self.facet = facet
             self._build(surface)
-        else:
-            self.facet = facet
+            self.time_s["build"] += time.perf_counter() - t1
         return changed
 
     def _keep_ties(self, facet: np.ndarray, x_slave: np.ndarray,

@@ -191,11 +191,14 @@ class TwoBodyModel:
     def solve_at(self, approach: float) -> typing.Any:
         """Equilibrium with the LOAD face moved by ``approach`` towards body 2 (Newton from the
         current state, the pairing searched again until it holds); returns the report."""
-        # the initial guess moves body 1 rigidly with its face: the contact zone of a rigid
-        # indentation is wider than the elastic one, and Newton's active set shrinks to it in
-        # a few iterations (growing it takes about one node per iteration)
-        self.u.x.array[self._body1_dofs] -= approach - float(self.approach.value)
-        self.u.x.scatter_forward()
+        # a deeper approach starts from body 1 moved rigidly with its face: the contact zone
+        # of a rigid indentation is wider than the elastic one, and Newton's active set shrinks
+        # to it in a few iterations (growing it takes about one node per iteration); a
+        # shallower one from the last state, whose zone also shrinks
+        increase = approach - float(self.approach.value)
+        if increase > 0:
+            self.u.x.array[self._body1_dofs] -= increase
+            self.u.x.scatter_forward()
         self._platen.value = -approach
         self.approach.value = approach
         return solve_with_search(self.solver, self.contacts)
