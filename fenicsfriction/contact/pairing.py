@@ -73,6 +73,20 @@ def _normal(x: np.ndarray) -> np.ndarray:
     return np.cross(t, x[..., 2, :] - x[..., 0, :])
 
 
+def _closest_by_geometry(distance: np.ndarray, centroids: np.ndarray) -> np.ndarray:
+    """The column of the smallest distance in each row; among facets as close to round-off
+    (a node over an edge or a vertex), the one whose reference centroid comes first in
+    (x, y, z) order, so that the choice does not depend on how the mesh is partitioned."""
+    best = np.argmin(distance, axis=1)
+    rows = np.arange(len(distance))
+    tied = distance <= distance[rows, best][:, None] * (1 + 1e-9) + 1e-14
+    for row in np.flatnonzero(tied.sum(axis=1) > 1):
+        columns = np.flatnonzero(tied[row])
+        order = np.lexsort(centroids[row, columns].T[::-1])
+        best[row] = columns[order[0]]
+    return best
+
+
 def point_facet_distance(p: np.ndarray, x: np.ndarray) -> np.ndarray:
     """Distance of points ``p[..., :]`` to the closed segments/triangles ``x[..., a, :]``."""
     if x.shape[-2] == 2:
@@ -191,7 +205,7 @@ class Pairing:
             _, candidates = cKDTree(surface.current.mean(axis=1)).query(x_slave, k=k)
             candidates = candidates.reshape(len(x_slave), k)
             distance = point_facet_distance(x_slave[:, None, :], surface.current[candidates])
-            best = np.argmin(distance, axis=1)
+            best = _closest_by_geometry(distance, surface.reference[candidates].mean(axis=2))
             facet = candidates[np.arange(len(x_slave)), best]
             if self._surface is not None:
                 facet = self._keep_ties(facet, x_slave, surface)

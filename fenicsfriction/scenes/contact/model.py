@@ -60,7 +60,7 @@ class Material:
 
 @dataclasses.dataclass
 class SurfaceValues:
-    """Nodal values on the slave surface, gathered on every rank, sorted by ``x[:, 0]``.
+    """Nodal values on the slave surface, gathered on every rank, sorted by x, then y, z.
 
     Attributes:
         x: reference coordinates of the slave nodes (n, dim).
@@ -266,7 +266,7 @@ class TwoBodyModel:
                                  *(v[owned] / weight[owned] for v in values),
                                  force[owned] / weight[owned, None]])
         rows = np.vstack(self.comm.allgather(local))
-        rows = rows[np.argsort(rows[:, 0], kind="stable")]
+        rows = rows[np.lexsort(rows[:, :self.dim].T[::-1])]  # by x, then y (then z)
         d = self.dim
         return SurfaceValues(x=rows[:, :d], weight=rows[:, d], gap=rows[:, d + 1],
                              pressure=rows[:, d + 2], traction=rows[:, d + 3:2 * d + 3],

@@ -1,0 +1,153 @@
+"""Node-to-segment contact between two bodies: derivatives, pairing, parallel agreement.
+
+The contact's Jacobian is ufl.derivative of its residual chained through the pairing operator
+Q; a Taylor test checks it: with a consistent Jacobian the remainder
+|R(u + h du) - R(u) - h J du| falls like h² (a wrong block leaves an O(h) remainder).
+"""
+
+from __future__ import annotations
+
+from mpi4py import MPI
+
+import dolfinx.fem.petsc
+import numpy as np
+import pytest
+import ufl
+from dolfinx import fem
+
+from fenicsfriction import _compat
+from fenicsfriction.contact import NodeToSegment, solve_with_search
+from fenicsfriction.contact.pairing import point_facet_distance, surface_coordinates
+from two_blocks import MASTER, SLAVE, UPPER, stacked_blocks
+
+
+def _contact(dim: int, friction: bool, overlap: float = 0.02, comm=MPI.COMM_WORLD,
+             frozen: bool = True, seed: int = 1):
+    msh, cell_tags, ft = stacked_blocks(comm, dim, 3, 4, overlap=overlap)
+    V = _compat.vector_function_space(msh, 1)
+    u, u_old = fem.Function(V, name="u"), fem.Function(V, name="u_old")
+    x = V.tabulate_dof_coordinates()[:, :dim]
+    # a smooth random-looking state, the same on any partition (a function of position)
+    rng = np.random.default_rng(seed)
+    k = rng.standard_normal((3, dim))
+    for f, scale in ((u, 0.01), (u_old, 0.005)):
+        f.x.array[:] = (scale * np.sin(x @ k[:dim].T + k[2])).ravel()
+        f.x.scatter_forward()
+    law = {"c_n": 100.0, "m_n": 2.0}
+    if friction:
+        law.update(c_T=50.0, velocity=(u - u_old) / 0.1, fields=[u_old], eps=1e-2)
+    contact = NodeToSegment(u, ft, SLAVE, MASTER, frozen=frozen, **law)
+    contact.cell_tags = cell_tags
+    return contact, u
+
+
+def _residual(operator, u, values):
+    u.x.array[:] = values
+    u.x.scatter_forward()
+    b = dolfinx.fem.petsc.create_vector(operator.F)
+    b.set(0.0)
+    operator.add_to_residual(b)
+    return b
+
+
+@pytest.mark.parametrize(("dim", "friction"), [(2, False), (2, True), (3, False), (3, True)])
+def test_contact_jacobian_passes_the_taylor_test(dim, friction):
+    contact, u = _contact(dim, friction)
+    operator = contact.operator({u: 1.0})
+    x0 = u.x.array.copy()
+    b0 = _residual(operator, u, x0)
+    J = operator.matrix()
+    du = fem.Function(u.function_space)
+    x = u.function_space.tabulate_dof_coordinates()[:, :dim]
+    # every dof moving, the same direction on any partition (a function of position)
+    du.x.array[:] = np.cos(x @ np.arange(1.0, dim + 1) * np.arange(1, dim + 1)[:, None]).T.ravel()
+    du.x.scatter_forward()
+    Jdu = b0.duplicate()
+    J.mult(_compat.petsc_vec(du), Jdu)
+    remainders = []
+    for h in (2e-4, 1e-4, 5e-5):
+        b = _residual(operator, u, x0 + h * du.x.array)
+        b.axpy(-1.0, b0)
+        first = b.norm()
+        b.axpy(-h, Jdu)
+        remainders.append(b.norm())
+        assert first > 0
+    rates = np.log2(np.array(remainders[:-1]) / remainders[1:])
+    # second order, the remainder's constant is the residual's curvature (m_n = 2, finite
+    # sliding of the closest point); a missing chain term leaves rate 1
+    assert rates.min() > 1.9, rates
+
+
+def test_projection_of_a_point_on_a_triangle_has_its_surface_coordinates():
+    x = np.array([[[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0]]])
+    p = np.array([[0.5, 0.25, 0.3]])
+    N = surface_coordinates(p, x)
+    # x1 + ξ1 (x2 - x1) + ξ2 (x3 - x1) = (0.5, 0.25): ξ1 = 0.25, ξ2 = 0.25
+    assert np.allclose(N, [[0.5, 0.25, 0.25]])
+    assert np.isclose(point_facet_distance(p, x)[0], 0.3)
+    outside = np.array([[3.0, 0.0, 0.4]])  # nearest point: the vertex (2, 0, 0)
+    assert np.isclose(point_facet_distance(outside, x)[0], np.hypot(1.0, 0.4))
+
+
+def test_pairing_follows_finite_sliding():
+    """The upper block slid by 1.3 of the lower mesh's cells: the search pairs every slave
+    node over the master surface with the facet under its current position."""
+    contact, u = _contact(2, friction=False, overlap=0.0)
+    V = u.function_space
+    cell_tags = contact.cell_tags
+    upper = fem.locate_dofs_topological(V, 2, cell_tags.indices[cell_tags.values == UPPER])
+    u.x.array[:] = 0.0
+    u.x.array.reshape(-1, 2)[upper, 0] = 1.3 / 4
+    u.x.scatter_forward()
+    contact.frozen = False
+    contact.update()
+    pairing = contact.pairing
+    xs = pairing.x_nodes[pairing.slave_nodes] + u.x.array.reshape(-1, 2)[pairing.slave_nodes]
+    N = surface_coordinates(xs, pairing._surface.current[pairing.facet])
+    over = xs[:, 0] <= 1.0  # the slave nodes still above the lower block
+    assert np.all(N[over] >= -1e-12) and np.all(N[over] <= 1 + 1e-12)
+    assert pairing.changes >= 1
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_parallel_solve_matches_the_serial_one(dim):
+    """The patch under pressure on this communicator (slave and master facets on different
+    ranks under MPI) against the same problem solved on each rank alone: the contact forces
+    agree to the solver tolerance."""
+    from fenicsfriction.scenes.contact.validation import Patch
+
+    scene = Patch(dim=dim, n_upper=3 if dim == 3 else 5, n_lower=4 if dim == 3 else 7)
+    summary, model = scene.run(MPI.COMM_WORLD)
+    alone, model_alone = scene.run(MPI.COMM_SELF)
+    here = model.surface_values()
+    there = model_alone.surface_values()
+    assert np.allclose(here.x, there.x)
+    # Newton stops at |R| <= 1e-9 against forces of 1e-2 per unit length/area
+    assert np.allclose(here.force, there.force, atol=1e-7 * scene.pressure / np.min(here.weight))
+    assert summary["pressure_deviation"] == pytest.approx(alone["pressure_deviation"], abs=1e-6)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_two_pass_contact_passes_the_patch_test_and_one_pass_does_not(dim):
+    """Taylor & Papadopoulos (1991): node-to-segment contact transmits a uniform pressure
+    across non-matching meshes only with both surfaces slave in turn. Two passes: the
+    deviation left is the penalty's (c_n = 1e4 against E = 1: a few 1e-3)."""
+    from fenicsfriction.scenes.contact.validation import Patch
+
+    one, _ = Patch(dim=dim, passes=1).run()
+    two, _ = Patch(dim=dim, passes=2).run()
+    assert two["pressure_deviation"] < 1e-2
+    assert one["pressure_deviation"] > 10 * two["pressure_deviation"]
+
+
+def test_search_between_solves_reaches_a_fixed_point():
+    """solve_with_search returns a state whose own search keeps the pairing."""
+    from fenicsfriction.scenes.contact.validation import Patch
+
+    _, model = Patch(dim=2).run()
+    contact = model.contacts[0]
+    changes = contact.pairing.changes
+    assert not contact.pairing.search(model.u)
+    assert contact.pairing.changes == changes
+    report = solve_with_search(model.solver, model.contacts)
+    assert report.rounds == 1
