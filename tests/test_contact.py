@@ -12,13 +12,12 @@ from mpi4py import MPI
 import dolfinx.fem.petsc
 import numpy as np
 import pytest
-import ufl
 from dolfinx import fem
+from two_blocks import MASTER, SLAVE, UPPER, stacked_blocks
 
 from fenicsfriction import _compat
 from fenicsfriction.contact import NodeToSegment, solve_with_search
 from fenicsfriction.contact.pairing import point_facet_distance, surface_coordinates
-from two_blocks import MASTER, SLAVE, UPPER, stacked_blocks
 
 
 def _contact(dim: int, friction: bool, overlap: float = 0.02, comm=MPI.COMM_WORLD,
