@@ -36,7 +36,11 @@ import ufl
 from dolfinx import fem
 
 from fenicsfriction import _compat
-from fenicsfriction.assembly import assemble_jacobian, assemble_residual
+from fenicsfriction.assembly import (
+    assemble_coupled_jacobian,
+    assemble_jacobian,
+    assemble_residual,
+)
 from fenicsfriction.forms import Residual
 from fenicsfriction.laws import check
 from fenicsfriction.timestepping import DEFAULT_OPTIONS, Alpha2Integrator, DynamicsError
@@ -94,6 +98,8 @@ class DynamicsSolver(Alpha2Integrator):
         if self.couplings:
             self.A = self._uncoupled.duplicate(copy=True)
         super().__init__(msh.comm, prefix, self.b, self.A, options, atol, predictor)
+        if self.couplings:  # the pairing is searched at each step's first residual
+            self.ts.setPreStep(lambda ts: _search_due(self.couplings))
 
     def _state(self) -> tuple[PETSc.Vec, PETSc.Vec]:
         return _compat.petsc_vec(self.residual.u), _compat.petsc_vec(self.residual.u_dot)
@@ -129,6 +135,12 @@ class DynamicsSolver(Alpha2Integrator):
             for coupling in self.couplings:
                 coupling.add_to_matrix(J, bcs)
         self.convergence.jacobian_assembled(J)
+
+
+def _search_due(couplings: typing.Sequence) -> None:
+    """Mark each contact's pairing to be searched at the next residual evaluation."""
+    for coupling in couplings:
+        coupling.contact.search_pending = True
 
 
 def _split_constant(jacobian: ufl.Form) -> tuple[ufl.Form | None, list]:
@@ -223,6 +235,10 @@ class CentralDifference:
     contact pressure during the run (the block's nodal pressure reaches ~3× its steady value
     past the flutter onset). ``stable_dt`` is the smaller bound, ``stable_dt_elastic`` and
     ``stable_dt_band`` the two.
+
+    With contact couplings (two bodies) the elastic bound is taken at the initial state with
+    the contact's Jacobian; springs that close later (an impact) are bounded by
+    ``stable_dt_contact`` (linear compliance: :meth:`NodeToSegment.frequency_bound`).
     """
 
     def __init__(self, residual: Residual, safety: float = 0.9,
@@ -238,10 +254,17 @@ class CentralDifference:
         M.assemble()
         self.lumped = self.b.duplicate()
         M.getRowSum(self.lumped)
+        self.couplings = [c.operator({}) for c in residual.couplings]
         bc_dofs = [i for bc in residual.bcs for i in bc.dof_indices()[0]]
         with self.lumped.localForm() as m:
             m.array[bc_dofs] = np.inf  # constrained dofs never accelerate
         self.stable_dt_elastic = self._stable_step(residual)
+        # contact springs that close later than the initial state (an impact): their bound
+        self.stable_dt_contact = np.inf
+        if residual.couplings and all(c.m_n == 1 for c in residual.couplings):
+            omega2 = (2.0 / self.stable_dt_elastic) ** 2 + sum(
+                c.frequency_bound(self.lumped) for c in residual.couplings)
+            self.stable_dt_contact = 2.0 / np.sqrt(omega2)
         self.stable_dt_band = np.inf
         if band_damping is not None:
             c = dolfinx.fem.petsc.assemble_vector(_compat.form(band_damping))
@@ -251,15 +274,26 @@ class CentralDifference:
             local = (2.0 * owned_m[active] / (band_margin * owned_c[active])).min(initial=np.inf)
             self.stable_dt_band = float(c.getComm().tompi4py().allreduce(local, op=MPI.MIN))
             c.destroy()
-        self.stable_dt = min(self.stable_dt_elastic, self.stable_dt_band)
+        self.stable_dt = min(self.stable_dt_elastic, self.stable_dt_band,
+                             self.stable_dt_contact)
         M.destroy()
 
     def _stable_step(self, residual: Residual) -> float:
-        """2 / ω_max with ω_max² the largest eigenvalue of K̄ w = ω² M_L w."""
+        """2 / ω_max with ω_max² the largest eigenvalue of K̄ w = ω² M_L w (contact couplings
+        included at the initial state: see ``contact_stiffness``)."""
         from slepc4py import SLEPc
         a = _compat.form(residual.derivative(residual.at_rest(residual.form), residual.u))
         K = dolfinx.fem.petsc.create_matrix(a)
         assemble_jacobian(K, a, residual.bcs, residual.springs)
+        if residual.couplings:
+            coupled = K.duplicate()
+            coupled.assemble()
+            assemble_coupled_jacobian(
+                coupled, K, a, residual.bcs, residual.springs,
+                [c.operator({residual.u: 1.0}, rest=[residual.u_dot])
+                 for c in residual.couplings])
+            K.destroy()
+            K = coupled
         inverse_mass = self.lumped.copy()
         inverse_mass.reciprocal()
         K.diagonalScale(inverse_mass, None)  # M_L^{-1} K̄: same eigenvalues ω²
@@ -291,7 +325,8 @@ class CentralDifference:
         def acceleration() -> None:
             R.u.x.scatter_forward()
             R.u_dot.x.scatter_forward()
-            assemble_residual(self.b, self.L, self.L, [], u, R.springs)
+            _search_due(self.couplings)
+            assemble_residual(self.b, self.L, self.L, [], u, R.springs, self.couplings)
             a.pointwiseDivide(self.b, self.lumped)
             a.scale(-1.0)
 

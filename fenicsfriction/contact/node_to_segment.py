@@ -84,6 +84,9 @@ class NodeToSegment:
         F, G: the slave- and master-side forms of the contact's virtual power.
         projection: the UFL projection (shape functions, normal, gap).
         pressure, traction: the normal pressure and tangential traction (UFL) at slave nodes.
+        potential, dissipation: the energy stored in the compliance
+            :math:`\int c_n d^{m_n+1}/(m_n+1)` and the power dissipated by friction and normal
+            damping (UFL forms, nodal rule; the latter zero without a velocity).
         relative_velocity: :math:`w`, the slave velocity less the master's at the closest point
             (UFL; None without ``velocity``).
     """
@@ -109,6 +112,7 @@ class NodeToSegment:
         self.dim = dim
         self.frozen = frozen
         self.search_every_residual = search == "residual"
+        self.c_n, self.m_n, self.weight = c_n, m_n, weight
         self.search_pending = True
         self.W = _compat.lagrange_vector_space(msh, 1, dim * dim)
         slave_nodes = np.unique(facet_nodes(V, facet_tags, slave, outward=False))
@@ -128,6 +132,10 @@ class NodeToSegment:
         d = laws.penetration(-self.projection.gap)
         w = None
         if velocity is not None:
+            unmirrored = set(ufl.algorithms.extract_coefficients(velocity)) - {u, *fields}
+            laws.check("fields", [f.name for f in fields], not unmirrored,
+                       "every Function the velocity depends on besides u (missing: "
+                       f"{', '.join(sorted(f.name for f in unmirrored))})")
             w = velocity - self._master_value(velocity, fields)
             if transport is not None:
                 w = w - ufl.as_vector(transport)
@@ -148,6 +156,39 @@ class NodeToSegment:
         master_test = self.projection.interpolate([self._node(omega, a) for a in range(dim)])
         self.F = -weight * ufl.inner(force, v) * self.ds
         self.G = weight * ufl.inner(force, master_test) * self.ds
+        # energy bookkeeping: the compliance's stored energy and the power the interface
+        # dissipates (friction, normal damping), both >= 0
+        self.potential = weight * c_n * d ** (m_n + 1) / (m_n + 1) * self.ds
+        dissipated = 0.0 * d
+        if w is not None:
+            damping = self.pressure - laws.normal_pressure(d, c_n, m_n)
+            dissipated = damping * approach
+            if self.traction is not None:
+                dissipated = dissipated - ufl.dot(self.traction, w)
+        self.dissipation = weight * dissipated * self.ds
+
+    def frequency_bound(self, lumped_mass: PETSc.Vec) -> float:
+        """An upper bound of the contact springs' frequency² on the lumped mass, for linear
+        compliance (m_n = 1, the stiffness c_n per unit length/area whatever the
+        penetration): every slave node in contact, its spring k_i = c_n A_i between masses no
+        lighter than the lightest node of either surface, ω² <= 2 max k_i / min m."""
+        laws.check("m_n", self.m_n, self.m_n == 1,
+                   "a penetration-independent bound exists for m_n = 1 only")
+        S = _compat.scalar_function_space(self.V.mesh, "Lagrange", 1)
+        area = dolfinx.fem.petsc.assemble_vector(
+            _compat.form(ufl.TestFunction(S) * self.ds))
+        area.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        slave = self.pairing.slave_nodes
+        stiffness = float(self.weight * float(self.c_n) * area.array_r[slave].max(initial=0.0))
+        area.destroy()
+        d = self.dim
+        masses = lumped_mass.array_r.reshape(-1, d)
+        surfaces = np.concatenate([slave, self.pairing.master_facets.ravel()])
+        surfaces = surfaces[surfaces < len(masses)]
+        lightest = float(masses[surfaces].min(initial=np.inf))
+        comm = self.V.mesh.comm
+        from mpi4py import MPI
+        return 2 * comm.allreduce(stiffness, op=MPI.MAX) / comm.allreduce(lightest, op=MPI.MIN)
 
     def _node(self, packed: typing.Any, a: int) -> typing.Any:
         """The vector of master node ``a`` in a packed W quantity."""

@@ -14,6 +14,7 @@ solve started from the last.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import logging
 import typing
 
@@ -91,6 +92,11 @@ class TwoBodyModel:
         passes: 1 (body 1's surface is the slave) or 2 (each surface in turn).
         clamp: body 2's :data:`FIXED` face clamped (True) or on rollers (normal component
             fixed only: a patch test's free lateral expansion).
+        density: both bodies' mass density [mass/length³]: a dynamic model (inertia, the
+            friction on the slip rate u̇, normal damping ``b_n``, the LOAD face under the
+            traction ``shear`` in every direction: no platen, inertia carries body 1); ``None``
+            (default): quasi-static.
+        b_n: normal damping coefficient (dynamic models), exponent ``m_n``.
         fix_load_face: also fix the tangential displacement of the :data:`LOAD` face
             (removes the sliding mode of a frictionless body 1 in a full model); else the
             face carries the tangential traction ``shear``.
@@ -112,7 +118,8 @@ class TwoBodyModel:
     def __init__(self, geometry: TwoBodyMesh, materials: tuple[Material, Material],
                  c_n: float, m_n: float = 1.0, mu: float = 0.0, eps: float = 1e-6,
                  passes: int = 1, fix_load_face: bool = False,
-                 regularisation: str = "c1", clamp: bool = True):
+                 regularisation: str = "c1", clamp: bool = True,
+                 density: float | None = None, b_n: float = 0.0):
         check("passes", passes, passes in (1, 2), "1 or 2")
         check("c_n", c_n, c_n > 0, "the normal compliance coefficient must be > 0")
         check("m_n", m_n, m_n >= 1, "the normal exponent must be >= 1")
@@ -132,29 +139,45 @@ class TwoBodyModel:
         self.approach = fem.Constant(msh, 0.0)
         self.shear = fem.Constant(msh, np.zeros(dim))
         form = forms.surface_traction(self.shear, v, ds(LOAD))
+        self.dx, self.ds = dx, ds
+        self.materials = materials
         for tag, material in zip((BODY1, BODY2), materials, strict=True):
             form += forms.elasticity(self.u, v, material.E, material.nu, dx(tag))
+        self.dynamic = density is not None
+        if density is not None:
+            check("density", density, density > 0, "the mass density must be > 0")
+            form += forms.inertia(density, u_ddot, v, dx)
+        self.density = density
         self.mu = fem.Constant(msh, float(mu))
         self.eps = fem.Constant(msh, float(eps))
         self.dt = fem.Constant(msh, 1.0)
-        friction = {}
+        law: dict = {"b_n": b_n}
+        if self.dynamic:
+            law.update(velocity=u_dot, fields=[u_dot])
         if mu > 0:
-            friction = {"c_T": self.mu * c_n, "m_T": m_n, "eps": self.eps,
-                        "regularisation": regularisation,
-                        "velocity": (self.u - self.u_old) / self.dt, "fields": [self.u_old]}
+            law.update({"c_T": self.mu * c_n, "m_T": m_n, "eps": self.eps,
+                        "regularisation": regularisation})
+            if not self.dynamic:
+                law.update({"velocity": (self.u - self.u_old) / self.dt,
+                            "fields": [self.u_old]})
         pairs = [(SLAVE, MASTER), (MASTER, SLAVE)][:passes]
         self.contacts = [NodeToSegment(self.u, facet_tags, slave, master, c_n=c_n, m_n=m_n,
-                                       weight=1.0 / passes, **friction)
+                                       weight=1.0 / passes, **law)
                          for slave, master in pairs]
         self.residual = forms.Residual(form, self.u, u_dot, u_ddot, v,
                                        bcs=self._bcs(fix_load_face, clamp),
                                        couplings=self.contacts)
-        self.solver = SteadySolver(self.residual, prefix="contact_", linear_solver="lu")
         cells = cell_tags.indices[cell_tags.values == BODY1]
         nodes = fem.locate_dofs_topological(
             _compat.scalar_function_space(msh, "Lagrange", 1), dim, cells)
         self._body1_rows = nodes[nodes < V.dofmap.index_map.size_local]
         self._body1_dofs = nodes * dim + dim - 1  # their normal components (local, ghosts too)
+
+    @functools.cached_property
+    def solver(self) -> SteadySolver:
+        """Newton on the quasi-static residual (built at first use: a dynamic model, whose
+        friction acts on u̇, is solved by the time integrators instead)."""
+        return SteadySolver(self.residual, prefix="contact_", linear_solver="lu")
 
     def _bcs(self, fix_load_face: bool, clamp: bool) -> list:
         V, facet_tags, fdim = self.V, self.geometry.facet_tags, self.dim - 1
@@ -170,7 +193,8 @@ class TwoBodyModel:
                 bcs.append(self._component_bc(axis, facets))
         load_face = facet_tags.indices[facet_tags.values == LOAD]
         self._platen = fem.Constant(self.geometry.mesh, 0.0)  # -approach
-        bcs.append(self._component_bc(self.dim - 1, load_face, self._platen))
+        if not self.dynamic:
+            bcs.append(self._component_bc(self.dim - 1, load_face, self._platen))
         if fix_load_face:
             bcs += [self._component_bc(axis, load_face) for axis in range(self.dim - 1)]
         return bcs
@@ -304,11 +328,16 @@ class TwoBodyModel:
         points = x[a] + t * (x[b] - x[a])
         return np.vstack(self.comm.allgather(points))
 
+    @functools.cached_property
+    def _force_operators(self) -> list:
+        """The contacts' residuals alone (no Jacobian), for their forces."""
+        return [contact.operator({}) for contact in self.contacts]
+
     def _contact_force(self) -> np.ndarray:
         """The contact force of every pass on each node (owned nodes, (n, dim))."""
-        b = dolfinx.fem.petsc.create_vector(self.solver.L)
+        b = dolfinx.fem.petsc.create_vector(self._force_operators[0].F)
         b.set(0.0)
-        for operator in self.solver.couplings:
+        for operator in self._force_operators:
             operator.add_to_residual(b)
         force = -b.getArray().reshape(-1, self.dim).copy()
         b.destroy()
