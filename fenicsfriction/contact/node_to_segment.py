@@ -53,7 +53,7 @@ Value = typing.Any
 
 
 class NodeToSegment:
-    """Slave nodes of one tagged surface against the facets of another, same residual.
+    r"""Slave nodes of one tagged surface against the facets of another, same residual.
 
     Args:
         u: the displacement (degree-1 Lagrange vectors on the mesh holding both bodies).

@@ -106,6 +106,7 @@ class PressAndDrag(_Bodies):
         summary (energy balance error, largest penetration, cut-backs, Newton iterations)."""
         check("scheme", scheme, scheme in SCHEMES, f"one of {', '.join(SCHEMES)}")
         model = model or self.build(comm)
+        assert self.load is not None
         energy = _EnergyBalance(model)
         if scheme == "alpha2":
             solver: typing.Any = DynamicsSolver(
@@ -143,6 +144,7 @@ class _EnergyBalance:
         self.model = model
         u, u_dot = model.u, model.residual.u_dot
         dx = model.dx
+        assert model.density is not None, "a dynamic model"
         eps = ufl.sym(ufl.grad(u))
         forms = {"kinetic": 0.5 * model.density * ufl.inner(u_dot, u_dot) * dx}
         elastic = 0.0
