@@ -47,7 +47,12 @@ from fenicsfriction import _compat, laws
 from fenicsfriction.contact.kinematics import Projection, project
 from fenicsfriction.contact.pairing import Pairing, facet_nodes
 
-__all__ = ["ContactOperator", "NodeToSegment", "solve_with_search"]
+__all__ = ["FORMULATIONS", "ContactOperator", "NodeToSegment", "solve_with_search"]
+
+#: the contact laws: ``"compliance"`` (normal compliance, friction regularised on the slip
+#: rate: Martins & Oden 1987) and ``"perturbed-lagrangian"`` (Pop 1997, eq. 27: normal and
+#: tangential penalties ε_N = c_n, ε_T with their multipliers eliminated node by node)
+FORMULATIONS = ("compliance", "perturbed-lagrangian")
 
 Value = typing.Any
 
@@ -71,6 +76,14 @@ class NodeToSegment:
         transport: the master body's rigid velocity :math:`U_T` (a vector; default zero).
         weight: the factor of the term (1/2 for each pass of two-pass contact).
         frozen: keep the pairing of the first search (derivative tests).
+        formulation: one of :data:`FORMULATIONS`. The perturbed Lagrangian's multipliers
+            are nodal and enter their own equations quadratically, so they are eliminated at
+            each slave node: λ_N = ε_N (-g)_+ (linear compliance, ``c_n`` = ε_N, m_n = 1) and
+            λ_T = ε_T times the slip increment from the last committed λ_T (:meth:`commit`),
+            returned to μλ_N in slide. ``eps`` is then unused.
+        eps_T: the tangential penalty ε_T [force/length³] (perturbed Lagrangian).
+        time_step: the increment's duration, slip increment = velocity × time_step
+            (perturbed Lagrangian; 1 with a quasi-static velocity (u - u_old)/1).
         search: when the pairing is searched again: ``"solve"`` (default) once at the start
             of each Newton solve or time step (:func:`solve_with_search` repeats a solve until
             its converged state keeps its pairing), ``"residual"`` at every residual
@@ -96,7 +109,9 @@ class NodeToSegment:
                  b_n: Value = 0.0, l_n: Value | None = None, eps: Value = 1e-3,
                  regularisation: str = "c1", velocity: typing.Any = None,
                  fields: typing.Sequence[fem.Function] = (), transport: typing.Any = None,
-                 weight: float = 1.0, frozen: bool = False, search: str = "solve"):
+                 weight: float = 1.0, frozen: bool = False, search: str = "solve",
+                 formulation: str = "compliance", eps_T: Value | None = None,
+                 time_step: Value = 1.0):
         V = u.function_space
         msh = V.mesh
         dim = msh.geometry.dim
@@ -108,6 +123,15 @@ class NodeToSegment:
         laws.check("regularisation", regularisation, regularisation in laws.REGULARISATIONS,
                    f"one of {sorted(laws.REGULARISATIONS)}")
         laws.check("search", search, search in ("solve", "residual"), "'solve' or 'residual'")
+        laws.check("formulation", formulation, formulation in FORMULATIONS,
+                   f"one of {', '.join(FORMULATIONS)}")
+        if formulation == "perturbed-lagrangian":
+            laws.check("m_n", m_n, m_n == 1, "the perturbed Lagrangian's normal penalty is "
+                       "linear: m_n = 1 (c_n is the penalty eps_N)")
+            laws.check("eps_T", eps_T, eps_T is not None, "the tangential penalty (> 0)")
+        self.formulation = formulation
+        #: the tangential multiplier of the last committed increment (perturbed Lagrangian)
+        self.traction_old = fem.Function(V, name="tangential_multiplier")
         self.u, self.V = u, V
         self.dim = dim
         self.frozen = frozen
@@ -149,8 +173,13 @@ class NodeToSegment:
             laws.check("velocity", velocity, w is not None,
                        "friction (c_T != 0) needs the slave velocity")
             w_T = w - ufl.dot(w, n) * n
-            self.traction = laws.friction_traction(d, w_T, c_T, m_n if m_T is None else m_T,
-                                                   eps, regularisation)
+            if formulation == "compliance":
+                self.traction = laws.friction_traction(d, w_T, c_T,
+                                                       m_n if m_T is None else m_T, eps,
+                                                       regularisation)
+            else:
+                self.traction = self._stick_penalty(d, w_T * time_step, n, c_T,
+                                                    m_n if m_T is None else m_T, eps_T)
             force = force + self.traction
         v, omega = ufl.TestFunction(V), ufl.TestFunction(self.W)
         master_test = self.projection.interpolate([self._node(omega, a) for a in range(dim)])
@@ -189,6 +218,38 @@ class NodeToSegment:
         comm = self.V.mesh.comm
         from mpi4py import MPI
         return 2 * comm.allreduce(stiffness, op=MPI.MAX) / comm.allreduce(lightest, op=MPI.MIN)
+
+    def _stick_penalty(self, d: typing.Any, slip: typing.Any, n: typing.Any, c_T: Value,
+                       m_T: Value, eps_T: Value) -> typing.Any:
+        """The tangential multiplier of the perturbed Lagrangian (Pop 1997, eq. 27), eliminated
+        node by node: a stick spring of stiffness ε_T on the slip increment from the last
+        committed multiplier, returned to the Coulomb bound c_T d^{m_T} when it would exceed
+        it (slide)."""
+        old = self.traction_old - ufl.dot(self.traction_old, n) * n
+        trial = old - eps_T * slip
+        size = ufl.sqrt(ufl.dot(trial, trial))
+        bound = laws.friction_bound(d, c_T, m_T)
+        return ufl.conditional(ufl.le(size, bound), trial, bound * trial / size)
+
+    def commit(self) -> None:
+        """Store the tangential multipliers of the current state as the last increment's
+        (perturbed Lagrangian; call after each converged increment)."""
+        if self.formulation != "perturbed-lagrangian" or self.traction is None:
+            return
+        self.update(search=False)
+        S = _compat.scalar_function_space(self.V.mesh, "Lagrange", 1)
+        q = ufl.TestFunction(S)
+        values = []
+        for form in [q * self.ds] + [self.traction[k] * q * self.ds for k in range(self.dim)]:
+            vec = dolfinx.fem.petsc.assemble_vector(_compat.form(form))
+            vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+            values.append(vec.array_r.copy())
+            vec.destroy()
+        weight, nodal = values[0], np.column_stack(values[1:])
+        owned = self.traction_old.x.array.reshape(-1, self.dim)[:len(weight)]
+        slave = weight > 0
+        owned[slave] = nodal[slave] / weight[slave, None]
+        self.traction_old.x.scatter_forward()
 
     def _node(self, packed: typing.Any, a: int) -> typing.Any:
         """The vector of master node ``a`` in a packed W quantity."""

@@ -97,6 +97,8 @@ class TwoBodyModel:
             traction ``shear`` in every direction: no platen, inertia carries body 1); ``None``
             (default): quasi-static.
         b_n: normal damping coefficient (dynamic models), exponent ``m_n``.
+        formulation, eps_T: the contact law (``"compliance"`` or ``"perturbed-lagrangian"``
+            with the tangential penalty ``eps_T``; :class:`~fenicsfriction.contact.NodeToSegment`).
         fix_load_face: also fix the tangential displacement of the :data:`LOAD` face
             (removes the sliding mode of a frictionless body 1 in a full model); else the
             face carries the tangential traction ``shear``.
@@ -119,7 +121,8 @@ class TwoBodyModel:
                  c_n: float, m_n: float = 1.0, mu: float = 0.0, eps: float = 1e-6,
                  passes: int = 1, fix_load_face: bool = False,
                  regularisation: str = "c1", clamp: bool = True,
-                 density: float | None = None, b_n: float = 0.0):
+                 density: float | None = None, b_n: float = 0.0,
+                 formulation: str = "compliance", eps_T: float | None = None):
         check("passes", passes, passes in (1, 2), "1 or 2")
         check("c_n", c_n, c_n > 0, "the normal compliance coefficient must be > 0")
         check("m_n", m_n, m_n >= 1, "the normal exponent must be >= 1")
@@ -159,7 +162,9 @@ class TwoBodyModel:
                         "regularisation": regularisation})
             if not self.dynamic:
                 law.update({"velocity": (self.u - self.u_old) / self.dt,
-                            "fields": [self.u_old]})
+                            "fields": [self.u_old], "time_step": self.dt})
+            self.eps_T = fem.Constant(msh, float(eps_T if eps_T is not None else 0.0))
+            law.update({"formulation": formulation, "eps_T": self.eps_T})
         pairs = [(SLAVE, MASTER), (MASTER, SLAVE)][:passes]
         self.contacts = [NodeToSegment(self.u, facet_tags, slave, master, c_n=c_n, m_n=m_n,
                                        weight=1.0 / passes, **law)

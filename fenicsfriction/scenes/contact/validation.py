@@ -208,13 +208,17 @@ class Cattaneo(Hertz):
         q_ratio: Q / (μ P), in [0, 1).
         increments: load increments of Q (the quasi-static path; the stick zone only shrinks).
         eps: the regularisation of the slip increment [length] (c1: Pop 1997, eq. 15); a
-            sequence ε_k → 0 is Kalker's sequential process (:meth:`run_sequence`).
+            sequence ε_k → 0 is Kalker's sequential process.
+        formulation: ``"compliance"`` (the regularised law) or ``"perturbed-lagrangian"``
+            (Pop 1997, eq. 27: penalties ε_N = ``c_n`` and ε_T = ``eps_T`` [force/length³]).
     """
 
     mu: float = 0.3
     q_ratio: float = 0.5
     increments: int = 10
     eps: float = 1e-6
+    formulation: str = "compliance"
+    eps_T: float = 1e4
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -228,7 +232,8 @@ class Cattaneo(Hertz):
     def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
         mesh = geometry.hertz_2d(comm, R=self.radius, refine=self.refine)
         return TwoBodyModel(mesh, self.materials, self.c_n, self.m_n, mu=self.mu,
-                            eps=self.eps, passes=self.passes)
+                            eps=self.eps, passes=self.passes, formulation=self.formulation,
+                            eps_T=self.eps_T)
 
     def stick_zone(self, values: SurfaceValues, tol: float = 1e-3) -> tuple[float, float]:
         """(stick half-width, slip half-width): the extent of the contact nodes whose traction
@@ -254,10 +259,14 @@ class Cattaneo(Hertz):
         # the normal load with a wide regularisation: identical bodies do not slip under it
         # (Johnson 1985, section 5.4), and the friction only holds the cylinder's sliding mode
         model.eps.value = NORMAL_LOADING_EPS * a
+        model.eps_T.value = self.E_star / self.radius  # a soft stick spring, for the same
         summary, model = Hertz.run(self, comm, model)
         model.eps.value = self.eps
+        model.eps_T.value = self.eps_T
         rows = []
         for k in range(1, self.increments + 1):
+            for contact in model.contacts:
+                contact.commit()
             model.u_old.x.array[:] = model.u.x.array
             q = self.q_ratio * k / self.increments
             model.shear.value = np.array([q * self.mu * self.load / (2 * self.radius), 0.0])
@@ -278,11 +287,13 @@ class Cattaneo(Hertz):
                               / np.sum(values.weight * exact**2)))
         summary.update({
             "scene": "cattaneo", "q_ratio": self.q_ratio, "mu": self.mu, "eps": self.eps,
+            "formulation": self.formulation,
             "stick_half_width": rows[-1]["stick_half_width"],
             "cattaneo_stick_half_width": rows[-1]["cattaneo_stick_half_width"],
             "traction_error_l2": error, "increments": rows,
             "newton_iterations": summary["newton_iterations"]
             + sum(r["newton_iterations"] for r in rows),
             "wall_time_s": time.perf_counter() - t0})
-        summary["parameters"].update({"mu": self.mu, "eps": self.eps})
+        summary["parameters"].update({"mu": self.mu, "eps": self.eps,
+                                      "formulation": self.formulation, "eps_T": self.eps_T})
         return summary, model
