@@ -395,7 +395,7 @@ def plot_contact_traction(x: np.ndarray, tractions: typing.Sequence[tuple[np.nda
     ``x`` against the closed forms on ``grid``, ``exact`` and μ p_Hertz; the stick zone
     |x| < c and the slip zones c < |x| < a of the closed form shaded. Call on rank 0."""
     plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(7.5, 4.5))
+    fig, ax = plt.subplots(figsize=(10, 4.5))
     ax.axvspan(-c, c, color="tab:green", alpha=0.12, label=f"stick |x| < c = {c:.4g}")
     for lo, hi in ((-a, -c), (c, a)):
         ax.axvspan(lo, hi, color="tab:red", alpha=0.10,
@@ -410,7 +410,7 @@ def plot_contact_traction(x: np.ndarray, tractions: typing.Sequence[tuple[np.nda
     ax.set_xlabel("x")
     ax.set_ylabel("tangential traction")
     ax.set_title(title)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)

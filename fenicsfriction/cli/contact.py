@@ -44,19 +44,19 @@ def _flag(name: str) -> str:
 
 
 def _scene(cls: type, args: argparse.Namespace, **fixed: typing.Any) -> typing.Any:
-    """The scene from the flags that name its fields (unset flags keep its defaults); a bad
-    value raises the scene's ValueError with the field renamed to its flag."""
+    """The scene from the flags that name its fields (unset flags keep its defaults)."""
     names = {f.name for f in dataclasses.fields(cls)} - set(fixed)
-    given = {k: v for k, v in vars(args).items() if k in names and v is not None}
-    try:
-        return cls(**fixed, **given)
-    except ValueError as err:
-        message = str(err)
-        for name in sorted(given, key=len, reverse=True):
-            if message.startswith(f"{name}="):
-                message = _flag(name) + message[len(name):]
-                break
-        raise ValueError(message) from None
+    return cls(**fixed, **{k: v for k, v in vars(args).items() if k in names and v is not None})
+
+
+def _named_by_flag(message: str, args: argparse.Namespace) -> str:
+    """A scene's or mesh's ``name=value is invalid: ...`` with ``name`` replaced by its flag,
+    when the user gave that flag."""
+    given = [k for k, v in vars(args).items() if v is not None]
+    for name in sorted(given, key=len, reverse=True):
+        if message.startswith(f"{name}="):
+            return _flag(name) + message[len(name):]
+    return message
 
 
 @contextlib.contextmanager
@@ -204,7 +204,8 @@ def _run_hertz(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) ->
     log.info(f"hertz {scene.dim}D: {model.dofs} dofs on {comm.size} rank(s), load "
              f"{scene.load:.6g} ({'per unit length' if scene.dim == 2 else 'total'}), "
              f"{scene.passes} pass(es); Hertz: {width.replace('_', ' ')} {a:.6g}, peak "
-             f"pressure {p0:.6g}")
+             f"pressure {p0:.6g}" + ("; a quarter model: each solve's force and load below "
+                                     "are a quarter of the total" if scene.dim == 3 else ""))
     try:
         with _solve_lines(comm):
             summary, model = scene.run(comm, model)
@@ -338,4 +339,7 @@ def _failed(out: pathlib.Path, name: str, scene: typing.Any, err: Exception,
 def run_contact(args: argparse.Namespace, log: logging.Logger) -> int:
     """``contact hertz|patch|cattaneo``: the scene, its summary and its outputs."""
     run = {"hertz": _run_hertz, "patch": _run_patch, "cattaneo": _run_cattaneo}[args.scene]
-    return run(args, log, MPI.COMM_WORLD)
+    try:
+        return run(args, log, MPI.COMM_WORLD)
+    except ValueError as err:  # the scenes and meshes name their fields: name the flags
+        raise ValueError(_named_by_flag(str(err), args)) from None

@@ -168,6 +168,9 @@ class Patch(_Bodies):
         super().__post_init__()
         check("dim", self.dim, self.dim in (2, 3), "2 or 3")
         check("pressure", self.pressure, self.pressure > 0, "the pressure must be > 0")
+        for name in ("n_upper", "n_lower"):
+            value = getattr(self, name)
+            check(name, value, isinstance(value, int) and value >= 1, "an integer >= 1")
 
     def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
         mesh = (geometry.patch_2d if self.dim == 2 else geometry.patch_3d)(
