@@ -328,7 +328,8 @@ def body_cells(u: fem.Function, cell_tags: typing.Any,
     gathered = msh.comm.gather((X, U, body), root=0)
     if msh.comm.rank != 0:
         return None
-    return tuple(np.concatenate([g[k] for g in gathered]) for k in range(3))  # type: ignore
+    X, U, body = (np.concatenate([g[k] for g in gathered]) for k in range(3))
+    return X, U, body
 
 
 def plot_contact_deformed(cells: tuple[np.ndarray, np.ndarray, np.ndarray], path: PathLike,
@@ -376,8 +377,8 @@ def plot_contact_pressure(curves: typing.Sequence[tuple[np.ndarray, np.ndarray, 
         ax.plot(*reference[:2], "k-", lw=1.2, label=reference[2])
     for (x, p, label), marker in zip(curves, "os^vd", strict=False):
         ax.plot(x, p, marker, ms=3.5, mfc="none", label=label)
-    for x in marks:
-        ax.axvline(x, color="k", ls=":", lw=0.8)
+    for mark in marks:
+        ax.axvline(mark, color="k", ls=":", lw=0.8)
     ax.set_xlabel(xlabel)
     ax.set_ylabel("contact pressure")
     ax.set_title(title)
