@@ -218,3 +218,16 @@ def test_bad_value_from_a_shell_is_one_stderr_line(tmp_path, args, name):
     lines = [line for line in result.stderr.splitlines() if line.strip()]
     assert len(lines) == 1, result.stderr
     assert "Traceback" not in result.stderr and name in lines[0]
+
+
+@pytest.mark.parametrize("argv", [["contact", "--help"], ["contact", "cattaneo", "--help"],
+                                  ["contact", "hertz", "--c-n", "x", "--out", "o"]])
+def test_contact_help_and_flag_errors_import_no_solver(argv):
+    """As for the other commands, argparse alone answers: no MPI, PETSc or dolfinx import."""
+    script = ("import sys\nfrom fenicsfriction.cli import main\ntry:\n"
+              f"    main({argv!r})\nexcept SystemExit as stop:\n    code = stop.code\n"
+              "print([m for m in ('dolfinx', 'mpi4py.MPI', 'petsc4py.PETSc') "
+              "if m in sys.modules], code)")
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          timeout=60)
+    assert done.stdout.splitlines()[-1] == f"[] {0 if '--help' in argv else 2}", done.stderr

@@ -22,7 +22,7 @@ from mpi4py import MPI
 
 import numpy as np
 
-from fenicsfriction import plotting, results
+from fenicsfriction import _compat, plotting, results
 from fenicsfriction.cli.common import output_folder, stop_line
 from fenicsfriction.laws import check
 from fenicsfriction.results import CsvRows
@@ -89,8 +89,8 @@ def _write_fields(path: pathlib.Path, model: TwoBodyModel) -> None:
     geometry.facet_tags.name = "surfaces"
     with io.XDMFFile(msh.comm, str(path), "w") as xdmf:
         xdmf.write_mesh(msh)
-        xdmf.write_meshtags(geometry.cell_tags)
-        xdmf.write_meshtags(geometry.facet_tags)
+        _compat.write_meshtags(xdmf, geometry.cell_tags, msh)
+        _compat.write_meshtags(xdmf, geometry.facet_tags, msh)
         xdmf.write_function(model.u, 0.0)
 
 
