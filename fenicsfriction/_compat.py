@@ -37,6 +37,7 @@ __all__ = [
     "petsc_vec",
     "scalar_function_space",
     "vector_function_space",
+    "write_meshtags",
 ]
 
 
@@ -214,3 +215,11 @@ def create_mesh_from_arrays(comm: MPI.Comm, cells: np.ndarray, x: np.ndarray,
     except (ImportError, AttributeError):
         element = ufl.VectorElement("Lagrange", cell_type, 1)
     return mesh.create_mesh(comm, cells.astype(np.int64), x, ufl.Mesh(element))
+
+
+def write_meshtags(xdmf: typing.Any, tags: mesh.MeshTags, msh: mesh.Mesh) -> None:
+    """``XDMFFile.write_meshtags``: dolfinx 0.5 takes the tags alone, 0.7+ also the geometry."""
+    try:
+        xdmf.write_meshtags(tags, msh.geometry)
+    except TypeError:
+        xdmf.write_meshtags(tags)

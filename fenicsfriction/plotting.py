@@ -14,7 +14,8 @@ from fenicsfriction import _compat
 
 PathLike = str | os.PathLike
 
-__all__ = ["cell_outlines", "plot_deformed", "plot_growth", "plot_loci", "plot_oscillator",
+__all__ = ["body_cells", "cell_outlines", "plot_contact_deformed", "plot_contact_pressure",
+           "plot_contact_traction", "plot_deformed", "plot_growth", "plot_loci", "plot_oscillator",
            "plot_stability_map", "plot_steady_forces", "plot_stick_slip",
            "plot_stroboscopic_growth"]
 
@@ -296,4 +297,121 @@ def plot_stroboscopic_growth(runs: dict, path: PathLike) -> None:
     ax.legend(fontsize="small")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+# --- two elastic bodies in contact -----------------------------------------------------------
+
+def body_cells(u: fem.Function, cell_tags: typing.Any,
+               window: tuple[float, float, float, float] | None = None
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """Corners, corner displacements and body tag of the 2D cells (triangles) in ``window``
+    (x_min, x_max, y_min, y_max; a cell with a corner inside is kept), gathered on rank 0.
+
+    ``u`` is a degree-1 vector Function. Returns ``(X, U, body)`` of shapes (n, 3, 2), (n, 3, 2)
+    and (n,) on rank 0, ``None`` elsewhere.
+    """
+    msh = u.function_space.mesh
+    V = u.function_space
+    num_cells = msh.topology.index_map(msh.topology.dim).size_local
+    dofs = np.array([V.dofmap.cell_dofs(c) for c in range(num_cells)]).reshape(num_cells, -1)
+    X = V.tabulate_dof_coordinates()[:, :2][dofs]
+    U = u.x.array.reshape(-1, 2)[dofs]
+    body = np.zeros(num_cells, dtype=np.int32)
+    tagged = cell_tags.indices < num_cells
+    body[cell_tags.indices[tagged]] = cell_tags.values[tagged]
+    if window is not None:
+        x0, x1, y0, y1 = window
+        inside = ((X[..., 0] >= x0) & (X[..., 0] <= x1) & (X[..., 1] >= y0)
+                  & (X[..., 1] <= y1)).any(axis=1)
+        X, U, body = X[inside], U[inside], body[inside]
+    gathered = msh.comm.gather((X, U, body), root=0)
+    if msh.comm.rank != 0:
+        return None
+    X, U, body = (np.concatenate([g[k] for g in gathered]) for k in range(3))
+    return X, U, body
+
+
+def plot_contact_deformed(cells: tuple[np.ndarray, np.ndarray, np.ndarray], path: PathLike,
+                          window: tuple[float, float, float, float], scale: float,
+                          title: str, marks: typing.Sequence[float] = ()) -> None:
+    """The undeformed (grey) and deformed (coloured by body) cells of :func:`body_cells`,
+    displacements multiplied by ``scale``, within ``window``; vertical lines at ``marks``
+    (e.g. Hertz's ±a). Call on rank 0."""
+    from matplotlib.collections import PolyCollection
+
+    plt = _pyplot()
+    X, U, body = cells
+    fig, ax = plt.subplots(figsize=(8, 4.8))
+    ax.add_collection(PolyCollection(list(X), facecolors="0.6", alpha=0.3, edgecolors="none",
+                                     label="undeformed"))
+    for tag, colour, name in ((1, "tab:blue", "body 1"), (2, "tab:orange", "body 2")):
+        mine = body == tag
+        if mine.any():
+            ax.add_collection(PolyCollection(list(X[mine] + scale * U[mine]), facecolors=colour,
+                                             alpha=0.35, edgecolors=colour, lw=0.15,
+                                             label=name))
+    for x in marks:
+        ax.axvline(x, color="k", ls=":", lw=0.8)
+    ax.set_xlim(window[0], window[1])
+    ax.set_ylim(window[2], window[3])
+    ax.set_aspect("equal")
+    ax.set_xlabel("x")
+    ax.set_ylabel("y")
+    ax.legend(loc="best", fontsize=8)
+    ax.set_title(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_contact_pressure(curves: typing.Sequence[tuple[np.ndarray, np.ndarray, str]],
+                          path: PathLike, xlabel: str, title: str,
+                          reference: tuple[np.ndarray, np.ndarray, str] | None = None,
+                          marks: typing.Sequence[float] = ()) -> None:
+    """Contact pressures (abscissa, pressure, label) against a closed form ``reference``
+    (drawn as a line), dotted verticals at ``marks``. Call on rank 0."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    if reference is not None:
+        ax.plot(*reference[:2], "k-", lw=1.2, label=reference[2])
+    for (x, p, label), marker in zip(curves, "os^vd", strict=False):
+        ax.plot(x, p, marker, ms=3.5, mfc="none", label=label)
+    for mark in marks:
+        ax.axvline(mark, color="k", ls=":", lw=0.8)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("contact pressure")
+    ax.set_title(title)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def plot_contact_traction(x: np.ndarray, tractions: typing.Sequence[tuple[np.ndarray, str]],
+                          mu_p: np.ndarray, grid: np.ndarray, exact: np.ndarray,
+                          mu_p_exact: np.ndarray, a: float, c: float, path: PathLike,
+                          title: str, window: float | None = None) -> None:
+    """Cattaneo-Mindlin: the tangential tractions (one per ε, label) and μ p at the nodes
+    ``x`` against the closed forms on ``grid``, ``exact`` and μ p_Hertz; the stick zone
+    |x| < c and the slip zones c < |x| < a of the closed form shaded. Call on rank 0."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(10, 4.5))
+    ax.axvspan(-c, c, color="tab:green", alpha=0.12, label=f"stick |x| < c = {c:.4g}")
+    for lo, hi in ((-a, -c), (c, a)):
+        ax.axvspan(lo, hi, color="tab:red", alpha=0.10,
+                   label="slip c < |x| < a" if lo < 0 else None)
+    ax.plot(grid, mu_p_exact, "k--", lw=1.0, label="μ p (Hertz)")
+    ax.plot(grid, exact, "k-", lw=1.2, label="q (Cattaneo-Mindlin)")
+    ax.plot(x, mu_p, "x", ms=4, color="tab:gray", label="μ p (computed)")
+    for (q, label), marker in zip(tractions, "os^vd", strict=False):
+        ax.plot(x, q, marker, ms=3.5, mfc="none", label=label)
+    half = window if window is not None else 1.5 * a
+    ax.set_xlim(-half, half)
+    ax.set_xlabel("x")
+    ax.set_ylabel("tangential traction")
+    ax.set_title(title)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
     plt.close(fig)

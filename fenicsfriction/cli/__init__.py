@@ -1,11 +1,12 @@
 """Command line: ``fenicsfriction steady block --mu-max 1.5 --steps 30 --out DIR``.
 
 One module per family of commands: :mod:`~fenicsfriction.cli.block` (the finite element block:
-``steady``, ``stability``, ``dynamics``) and :mod:`~fenicsfriction.cli.oscillators` (the reduced
-oscillators: ``stability-map``, ``oscillator``); :mod:`~fenicsfriction.cli.common` holds what they
-share. The flags are in :mod:`~fenicsfriction.cli.arguments`, which imports nothing heavy: the
-command's module (MPI, PETSc, dolfinx) is imported after the flags parse, so ``--help`` and a
-flag error answer at once.
+``steady``, ``stability``, ``dynamics``), :mod:`~fenicsfriction.cli.oscillators` (the reduced
+oscillators: ``stability-map``, ``oscillator``) and :mod:`~fenicsfriction.cli.contact` (two
+elastic bodies in contact: ``contact hertz|patch|cattaneo``); :mod:`~fenicsfriction.cli.common`
+holds what they share. The flags are in :mod:`~fenicsfriction.cli.arguments`, which imports
+nothing heavy: the command's module (MPI, PETSc, dolfinx) is imported after the flags parse,
+so ``--help`` and a flag error answer at once.
 
 User errors (a bad flag or parameter value, an unwritable ``--out``) print one line and exit
 with status 2; a solver failure writes what converged, prints one line and exits with
@@ -19,7 +20,12 @@ import importlib
 import logging
 import sys
 
-from fenicsfriction.cli.arguments import Parser, add_block_parsers, add_oscillator_parsers
+from fenicsfriction.cli.arguments import (
+    Parser,
+    add_block_parsers,
+    add_contact_parsers,
+    add_oscillator_parsers,
+)
 
 __all__ = ["main"]
 
@@ -27,7 +33,8 @@ __all__ = ["main"]
 COMMANDS = {"steady": ("block", "run_steady"), "stability": ("block", "run_stability"),
             "dynamics": ("block", "run_dynamics"),
             "stability-map": ("oscillators", "run_stability_map"),
-            "oscillator": ("oscillators", "run_oscillator")}
+            "oscillator": ("oscillators", "run_oscillator"),
+            "contact": ("contact", "run_contact")}
 
 
 def _parser() -> Parser:
@@ -35,6 +42,7 @@ def _parser() -> Parser:
     commands = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
     add_block_parsers(commands)
     add_oscillator_parsers(commands)
+    add_contact_parsers(commands)
     return parser
 
 

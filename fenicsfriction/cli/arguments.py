@@ -13,8 +13,8 @@ import importlib
 import pathlib
 import typing
 
-__all__ = ["SLAB_FLAGS", "LazyChoices", "Parser", "add_block_parsers", "add_oscillator_parsers",
-           "floats", "omega_range"]
+__all__ = ["SLAB_FLAGS", "LazyChoices", "Parser", "add_block_parsers", "add_contact_parsers",
+           "add_oscillator_parsers", "floats", "omega_range"]
 
 
 class Parser(argparse.ArgumentParser):
@@ -213,3 +213,76 @@ def add_oscillator_parsers(commands: typing.Any) -> None:
     belt.add_argument("--x0", type=float, default=0.0, help="initial displacement (0)")
     belt.add_argument("--v0", type=float,
                       help="initial velocity (the belt's: the mass starts stuck to the belt)")
+
+
+def _bodies_flags() -> argparse.ArgumentParser:
+    """The two bodies and their interface law, shared by the contact scenes (None: the scene's
+    defaults, given in the help)."""
+    flags = Parser(add_help=False)
+    group = flags.add_argument_group("the two bodies and the interface law")
+    for flag, text in (("--E1", "body 1's Young's modulus (1)"),
+                       ("--nu1", "body 1's Poisson's ratio (0.3)"),
+                       ("--E2", "body 2's Young's modulus (1)"),
+                       ("--nu2", "body 2's Poisson's ratio (0.3)"),
+                       ("--c-n", "normal compliance coefficient: p = c_n d^m_n (1e4)"),
+                       ("--m-n", "normal compliance exponent, >= 1 (1: a linear penalty)")):
+        group.add_argument(flag, type=float, dest=flag[2:].replace("-", "_"), help=text)
+    flags.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    return flags
+
+
+def _hertz_flags(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--load", type=float,
+                        help="P per unit length (2D) or the total force F (3D); default: the "
+                             "load giving a = R/10")
+    parser.add_argument("--radius", type=float, help="R of the cylinder or sphere (1)")
+    parser.add_argument("--refine", type=int,
+                        help="mesh refinement level: each halves the element size (0: 0.005 R "
+                             "at the contact)")
+
+
+def add_contact_parsers(commands: typing.Any) -> None:
+    """``contact hertz|patch|cattaneo``: the two-body validation scenes."""
+    contact = commands.add_parser(
+        "contact", help="two elastic bodies in node-to-segment contact, against closed forms",
+        description="Validation scenes of two-body contact: Hertz (2D cylinder, 3D sphere), "
+                    "the contact patch test and Cattaneo-Mindlin's partial slip; each writes "
+                    "contact.json, surface.csv, figures and bodies.xdmf to --out. PETSc "
+                    "options as -contact_<option> after the flags.")
+    scenes = contact.add_subparsers(dest="scene", required=True, parser_class=Parser)
+    bodies = _bodies_flags()
+    hertz = scenes.add_parser(
+        "hertz", parents=[bodies], help="cylinder (2D) or sphere (3D) on a block, vs Hertz",
+        description="A cylinder (plane strain) or a quarter sphere pressed on an elastic "
+                    "block to the load --load: contact half-width (radius) and peak pressure "
+                    "against Hertz's.")
+    hertz.add_argument("--dim", type=int, choices=[2, 3], default=2, help="2 or 3 (2)")
+    _hertz_flags(hertz)
+    hertz.add_argument("--passes", type=int, choices=[1, 2], default=1,
+                       help="1: the cylinder's surface is the slave; 2: each surface in turn")
+    patch = scenes.add_parser(
+        "patch", parents=[bodies], help="the contact patch test (non-matching meshes)",
+        description="Two stacked blocks with non-matching meshes under a uniform pressure "
+                    "must transmit it uniformly (Taylor & Papadopoulos 1991).")
+    patch.add_argument("--dim", type=int, choices=[2, 3], default=2, help="2 or 3 (2)")
+    patch.add_argument("--passes", choices=["1", "2", "both"], default="both",
+                       help="one pass, two passes, or both side by side (both)")
+    patch.add_argument("--pressure", type=float, help="the pressure applied (0.01)")
+    patch.add_argument("--n-upper", type=int, help="elements across the upper block (5)")
+    patch.add_argument("--n-lower", type=int, help="elements across the lower block (7)")
+    cattaneo = scenes.add_parser(
+        "cattaneo", parents=[bodies], help="partial slip under a tangential force (2D)",
+        description="The 2D Hertz cylinder with friction, then a tangential force rising to "
+                    "Q = q μP in increments (Pop 1997's incremental formulation): stick zone "
+                    "and tangential traction against Cattaneo (1938) and Mindlin (1949).")
+    _hertz_flags(cattaneo)
+    cattaneo.add_argument("--passes", type=int, choices=[1, 2], default=1,
+                          help="1: the cylinder's surface is the slave; 2: each in turn")
+    cattaneo.add_argument("--mu", type=float, help="friction coefficient (0.3)")
+    cattaneo.add_argument("--q-ratio", type=float, help="Q/(μP) reached, in [0, 1) (0.5)")
+    cattaneo.add_argument("--increments", type=int, help="increments of Q (10)")
+    cattaneo.add_argument("--eps", type=float,
+                          help="regularisation of the slip increment [length] (1e-6)")
+    cattaneo.add_argument("--eps-sequence", type=floats, metavar="E1,E2,...",
+                          help="Kalker's sequential process: the tangential loading again for "
+                               "each ε (replaces --eps)")

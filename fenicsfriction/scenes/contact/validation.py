@@ -58,7 +58,7 @@ class _Bodies:
     passes: int = 1
 
     def __post_init__(self) -> None:
-        self.materials  # noqa: B018  (validates E, nu)
+        self.E_star  # noqa: B018  (validates E1, nu1, E2, nu2, naming each)
         check("c_n", self.c_n, self.c_n > 0, "the normal compliance coefficient must be > 0")
         check("m_n", self.m_n, self.m_n >= 1, "the normal exponent must be >= 1")
         check("passes", self.passes, self.passes in (1, 2), "1 or 2")
@@ -168,6 +168,9 @@ class Patch(_Bodies):
         super().__post_init__()
         check("dim", self.dim, self.dim in (2, 3), "2 or 3")
         check("pressure", self.pressure, self.pressure > 0, "the pressure must be > 0")
+        for name in ("n_upper", "n_lower"):
+            value = getattr(self, name)
+            check(name, value, isinstance(value, int) and value >= 1, "an integer >= 1")
 
     def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
         mesh = (geometry.patch_2d if self.dim == 2 else geometry.patch_3d)(
@@ -246,22 +249,31 @@ class Cattaneo(Hertz):
         return (float(np.ptp(x[stick]) / 2) if stick.any() else 0.0,
                 float(np.ptp(x[contact]) / 2) if contact.any() else 0.0)
 
-    def run(self, comm: MPI.Comm = MPI.COMM_WORLD, model: TwoBodyModel | None = None,
-            on_increment: typing.Callable[[dict], None] | None = None
-            ) -> tuple[dict, TwoBodyModel]:
-        """Normal load, then Q in increments; the summary adds ``q_ratio``,
-        ``stick_half_width`` (and Cattaneo's), the traction error and one row per
-        increment."""
-        t0 = time.perf_counter()
+    def load_normal(self, comm: MPI.Comm = MPI.COMM_WORLD, model: TwoBodyModel | None = None
+                    ) -> tuple[dict, TwoBodyModel]:
+        """The normal load P alone (:meth:`Hertz.run`), under a wide regularisation: identical
+        bodies do not slip under it (Johnson 1985, section 5.4), and the friction only holds the
+        cylinder's sliding mode. Returns Hertz's summary and the model."""
         model = model or self.build(comm)
+        a, _ = self.closed_form()
+        model.eps.value = NORMAL_LOADING_EPS * a
+        model.eps_T.value = self.E_star / self.radius  # the perturbed Lagrangian's: a soft spring
+        return Hertz.run(self, comm, model)
+
+    def load_tangential(self, model: TwoBodyModel, eps: float | None = None,
+                        on_increment: typing.Callable[[dict], None] | None = None) -> dict:
+        """Q from 0 to ``q_ratio`` μP in :attr:`increments` steps under the regularisation
+        ``eps`` (default :attr:`eps`), from the model's current (normally loaded) state.
+
+        Returns ``eps``, ``stick_half_width`` (and Cattaneo's), ``traction_error_l2`` (the
+        relative L2 error of the final tangential traction against Cattaneo-Mindlin's),
+        ``newton_iterations`` (all increments) and ``increments`` (one row per increment).
+        """
+        eps = self.eps if eps is None else eps
+        check("eps", eps, eps > 0, "the regularisation must be > 0")
         assert self.load is not None
         a, p0 = self.closed_form()
-        # the normal load with a wide regularisation: identical bodies do not slip under it
-        # (Johnson 1985, section 5.4), and the friction only holds the cylinder's sliding mode
-        model.eps.value = NORMAL_LOADING_EPS * a
-        model.eps_T.value = self.E_star / self.radius  # a soft stick spring, for the same
-        summary, model = Hertz.run(self, comm, model)
-        model.eps.value = self.eps
+        model.eps.value = eps
         model.eps_T.value = self.eps_T
         rows = []
         for k in range(1, self.increments + 1):
@@ -280,20 +292,72 @@ class Cattaneo(Hertz):
             if on_increment is not None:
                 on_increment(row)
         values = model.surface_values()
-        x = values.x[:, 0]
-        exact = closed_forms.cattaneo_traction(x, a, p0, self.mu, self.q_ratio)
+        exact = closed_forms.cattaneo_traction(values.x[:, 0], a, p0, self.mu, self.q_ratio)
         # the traction on the cylinder opposes Q: its x component is -q(x)
         error = float(np.sqrt(np.sum(values.weight * (-values.traction[:, 0] - exact) ** 2)
                               / np.sum(values.weight * exact**2)))
+        return {"eps": eps, "stick_half_width": rows[-1]["stick_half_width"],
+                "cattaneo_stick_half_width": rows[-1]["cattaneo_stick_half_width"],
+                "traction_error_l2": error,
+                "newton_iterations": sum(r["newton_iterations"] for r in rows),
+                "increments": rows}
+
+    def _summary(self, normal: dict, tangential: dict, t0: float) -> dict:
+        summary = dict(normal)
         summary.update({
-            "scene": "cattaneo", "q_ratio": self.q_ratio, "mu": self.mu, "eps": self.eps,
-            "formulation": self.formulation,
-            "stick_half_width": rows[-1]["stick_half_width"],
-            "cattaneo_stick_half_width": rows[-1]["cattaneo_stick_half_width"],
-            "traction_error_l2": error, "increments": rows,
-            "newton_iterations": summary["newton_iterations"]
-            + sum(r["newton_iterations"] for r in rows),
+            "scene": "cattaneo", "q_ratio": self.q_ratio, "mu": self.mu,
+            "formulation": self.formulation, "eps": tangential["eps"], "stick_half_width": tangential["stick_half_width"],
+            "cattaneo_stick_half_width": tangential["cattaneo_stick_half_width"],
+            "traction_error_l2": tangential["traction_error_l2"],
+            "increments": tangential["increments"],
+            "newton_iterations": normal["newton_iterations"] + tangential["newton_iterations"],
             "wall_time_s": time.perf_counter() - t0})
-        summary["parameters"].update({"mu": self.mu, "eps": self.eps,
-                                      "formulation": self.formulation, "eps_T": self.eps_T})
+        summary["parameters"] = {**normal["parameters"], "mu": self.mu, "eps": self.eps,
+                                 "increments": self.increments,
+                                 "formulation": self.formulation, "eps_T": self.eps_T}
+        return summary
+
+    def run(self, comm: MPI.Comm = MPI.COMM_WORLD, model: TwoBodyModel | None = None,
+            on_increment: typing.Callable[[dict], None] | None = None
+            ) -> tuple[dict, TwoBodyModel]:
+        """Normal load, then Q in increments; the summary adds ``q_ratio``,
+        ``stick_half_width`` (and Cattaneo's), the traction error and one row per
+        increment."""
+        t0 = time.perf_counter()
+        normal, model = self.load_normal(comm, model)
+        tangential = self.load_tangential(model, on_increment=on_increment)
+        return self._summary(normal, tangential, t0), model
+
+    def run_sequence(self, eps_values: typing.Sequence[float], comm: MPI.Comm = MPI.COMM_WORLD,
+                     model: TwoBodyModel | None = None,
+                     on_increment: typing.Callable[[dict], None] | None = None
+                     ) -> tuple[dict, TwoBodyModel]:
+        """Kalker's sequential process: the tangential loading for each ε of ``eps_values``
+        in turn, each from the same normally loaded state (the normal solve is done once; the
+        friction law's history is the loading path, so each ε reruns the whole path, Newton
+        starting every increment from the last increment of the same ε).
+
+        The summary is :meth:`run`'s for the last ε, with ``eps_sequence``: one entry per ε
+        (see :meth:`load_tangential`). ``on_increment`` receives each row with its ``eps``.
+        """
+        check("eps_sequence", list(eps_values), len(eps_values) >= 1, "at least one value")
+        for eps in eps_values:
+            check("eps_sequence", list(eps_values), eps > 0, "every ε must be > 0")
+        t0 = time.perf_counter()
+        normal, model = self.load_normal(comm, model)
+        loaded = model.u.x.array.copy()
+        multipliers = [c.traction_old.x.array.copy() for c in model.contacts]
+        sequence = []
+        for eps in eps_values:
+            model.u.x.array[:] = loaded
+            for contact, values in zip(model.contacts, multipliers, strict=True):
+                contact.traction_old.x.array[:] = values
+            model.shear.value = np.zeros(2)
+            callback = None if on_increment is None else (
+                lambda row, eps=eps: on_increment({"eps": eps, **row}))
+            sequence.append(self.load_tangential(model, eps, on_increment=callback))
+        summary = self._summary(normal, sequence[-1], t0)
+        summary["newton_iterations"] = normal["newton_iterations"] + sum(
+            s["newton_iterations"] for s in sequence)
+        summary["eps_sequence"] = sequence
         return summary, model
