@@ -306,7 +306,8 @@ class Cattaneo(Hertz):
         summary = dict(normal)
         summary.update({
             "scene": "cattaneo", "q_ratio": self.q_ratio, "mu": self.mu,
-            "formulation": self.formulation, "eps": tangential["eps"], "stick_half_width": tangential["stick_half_width"],
+            "formulation": self.formulation, "eps": tangential["eps"],
+            "stick_half_width": tangential["stick_half_width"],
             "cattaneo_stick_half_width": tangential["cattaneo_stick_half_width"],
             "traction_error_l2": tangential["traction_error_l2"],
             "increments": tangential["increments"],
