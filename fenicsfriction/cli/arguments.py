@@ -286,3 +286,10 @@ def add_contact_parsers(commands: typing.Any) -> None:
     cattaneo.add_argument("--eps-sequence", type=floats, metavar="E1,E2,...",
                           help="Kalker's sequential process: the tangential loading again for "
                                "each ε (replaces --eps)")
+    cattaneo.add_argument("--formulation", choices=["compliance", "perturbed-lagrangian"],
+                          help="the contact law: normal compliance with regularised friction, "
+                               "or Pop's perturbed Lagrangian (penalties c_n and --eps-T) "
+                               "(compliance)")
+    cattaneo.add_argument("--eps-T", dest="eps_T", type=float,
+                          help="tangential penalty of the perturbed Lagrangian "
+                               "[force/length^3] (1e4)")

@@ -82,12 +82,15 @@ class Hertz(_Bodies):
         load: P [force/length] in 2D, F [force] in 3D; ``None``: the load giving a = R/10.
         radius: R [length].
         refine: the mesh's refinement level (each halves the element size).
+        h_contact: the element size at the contact before refinement (``None``: the
+            geometry's default, R/200 in 2D and R/50 in 3D).
     """
 
     dim: int = 2
     load: float | None = None
     radius: float = 1.0
     refine: int = 0
+    h_contact: float | None = None
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -110,7 +113,7 @@ class Hertz(_Bodies):
 
     def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
         mesh = (geometry.hertz_2d if self.dim == 2 else geometry.hertz_3d)(
-            comm, R=self.radius, refine=self.refine)
+            comm, R=self.radius, refine=self.refine, h_contact=self.h_contact)
         # the 2D cylinder's sliding is stopped at its loaded face; the quarter sphere's by the
         # symmetry planes
         return TwoBodyModel(mesh, self.materials, self.c_n, self.m_n, passes=self.passes,
@@ -233,7 +236,8 @@ class Cattaneo(Hertz):
         check("eps", self.eps, self.eps > 0, "the regularisation must be > 0")
 
     def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
-        mesh = geometry.hertz_2d(comm, R=self.radius, refine=self.refine)
+        mesh = geometry.hertz_2d(comm, R=self.radius, refine=self.refine,
+                                 h_contact=self.h_contact)
         return TwoBodyModel(mesh, self.materials, self.c_n, self.m_n, mu=self.mu,
                             eps=self.eps, passes=self.passes, formulation=self.formulation,
                             eps_T=self.eps_T)
