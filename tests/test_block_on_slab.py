@@ -1,5 +1,5 @@
 r"""The block of Martins & Oden (1986) on an elastic slab (two-body node-to-segment contact,
-Pop 1997): the stiff-slab limit is the block on a rigid belt, the distributed solve the serial
+Pop): the stiff-slab limit is the block on a rigid belt, the distributed solve the serial
 one, and the time integration grows at the rate of the unstable eigenvalue.
 
 The one-body reference is the same discretisation on a rigid belt: Q1 elements and the nodal

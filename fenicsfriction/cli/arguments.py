@@ -273,7 +273,7 @@ def add_contact_parsers(commands: typing.Any) -> None:
     cattaneo = scenes.add_parser(
         "cattaneo", parents=[bodies], help="partial slip under a tangential force (2D)",
         description="The 2D Hertz cylinder with friction, then a tangential force rising to "
-                    "Q = q μP in increments (Pop 1997's incremental formulation): stick zone "
+                    "Q = q μP in increments (Pop's incremental formulation): stick zone "
                     "and tangential traction against Cattaneo (1938) and Mindlin (1949).")
     _hertz_flags(cattaneo)
     cattaneo.add_argument("--passes", type=int, choices=[1, 2], default=1,

@@ -1,5 +1,5 @@
-"""Two deformable bodies in frictional contact (Pop 1997): node-to-segment contact elements
-carrying the interface law of Martins & Oden (1987) between a slave surface and a master one,
+"""Two deformable bodies in frictional contact (Pop): node-to-segment contact elements
+carrying the interface law of Martins & Oden (1986) between a slave surface and a master one,
 in the same residual as the bulk terms (:mod:`fenicsfriction.forms`); the gmsh geometries of
 the two-body scenes (:mod:`fenicsfriction.contact.geometry`)."""
 

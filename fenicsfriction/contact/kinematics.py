@@ -2,14 +2,14 @@ r"""Node-to-segment kinematics as UFL expressions of the current nodal positions
 
 A slave point :math:`x_s` is paired with a master facet, a segment (2D, nodes
 :math:`x_1, x_2`) or a triangle (3D, :math:`x_1, x_2, x_3`), whose nodes are ordered so that
-the facet normal points out of the master body (Pop 1997, eq. 28):
+the facet normal points out of the master body (Pop, eq. 28):
 
 .. math::
     n = \frac{(x_2 - x_1)^\perp}{|x_2 - x_1|}\ (2D), \qquad
     n = \frac{(x_2 - x_1)\times(x_3 - x_1)}{|(x_2 - x_1)\times(x_3 - x_1)|}\ (3D).
 
 The closest point :math:`x_m = \sum_a N_a(\xi) x_a` has the surface coordinates of the
-projection (Pop 1997, eq. 29), :math:`\xi = A^{-1} [\tau_\alpha\cdot(x_s - x_1)]` with the
+projection (Pop, eq. 29), :math:`\xi = A^{-1} [\tau_\alpha\cdot(x_s - x_1)]` with the
 tangents :math:`\tau_\alpha = x_{\alpha+1} - x_1` and the metric
 :math:`A_{\alpha\beta} = \tau_\alpha\cdot\tau_\beta`; the normal gap is
 :math:`g = (x_s - x_1)\cdot n`, positive while the slave point is outside the master body.

@@ -1,6 +1,6 @@
 r"""The interface law between two deformable bodies: node-to-segment contact elements.
 
-Pop (1997) puts the law of Martins & Oden (1987) — normal compliance, normal damping,
+Pop puts the law of Martins & Oden (1986) — normal compliance, normal damping,
 regularised friction — between a slave node :math:`s` and its closest point on the master
 surface, in contact elements of one slave node and the two (2D) or three (3D) nodes of the
 master facet. With the projection of :mod:`fenicsfriction.contact.kinematics`
@@ -50,7 +50,7 @@ from fenicsfriction.contact.pairing import Pairing, facet_nodes
 __all__ = ["FORMULATIONS", "ContactOperator", "NodeToSegment", "solve_with_search"]
 
 #: the contact laws: ``"compliance"`` (normal compliance, friction regularised on the slip
-#: rate: Martins & Oden 1987) and ``"perturbed-lagrangian"`` (Pop 1997, eq. 27: normal and
+#: rate: Martins & Oden 1986) and ``"perturbed-lagrangian"`` (Pop, eq. 27: normal and
 #: tangential penalties ε_N = c_n, ε_T with their multipliers eliminated node by node)
 FORMULATIONS = ("compliance", "perturbed-lagrangian")
 
@@ -221,7 +221,7 @@ class NodeToSegment:
 
     def _stick_penalty(self, d: typing.Any, slip: typing.Any, n: typing.Any, c_T: Value,
                        m_T: Value, eps_T: Value) -> typing.Any:
-        """The tangential multiplier of the perturbed Lagrangian (Pop 1997, eq. 27), eliminated
+        """The tangential multiplier of the perturbed Lagrangian (Pop, eq. 27), eliminated
         node by node: a stick spring of stiffness ε_T on the slip increment from the last
         committed multiplier, returned to the Coulomb bound c_T d^{m_T} when it would exceed
         it (slide)."""

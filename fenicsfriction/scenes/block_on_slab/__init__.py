@@ -1,5 +1,5 @@
 """The block of Martins & Oden (1986) on an elastic slab (a deformable belt), in two-body
-node-to-segment contact (Pop 1997): its data (dolfinx-free) and the finite element model,
+node-to-segment contact (Pop): its data (dolfinx-free) and the finite element model,
 which loads dolfinx on first use."""
 
 from __future__ import annotations

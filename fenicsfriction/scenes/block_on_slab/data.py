@@ -3,8 +3,8 @@ r"""The block of Martins & Oden (1986) on an elastic belt: its data.
 The block, its interface law, its weight and its driver spring are those of
 :class:`~fenicsfriction.scenes.block.BlockOnBelt` (every field kept and validated alike); the
 rigid belt is replaced by a deformable slab, a second body in the same mesh, and the contact
-between them is two-body node-to-segment contact (Pop 1997) carrying the same law of
-Martins & Oden (1987): the block's bottom is the slave surface, the slab's top the master.
+between them is two-body node-to-segment contact (Pop) carrying the same law of
+Martins & Oden (1986): the block's bottom is the slave surface, the slab's top the master.
 
 Modelling choices, changeable through the fields where they are numbers:
 

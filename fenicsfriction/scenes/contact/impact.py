@@ -5,7 +5,7 @@ cylinder's flat top pushes it from rest into the block, about whose static Hertz
 oscillates (a suddenly applied load: the approach overshoots to about twice the static one).
 From ``drag_start`` a tangential traction Q = ``q_ratio`` μP pulls the top: above μP the
 cylinder slides, and when the traction is released (``drag_end``) the contact passes from
-slide to stick, where the regularised friction's slope is steepest (Pop 1997's remark: the
+slide to stick, where the regularised friction's slope is steepest (Pop's remark: the
 step is cut back until Newton converges, PETSc TS's rejection of a failed step).
 
 The energy balance closes the run: kinetic + elastic + stored in the compliance − work of the

@@ -5,7 +5,7 @@ its own Hooke's law; the interface law acts between the slave surface (body 1) a
 surface (body 2) through node-to-segment contact (:class:`fenicsfriction.contact.NodeToSegment`),
 optionally in two passes (each surface slave in turn, each pass with weight 1/2).
 
-Friction in a quasi-static scene follows Pop (1997)'s incremental formulation: the slave
+Friction in a quasi-static scene follows Pop's incremental formulation: the slave
 velocity of the regularised law is the increment :math:`(u - u_{old})/\Delta t` of a pseudo time
 step (``dt``, 1 by default, so ε is a slip increment), and each load increment is one Newton
 solve started from the last.

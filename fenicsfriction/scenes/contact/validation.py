@@ -7,7 +7,7 @@ r"""The validation scenes of two-body contact, each against its closed form.
 * :class:`Patch` — two blocks with non-matching meshes under a uniform pressure must transmit
   it uniformly (Taylor & Papadopoulos 1991's contact patch test), one pass or two.
 * :class:`Cattaneo` — the 2D cylinder, then a tangential force rising to Q = q μP in
-  increments (Pop 1997's incremental formulation): the stick zone and the tangential traction
+  increments (Pop's incremental formulation): the stick zone and the tangential traction
   against Cattaneo-Mindlin's, with Kalker's sequential ε → 0.
 
 Units are the user's (consistent); the defaults are dimensionless: R = 1, E = 1, and the load
@@ -213,10 +213,10 @@ class Cattaneo(Hertz):
         mu: friction coefficient.
         q_ratio: Q / (μ P), in [0, 1).
         increments: load increments of Q (the quasi-static path; the stick zone only shrinks).
-        eps: the regularisation of the slip increment [length] (c1: Pop 1997, eq. 15); a
+        eps: the regularisation of the slip increment [length] (c1: Pop, eq. 15); a
             sequence ε_k → 0 is Kalker's sequential process.
         formulation: ``"compliance"`` (the regularised law) or ``"perturbed-lagrangian"``
-            (Pop 1997, eq. 27: penalties ε_N = ``c_n`` and ε_T = ``eps_T`` [force/length³]).
+            (Pop, eq. 27: penalties ε_N = ``c_n`` and ε_T = ``eps_T`` [force/length³]).
     """
 
     mu: float = 0.3
