@@ -54,7 +54,7 @@ def test_hertz_2d_matches_hertz_and_writes_its_outputs(shared_tmp_path):
     assert summary["ranks"] == MPI.COMM_WORLD.size
     assert {"radius", "E1", "nu1", "E2", "nu2", "c_n", "m_n", "refine",
             "passes"} <= set(summary["parameters"])
-    # the default load is the one giving Hertz's a = R/10 (Johnson 1985, eq. 4.43), reached to
+    # the default load is the one giving Hertz's a = R/10 (Johnson 1985, chapter 4), reached to
     # the search's 1e-5
     E_star = closed_forms.effective_modulus(1.0, 0.3, 1.0, 0.3)
     P = 0.1**2 * np.pi * E_star / 4

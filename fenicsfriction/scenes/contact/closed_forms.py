@@ -27,7 +27,7 @@ def effective_modulus(E1: float, nu1: float, E2: float, nu2: float) -> float:
 
 
 def hertz_line_contact(load: float, radius: float, E_star: float) -> tuple[float, float]:
-    """Cylinder on a flat, plane strain (Johnson 1985, eqs. 4.43-4.45): the half-width
+    """Cylinder on a flat, plane strain (Johnson 1985, chapter 4): the half-width
     :math:`a = \\sqrt{4 P R / (\\pi E^*)}` and peak pressure :math:`p_0 = 2 P / (\\pi a)` under
     the load ``load`` = P per unit length."""
     check("load", load, load > 0, "the load must be > 0")
@@ -37,7 +37,7 @@ def hertz_line_contact(load: float, radius: float, E_star: float) -> tuple[float
 
 
 def hertz_point_contact(load: float, radius: float, E_star: float) -> tuple[float, float]:
-    """Sphere on a flat (Johnson 1985, eqs. 4.22-4.23): contact radius
+    """Sphere on a flat (Johnson 1985, chapter 4): contact radius
     :math:`a = (3 F R / (4 E^*))^{1/3}` and peak pressure :math:`p_0 = 3 F / (2 \\pi a^2)`
     under the total force ``load`` = F."""
     check("load", load, load > 0, "the load must be > 0")
@@ -53,14 +53,14 @@ def hertz_pressure(r: np.ndarray, a: float, p0: float) -> np.ndarray:
 
 def cattaneo_stick_half_width(a: float, q_ratio: float) -> float:
     """Stick half-width :math:`c = a\\sqrt{1 - Q/(\\mu P)}` under a tangential force Q rising
-    monotonically to ``q_ratio`` = Q/(μP) < 1 (Johnson 1985, eq. 7.28)."""
+    monotonically to ``q_ratio`` = Q/(μP) < 1 (Johnson 1985, chapter 7)."""
     check("q_ratio", q_ratio, 0 <= q_ratio < 1, "Q/(mu P) must be in [0, 1)")
     return a * math.sqrt(1 - q_ratio)
 
 
 def cattaneo_traction(x: np.ndarray, a: float, p0: float, mu: float,
                       q_ratio: float) -> np.ndarray:
-    """Tangential traction of the cylinders (Johnson 1985, eqs. 7.26-7.27): μ p(x) in the slip
+    """Tangential traction of the cylinders (Johnson 1985, chapter 7): μ p(x) in the slip
     zones c ≤ |x| ≤ a, minus :math:`\\mu p_0 (c/a)\\sqrt{1 - x^2/c^2}` in the stick zone."""
     c = cattaneo_stick_half_width(a, q_ratio)
     q = mu * hertz_pressure(x, a, p0)
