@@ -256,8 +256,9 @@ class Cattaneo(Hertz):
     def load_normal(self, comm: MPI.Comm = MPI.COMM_WORLD, model: TwoBodyModel | None = None
                     ) -> tuple[dict, TwoBodyModel]:
         """The normal load P alone (:meth:`Hertz.run`), under a wide regularisation: identical
-        bodies (Dundurs' β = 0) do not slip under it (Johnson 1985, chapter 5), and the friction only holds the
-        cylinder's sliding mode. Returns Hertz's summary and the model."""
+        bodies (Dundurs' β = 0) do not slip under it (Johnson 1985, chapter 5), and the
+        friction only holds the cylinder's sliding mode. Returns Hertz's summary and the
+        model."""
         model = model or self.build(comm)
         a, _ = self.closed_form()
         model.eps.value = NORMAL_LOADING_EPS * a
