@@ -275,6 +275,8 @@ class SteadySolver:
 
     def solve(self) -> SolveReport:
         """Solve from the current ``u``; on failure restore ``u`` and raise :class:`SolveError`."""
+        for coupling in self.couplings:  # the contact pairing, searched at the first residual
+            coupling.contact.search_pending = True
         u_vec = _compat.petsc_vec(self.u)
         u_vec.copy(self.x)
         saved = u_vec.copy()

@@ -297,14 +297,23 @@ class NodeToSegment:
 
 def _derivative(form: ufl.Form, pairs: list[tuple[fem.Function, Value]],
                 space: fem.FunctionSpace, at_rest: dict) -> ufl.Form | None:
-    """Σ weight · ∂form/∂field (trial functions of ``space``) with ``at_rest`` substituted
-    after differentiating, or None if it vanishes."""
+    """Σ weight · ∂form/∂field (trial functions of ``space``) at ``at_rest``, or None if it
+    vanishes. A field that ``at_rest`` sets to zero is differentiated first (u̇ for C);
+    the others after the substitution, which commutes with them and which UFL handles better
+    before differentiation (replacing inside an expanded derivative can leave a sum whose
+    terms disagree on their arguments)."""
     trial = ufl.TrialFunction(space)
-    terms = [weight * ufl.derivative(form, f, trial) for f, weight in pairs
-             if f in form.coefficients()]
+    rested = _substitute(form, at_rest)
+    terms = []
+    for f, weight in pairs:
+        if f in at_rest:
+            derivative = ufl.algorithms.expand_derivatives(ufl.derivative(form, f, trial))
+            terms.append(weight * _substitute(derivative, at_rest))
+        elif f in rested.coefficients():
+            terms.append(weight * ufl.derivative(rested, f, trial))
     if not terms:
         return None
-    total = _substitute(ufl.algorithms.expand_derivatives(sum(terms[1:], terms[0])), at_rest)
+    total = ufl.algorithms.expand_derivatives(sum(terms[1:], terms[0]))
     return None if total.empty() else total
 
 
