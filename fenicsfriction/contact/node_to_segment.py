@@ -196,13 +196,22 @@ class NodeToSegment:
 def _derivative(form: ufl.Form, pairs: list[tuple[fem.Function, Value]],
                 space: fem.FunctionSpace, at_rest: dict) -> ufl.Form | None:
     """Σ weight · ∂form/∂field (trial functions of ``space``) with ``at_rest`` substituted
-    after differentiating, or None if it vanishes."""
+    after differentiating, or None if it vanishes.
+
+    The fields at rest that are not differentiated are substituted before: the same form, but
+    zeroing a velocity inside the derivative of the c1 friction direction (a UFL conditional)
+    can leave a sum of a term with the trial function and one without, which UFL refuses
+    (an ArityMismatch: the block on a moving elastic slab in steady sliding)."""
     trial = ufl.TrialFunction(space)
+    differentiated = {f for f, _ in pairs}
+    before = {f: z for f, z in at_rest.items() if f not in differentiated}
+    after = {f: z for f, z in at_rest.items() if f in differentiated}
+    form = _substitute(form, before)
     terms = [weight * ufl.derivative(form, f, trial) for f, weight in pairs
              if f in form.coefficients()]
     if not terms:
         return None
-    total = _substitute(ufl.algorithms.expand_derivatives(sum(terms[1:], terms[0])), at_rest)
+    total = _substitute(ufl.algorithms.expand_derivatives(sum(terms[1:], terms[0])), after)
     return None if total.empty() else total
 
 
