@@ -143,7 +143,11 @@ class SlabModel(BlockModel):
             u, self.facet_tags, slave=CONTACT, master=SLAB_TOP, c_n=self.c_n, m_n=self.m_n,
             c_T=self.friction_c_T if self.with_friction else 0.0, m_T=self.m_T, b_n=law.b_n,
             l_n=law.l_n, eps=self.eps, regularisation=law.regularisation, velocity=u_dot,
-            fields=[u_dot], transport=self.belt_velocity, weight=float(self.thickness.value))
+            fields=[u_dot], transport=self.belt_velocity, weight=float(self.thickness.value),
+            # searched at every residual, as this scene was built and verified with: its
+            # solvers (steady, stability, dynamics) do not go through solve_with_search,
+            # so with the default search='solve' the pairing would never be searched again
+            search="residual")
         self.ds_contact = self.contact.ds
         return slab, [self.contact]
 
