@@ -38,6 +38,7 @@
 # parallel: `mpirun -n 2 python3 demos/demo_two_body_contact.py`.
 
 # %%
+import itertools
 import logging
 import os
 import pathlib
@@ -259,9 +260,11 @@ if comm.rank == 0:
 # (we allow 2 % of $c$ more on each side for the regularisation and the compliance). It
 # shrinks monotonically with $Q$. The contact forces must carry $Q$ exactly, to the
 # solver's tolerance (1e-6 relative; 1e-10 is measured). The tangential tractions alone carry
-# 1 % more: a tangential traction also displaces the surfaces normally, equally on identical
-# bodies, so the gap stays but the normal tilts and the pressure takes a share of $Q$ along
-# it — a geometric effect that the half-space theory leaves out. The tractions' L2 distance from the closed form (8.8 % here, 7.2 % at $h = a/20$) comes from the two kinks
+# 1 % more. Our reading, not checked further: a tangential traction also displaces the
+# surfaces normally — alike on identical bodies, so the gap stays — which tilts the normal,
+# and the pressure takes a share of $Q$ along it, a geometric effect that the half-space
+# theory leaves out. The tractions' L2 distance
+# from the closed form (8.8 % here, 7.2 % at $h = a/20$) comes from the two kinks
 # of $q(x)$ at $|x| = c$ and $|x| = a$, each placed only to within an element; we assert 15 %.
 
 # %%
@@ -269,7 +272,8 @@ rows = summary_c["increments"]
 for row in rows:
     c_h, c = row["stick_half_width"], row["cattaneo_stick_half_width"]
     assert 0.98 * c - H_CONTACT <= c_h <= 1.02 * c, row
-assert all(r1["stick_half_width"] <= r0["stick_half_width"] for r0, r1 in zip(rows, rows[1:]))
+assert all(r1["stick_half_width"] <= r0["stick_half_width"]
+           for r0, r1 in itertools.pairwise(rows))
 assert abs(carried / Q - 1) < 1e-6
 assert summary_c["traction_error_l2"] < 0.15
 
