@@ -28,8 +28,8 @@ keep the pairing), and fitting time ∝ facets^α.
 
 Writes ``bench_contact.json`` and ``bench_contact.png`` to ``--out`` and prints markdown
 tables to stdout (progress on stderr). Rank 0 writes and prints; run serially or with
-``mpirun -n 2``. About 6 minutes serially with the defaults (the 2D level 2 mesh, 544 000
-unknowns, takes 4.5 of them); ``--refine-3d 0,1`` adds the 3D level 1 mesh (see
+``mpirun -n 2``. About 10 minutes serially with the defaults (the 2D level 2 mesh, 544 000
+unknowns, takes 4 of them); ``--refine-3d 0,1`` adds the 3D level 1 mesh (see
 docs/benchmarks.md for its cost).
 """
 
