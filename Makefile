@@ -68,6 +68,7 @@ benchmark: setup
 	$(PY) benchmarks/bench_scaling.py --out $(OUT)/benchmarks
 	$(MPIRUN) $(PY) benchmarks/bench_scaling.py --out $(OUT)/benchmarks
 	$(PY) benchmarks/bench_getfem.py --out $(OUT)/benchmarks
+	$(PY) benchmarks/bench_contact.py --out $(OUT)/benchmarks
 
 clean:
 	rm -rf .venv .venv-debian13 results *.egg-info

@@ -5,10 +5,11 @@ from fenicsfriction.scenes.contact.closed_forms import (
     cattaneo_stick_half_width,
     cattaneo_traction,
     effective_modulus,
+    fit_hertz_pressure,
     hertz_line_contact,
     hertz_point_contact,
     hertz_pressure,
 )
 
 __all__ = ["cattaneo_stick_half_width", "cattaneo_traction", "effective_modulus",
-           "hertz_line_contact", "hertz_point_contact", "hertz_pressure"]
+           "fit_hertz_pressure", "hertz_line_contact", "hertz_point_contact", "hertz_pressure"]

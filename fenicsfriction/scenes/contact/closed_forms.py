@@ -14,7 +14,7 @@ import numpy as np
 from fenicsfriction.laws import check
 
 __all__ = ["cattaneo_stick_half_width", "cattaneo_traction", "effective_modulus",
-           "hertz_line_contact", "hertz_point_contact", "hertz_pressure"]
+           "fit_hertz_pressure", "hertz_line_contact", "hertz_point_contact", "hertz_pressure"]
 
 
 def effective_modulus(E1: float, nu1: float, E2: float, nu2: float) -> float:
@@ -49,6 +49,22 @@ def hertz_point_contact(load: float, radius: float, E_star: float) -> tuple[floa
 def hertz_pressure(r: np.ndarray, a: float, p0: float) -> np.ndarray:
     """:math:`p(r) = p_0\\sqrt{1 - r^2/a^2}` inside the contact, 0 outside."""
     return p0 * np.sqrt(np.clip(1 - (np.asarray(r) / a) ** 2, 0.0, None))
+
+
+def fit_hertz_pressure(r: np.ndarray, pressure: np.ndarray) -> tuple[float, float]:
+    """The half-width (radius) a and peak p_0 of the Hertz profile that fits nodal pressures.
+
+    :math:`p^2 = p_0^2 - (p_0/a)^2 r^2` is linear in :math:`r^2`: a least-squares line through
+    the points of ``pressure > 0`` gives both. Unlike the nodes where contact ends, which
+    place the edge only to within one element, the fit uses every contact node, so its error
+    is that of the pressures, not of where the nodes happen to fall.
+    """
+    r, pressure = np.asarray(r, dtype=float), np.asarray(pressure, dtype=float)
+    contact = pressure > 0
+    check("pressure", int(contact.sum()), contact.sum() >= 2, "at least two contact nodes")
+    slope, intercept = np.polyfit(r[contact] ** 2, pressure[contact] ** 2, 1)
+    check("pressure", slope, slope < 0 < intercept, "a profile falling from its peak")
+    return float(math.sqrt(-intercept / slope)), float(math.sqrt(intercept))
 
 
 def cattaneo_stick_half_width(a: float, q_ratio: float) -> float:
