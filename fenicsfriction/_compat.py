@@ -11,6 +11,7 @@ from __future__ import annotations
 import logging
 import math
 import typing
+import warnings
 
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -22,6 +23,7 @@ from dolfinx import fem, geometry, mesh
 
 __all__ = [
     "assemble_matrix_into",
+    "cell_dofs",
     "colliding_cells",
     "create_box",
     "create_mesh_from_arrays",
@@ -29,6 +31,7 @@ __all__ = [
     "evaluate_expression",
     "create_rectangle",
     "dg0_vector_space",
+    "element_degree",
     "interpolation_points",
     "jit_options",
     "lagrange_vector_space",
@@ -81,11 +84,27 @@ def nodal_quadrature(facet_dim: int) -> dict:
     """Integral metadata of the nodal (trapezoidal) rule on facets: the facet's vertices with
     equal weights. FFCx's ``"vertex"`` rule is for cell integrals only, so the points are given
     as a ``"custom"`` rule on the reference facet (an interval or a triangle)."""
-    logging.getLogger("UFL").addFilter(_QuietArrayMetadata())
+    logging.getLogger("UFL").addFilter(_QuietArrayMetadata())  # UFL 2022 logs it,
+    warnings.filterwarnings("ignore", message=".*metadata value of type ndarray")  # 2024 warns
     points = np.vstack([np.zeros(facet_dim), np.eye(facet_dim)])
     weights = np.full(facet_dim + 1, 1.0 / math.factorial(facet_dim) / (facet_dim + 1))
     return {"quadrature_rule": "custom", "quadrature_degree": 1,
             "quadrature_points": points, "quadrature_weights": weights}
+
+
+def cell_dofs(V: fem.FunctionSpace, cells: np.ndarray) -> np.ndarray:
+    """The (block) dofs of ``V`` on ``cells``: ``locate_dofs_topological`` on cells, which from
+    0.7 needs the cell-to-cell connectivity made first."""
+    tdim = V.mesh.topology.dim
+    V.mesh.topology.create_connectivity(tdim, tdim)
+    return fem.locate_dofs_topological(V, tdim, cells)
+
+
+def element_degree(V: fem.FunctionSpace) -> int:
+    """The polynomial degree of a space's element (a method of the UFL element up to 0.6, a
+    property of the Basix UFL element from 0.7)."""
+    degree = V.ufl_element().degree
+    return int(degree() if callable(degree) else degree)
 
 
 def petsc_vec(u: fem.Function) -> PETSc.Vec:

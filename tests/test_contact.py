@@ -94,7 +94,7 @@ def test_pairing_follows_finite_sliding():
     contact, u = _contact(2, friction=False, overlap=0.0)
     V = u.function_space
     cell_tags = contact.cell_tags
-    upper = fem.locate_dofs_topological(V, 2, cell_tags.indices[cell_tags.values == UPPER])
+    upper = _compat.cell_dofs(V, cell_tags.indices[cell_tags.values == UPPER])
     u.x.array[:] = 0.0
     u.x.array.reshape(-1, 2)[upper, 0] = 1.3 / 4
     u.x.scatter_forward()

@@ -115,7 +115,7 @@ class NodeToSegment:
         V = u.function_space
         msh = V.mesh
         dim = msh.geometry.dim
-        laws.check("V", V.ufl_element().degree(), V.ufl_element().degree() == 1,
+        laws.check("V", _compat.element_degree(V), _compat.element_degree(V) == 1,
                    "node-to-segment contact needs a degree-1 Lagrange displacement space")
         for name, tag in (("slave", slave), ("master", master)):
             count = msh.comm.allreduce(int(np.count_nonzero(facet_tags.values == tag)))

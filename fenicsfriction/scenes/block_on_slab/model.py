@@ -161,8 +161,7 @@ class SlabModel(BlockModel):
     def _slab_dofs(self) -> np.ndarray:
         """Local (unrolled) dofs of the slab's nodes."""
         assert self.cell_tags is not None
-        nodes = fem.locate_dofs_topological(self.V, self.msh.topology.dim,
-                                            self.cell_tags.find(SLAB))
+        nodes = _compat.cell_dofs(self.V, self.cell_tags.find(SLAB))
         return (nodes[:, None] * 2 + np.arange(2)).ravel()
 
     # --- the contact tractions (UFL, on the slave surface) ------------------------------------

@@ -173,8 +173,7 @@ class TwoBodyModel:
                                        bcs=self._bcs(fix_load_face, clamp),
                                        couplings=self.contacts)
         cells = cell_tags.indices[cell_tags.values == BODY1]
-        nodes = fem.locate_dofs_topological(
-            _compat.scalar_function_space(msh, "Lagrange", 1), dim, cells)
+        nodes = _compat.cell_dofs(_compat.scalar_function_space(msh, "Lagrange", 1), cells)
         self._body1_rows = nodes[nodes < V.dofmap.index_map.size_local]
         self._body1_dofs = nodes * dim + dim - 1  # their normal components (local, ghosts too)
 
