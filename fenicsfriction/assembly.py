@@ -16,7 +16,7 @@ from dolfinx import fem
 
 from fenicsfriction import _compat
 
-__all__ = ["assemble_coupled_jacobian", "assemble_jacobian", "assemble_residual"]
+__all__ = ["add_couplings", "assemble_jacobian", "assemble_residual"]
 
 
 def assemble_residual(b: PETSc.Vec, L: fem.FormMetaClass, a: fem.FormMetaClass, bcs: list,
@@ -71,17 +71,30 @@ def assemble_jacobian(A: PETSc.Mat, a: fem.FormMetaClass, bcs: list,
     A.assemble()
 
 
-def assemble_coupled_jacobian(A: PETSc.Mat, bulk: PETSc.Mat, a: fem.FormMetaClass, bcs: list,
-                              springs: typing.Sequence = (), couplings: typing.Sequence = (),
-                              diagonal: float = 1.0) -> None:
-    """A = dR/du with terms that couple distant dofs (two-body contact) added.
+def add_couplings(A: PETSc.Mat, base: PETSc.Mat, couplings: typing.Sequence, bcs: list,
+                  pattern: tuple | None) -> tuple[tuple, bool]:
+    """A = base + each coupling's Jacobian (``add_to_matrix``, Dirichlet rows and columns
+    zeroed) for terms that couple distant dofs (two-body contact).
 
-    ``bulk`` (created by dolfinx for ``a``) receives the integrals and springs, A their sum
-    with each coupling's ``add_to_matrix(A, bcs)``. A is a separate matrix because the
-    couplings' pattern (e.g. the contact pairing) changes from one call to the next and
-    dolfinx can assemble only into the pattern it created.
+    A is a matrix of its own because the couplings' nonzero pattern follows the contact
+    pairing and dolfinx assembles only into the pattern it created. ``pattern`` identifies
+    the couplings' pattern A was last built for (``None``: never); while it holds, the sums go
+    into A's existing pattern. When it changed, A's pattern is rebuilt (PETSc replaces its
+    storage) and the caller must reset the preconditioner that factorised A: PETSc 3.22 does
+    not see the new pattern by itself and would reuse the old symbolic factorisation.
+
+    Returns:
+        The pattern A now has and whether it was rebuilt.
     """
-    assemble_jacobian(bulk, a, bcs, springs, diagonal)
-    bulk.copy(A, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+    new = tuple(coupling.pattern for coupling in couplings)
+    structure = PETSc.Mat.Structure
+    if new == pattern:
+        A.zeroEntries()
+        A.axpy(1.0, base, structure=structure.SUBSET_NONZERO_PATTERN)
+        for coupling in couplings:
+            coupling.add_to_matrix(A, bcs, structure.SUBSET_NONZERO_PATTERN)
+        return new, False
+    base.copy(A, structure=structure.DIFFERENT_NONZERO_PATTERN)
     for coupling in couplings:
-        coupling.add_to_matrix(A, bcs)
+        coupling.add_to_matrix(A, bcs, structure.DIFFERENT_NONZERO_PATTERN)
+    return new, True

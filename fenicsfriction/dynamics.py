@@ -36,11 +36,7 @@ import ufl
 from dolfinx import fem
 
 from fenicsfriction import _compat
-from fenicsfriction.assembly import (
-    assemble_coupled_jacobian,
-    assemble_jacobian,
-    assemble_residual,
-)
+from fenicsfriction.assembly import add_couplings, assemble_jacobian, assemble_residual
 from fenicsfriction.forms import Residual
 from fenicsfriction.laws import check
 from fenicsfriction.timestepping import DEFAULT_OPTIONS, Alpha2Integrator, DynamicsError
@@ -95,6 +91,7 @@ class DynamicsSolver(Alpha2Integrator):
         self.couplings = [c.operator({residual.u: 1.0, residual.u_dot: self.shift_v})
                           for c in residual.couplings]
         self._uncoupled = self.A
+        self._pattern: tuple | None = None  # the couplings' pattern A has (add_couplings)
         if self.couplings:
             self.A = self._uncoupled.duplicate(copy=True)
         super().__init__(msh.comm, prefix, self.b, self.A, options, atol, predictor)
@@ -131,9 +128,10 @@ class DynamicsSolver(Alpha2Integrator):
             assemble_jacobian(target, self.a_varying, bcs,
                               base=self._bulk.matrix(shift_v, shift_a))
         if self.couplings:
-            target.copy(J, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-            for coupling in self.couplings:
-                coupling.add_to_matrix(J, bcs)
+            self._pattern, rebuilt = add_couplings(J, target, self.couplings, bcs,
+                                                   self._pattern)
+            if rebuilt:
+                ts.getSNES().getKSP().getPC().reset()
         self.convergence.jacobian_assembled(J)
 
 
@@ -288,10 +286,8 @@ class CentralDifference:
         if residual.couplings:
             coupled = K.duplicate()
             coupled.assemble()
-            assemble_coupled_jacobian(
-                coupled, K, a, residual.bcs, residual.springs,
-                [c.operator({residual.u: 1.0}, rest=[residual.u_dot])
-                 for c in residual.couplings])
+            add_couplings(coupled, K, [c.operator({residual.u: 1.0}, rest=[residual.u_dot])
+                                       for c in residual.couplings], residual.bcs, None)
             K.destroy()
             K = coupled
         inverse_mass = self.lumped.copy()

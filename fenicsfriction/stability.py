@@ -34,7 +34,7 @@ import numpy as np
 import scipy.optimize
 
 from fenicsfriction import _compat
-from fenicsfriction.assembly import assemble_jacobian
+from fenicsfriction.assembly import add_couplings, assemble_jacobian
 from fenicsfriction.forms import Residual
 from fenicsfriction.laws import check
 from fenicsfriction.numerics import bisect
@@ -121,6 +121,7 @@ class StabilitySolver:
             "K": [c.operator({u: 1.0}, rest=[u_dot]) for c in residual.couplings],
             "C": [c.operator({u_dot: 1.0}, rest=[u_dot]) for c in residual.couplings]}
         self._uncoupled = {}
+        self._patterns: dict[str, tuple | None] = {"K": None, "C": None}
         if residual.couplings:
             for name in ("K", "C"):
                 self._uncoupled[name] = getattr(self, name)
@@ -152,10 +153,11 @@ class StabilitySolver:
                 uncoupled.zeroEntries()
                 uncoupled.assemble()
             if name in self._uncoupled:
-                coupled = getattr(self, name)
-                uncoupled.copy(coupled, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-                for coupling in self._couplings[name]:
-                    coupling.add_to_matrix(coupled, bcs)
+                self._patterns[name], rebuilt = add_couplings(
+                    getattr(self, name), uncoupled, self._couplings[name], bcs,
+                    self._patterns[name])
+                if rebuilt:  # the spectral transformation's factorisation is set up anew
+                    self.pep.setOperators([self.K, self.C, self.M])
         self._norms = tuple(A.norm(PETSc.NormType.INFINITY) for A in (self.K, self.C, self.M))
 
     def _relative_residual(self, lam: complex, xr: PETSc.Vec, xi: PETSc.Vec) -> float:

@@ -35,11 +35,7 @@ import ufl
 from dolfinx import fem
 
 from fenicsfriction import _compat
-from fenicsfriction.assembly import (
-    assemble_coupled_jacobian,
-    assemble_jacobian,
-    assemble_residual,
-)
+from fenicsfriction.assembly import add_couplings, assemble_jacobian, assemble_residual
 from fenicsfriction.condensation import (
     InterfaceCondensation,
     condensation_for,
@@ -176,6 +172,7 @@ class SteadySolver:
         # integrals are assembled apart (dolfinx assembles only into its own pattern)
         self.couplings = [c.operator({self.u: 1.0}, rest=[residual.u_dot], jit_cache_dir=
                                      jit_cache_dir) for c in residual.couplings]
+        self._pattern: tuple | None = None  # the couplings' pattern A has (add_couplings)
         if self.couplings:
             self._uncoupled, self.A = self.A, self.A.duplicate()
             self.A.assemble()
@@ -267,8 +264,11 @@ class SteadySolver:
                 self.preconditioner.stale = True
             assemble_jacobian(A, self._a_interface, self.residual.bcs, base=self._bulk)
         elif self.couplings:
-            assemble_coupled_jacobian(A, self._uncoupled, self.a, self.residual.bcs,
-                                      self.residual.springs, self.couplings)
+            assemble_jacobian(self._uncoupled, self.a, self.residual.bcs, self.residual.springs)
+            self._pattern, rebuilt = add_couplings(A, self._uncoupled, self.couplings,
+                                                   self.residual.bcs, self._pattern)
+            if rebuilt:
+                snes.getKSP().getPC().reset()
         else:
             assemble_jacobian(A, self.a, self.residual.bcs, self.residual.springs)
         self.convergence.jacobian_assembled(A)

@@ -398,14 +398,21 @@ class ContactOperator:
             part.destroy()
         return J
 
-    def add_to_matrix(self, A: PETSc.Mat, bcs: typing.Sequence[fem.DirichletBC] = ()) -> None:
-        """``A += dR_c/du``; A's pattern grows to the contact's couplings, so A must not be a
-        matrix dolfinx assembles into (see
-        :func:`fenicsfriction.assembly.assemble_coupled_jacobian`)."""
+    @property
+    def pattern(self) -> int:
+        """Identifies this Jacobian's nonzero pattern: it changes with the pairing only."""
+        return self.contact.pairing.changes
+
+    def add_to_matrix(self, A: PETSc.Mat, bcs: typing.Sequence[fem.DirichletBC] = (),
+                      structure: typing.Any = None) -> None:
+        """``A += dR_c/du``. With ``DIFFERENT_NONZERO_PATTERN`` (the default) A's pattern
+        grows to the contact's couplings, so A must not be a matrix dolfinx assembles into
+        (see :func:`fenicsfriction.assembly.add_couplings`); ``SUBSET_NONZERO_PATTERN`` once
+        it has."""
         t0 = time.perf_counter()
         J = self.matrix(bcs)
         if J is not None:
-            A.axpy(1.0, J, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+            A.axpy(1.0, J, structure=structure or PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
             J.destroy()
         self.time_s["jacobian"] += time.perf_counter() - t0
 
