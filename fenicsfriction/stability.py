@@ -158,6 +158,7 @@ class StabilitySolver:
                     self._patterns[name])
                 if rebuilt:  # the spectral transformation's factorisation is set up anew
                     self.pep.setOperators([self.K, self.C, self.M])
+                    self.pep.getST().getKSP().getPC().reset()
         self._norms = tuple(A.norm(PETSc.NormType.INFINITY) for A in (self.K, self.C, self.M))
 
     def _relative_residual(self, lam: complex, xr: PETSc.Vec, xi: PETSc.Vec) -> float:
