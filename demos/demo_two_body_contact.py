@@ -18,7 +18,7 @@
 #
 # **The formulation.** Two bodies share one mesh without sharing nodes. Each node of the
 # slave surface is paired with the closest facet of the master surface, and a node-to-segment
-# element (Pop 1997) puts the interface law of Martins & Oden (1987) between the node and its
+# element (Pop) puts the interface law of Martins & Oden (1986) between the node and its
 # closest point: normal compliance $p = c_n d^{m_n}$ on the penetration $d = (-g)_+$, and
 # regularised Coulomb friction $|t_T| \le \mu p$ on the slip. The gap $g$, the normal and the
 # closest point are UFL expressions of the current nodal positions, so the residual and its
@@ -207,7 +207,7 @@ for dim in (2, 3):
 # ## 4. Cattaneo-Mindlin: a tangential force below the friction limit
 #
 # The same cylinder, now with friction ($\mu = 0.3$), is pushed sideways by a force $Q$ that
-# rises to $Q = \mu P/2$ in 5 increments, each one Newton solve of Pop (1997)'s incremental
+# rises to $Q = \mu P/2$ in 5 increments, each one Newton solve of Pop's incremental
 # problem (the slip velocity is the increment of displacement, regularised by
 # $\varepsilon = 10^{-6}$). The bodies are identical, so the normal pressure stays Hertz's
 # (Johnson 1985, section 5.4), and the contact splits into a central stick zone $|x| < c$ and
@@ -280,7 +280,7 @@ assert summary_c["traction_error_l2"] < 0.15
 # %% [markdown]
 # ## 5. The block on an elastic belt
 #
-# The elastic block of Martins & Oden (1987) slides on a belt; on a rigid belt its steady
+# The elastic block of Martins & Oden (1986) slides on a belt; on a rigid belt its steady
 # sliding loses stability to flutter at a friction coefficient $\mu_{crit}$ where two of its
 # modes (normal and rotational) coalesce. `BlockOnSlab` replaces the rigid belt by an elastic
 # slab in two-body contact with the block — the same node-to-segment elements as above — and
