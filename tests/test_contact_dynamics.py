@@ -31,32 +31,45 @@ def _static_penetration(scene: PressAndDrag) -> float:
 @pytest.mark.parametrize("scheme", ["alpha2", "central"])
 def test_pressing_the_cylinder_balances_energy_without_runaway(scheme):
     scene = PressAndDrag(mu=0.0, t_end=1.8, h_contact=H)
-    records, summary = scene.run(scheme=scheme, dt=0.05)
-    # generalized-α (ρ∞ = 0.8) dissipates the unresolved contact chatter, central differences
-    # are conservative to O(dt²): both within 1 % of the work done
+    # dt = 0.02 resolves the contact springs' period (~0.04 for a few nodes of c_n h): at
+    # 0.05 generalized-α damps them and the balance drifts by 20-50 % (docs/contact.md)
+    records, summary = scene.run(scheme=scheme, dt=0.02)
+    # measured 1e-4 (generalized-α, ρ∞ = 0.8) and 4e-3 (central differences, O(dt²))
     assert summary["energy_error"] < 1e-2, summary
     assert summary["max_penetration"] < 3 * _static_penetration(scene), summary
     assert records[-1]["contact_energy"] > 0  # the cylinder has landed
 
 
-def test_dragging_with_friction_cuts_steps_back_and_goes_on():
+def test_dragging_the_cylinder_with_friction_balances_energy():
     scene = PressAndDrag(mu=0.3, q_ratio=1.5, drag_start=1.5, drag_end=2.5, t_end=3.0,
                          h_contact=H)
+    records, summary = scene.run(scheme="alpha2", dt=0.02)
+    assert records[-1]["time"] == pytest.approx(scene.t_end)
+    assert records[-1]["dissipated"] > 0
+    assert summary["energy_error"] < 1e-2, summary  # measured 1.1e-4
+    assert summary["max_penetration"] < 3 * _static_penetration(scene), summary
+
+
+def test_stick_transitions_cut_the_step_back_and_the_run_goes_on():
+    """A narrow regularisation (ε = 1e-4) and a long step: Newton fails where nodes enter
+    stick, the step is cut back and grows again, and the run reaches its end with the balance
+    closed (measured 41 cut-backs, 0.1 %)."""
+    scene = PressAndDrag(mu=0.3, q_ratio=1.5, eps=1e-4, drag_start=1.5, drag_end=2.5,
+                         t_end=3.0, h_contact=H)
     records, summary = scene.run(scheme="alpha2", dt=0.05)
     assert records[-1]["time"] == pytest.approx(scene.t_end)
-    assert summary["rejected_steps"] > 0  # Newton failed at stick transitions and recovered
+    assert summary["rejected_steps"] > 0
     assert summary["energy_error"] < 1e-2, summary
-    assert records[-1]["dissipated"] > 0
     assert summary["max_penetration"] < 3 * _static_penetration(scene), summary
 
 
 @pytest.mark.mpi
 def test_two_ranks_integrate_the_serial_motion():
-    scene = PressAndDrag(mu=0.0, t_end=1.2, h_contact=H)
-    here, _ = scene.run(scheme="alpha2", dt=0.05, comm=MPI.COMM_WORLD)
-    alone, _ = scene.run(scheme="alpha2", dt=0.05, comm=MPI.COMM_SELF)
+    scene = PressAndDrag(mu=0.0, t_end=1.0, h_contact=H)
+    here, _ = scene.run(scheme="alpha2", dt=0.02, comm=MPI.COMM_WORLD)
+    alone, _ = scene.run(scheme="alpha2", dt=0.02, comm=MPI.COMM_SELF)
     for key in ("kinetic", "elastic", "contact_energy"):
         a = np.array([r[key] for r in here])
         b = np.array([r[key] for r in alone])
-        # Newton's tolerance 1e-10 P per step, accumulated over 24 steps
+        # Newton's tolerance 1e-10 P per step, accumulated over 50 steps
         assert np.allclose(a, b, rtol=1e-6, atol=1e-9 * np.abs(b).max()), key
