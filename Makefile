@@ -40,6 +40,7 @@ demo: setup
 	$(PY) -m fenicsfriction stability block --mu-max 1.55 --steps 62 --out $(OUT)/stability-block
 	FENICSFRICTION_DEMO_OUT=$(OUT)/stick-slip-block $(MPIRUN) $(PY) demos/demo_block_stick_slip.py
 	FENICSFRICTION_DEMO_OUT=$(OUT)/slider $(MPIRUN) $(PY) demos/demo_slider_table2.py
+	FENICSFRICTION_DEMO_OUT=$(OUT)/two_body_contact $(MPIRUN) $(PY) demos/demo_two_body_contact.py
 
 lint: setup
 	$(PY) -m ruff check .
