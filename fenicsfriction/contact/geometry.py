@@ -213,6 +213,25 @@ def _refine_near_origin(gmsh: typing.Any, h_contact: float, h_far: float, half_w
 
 # --- Hertz: a cylinder / sphere on a block -----------------------------------------------------
 
+def _hertz_sizes(R: float, block_half_width: float | None, block_height: float | None,
+                 h_contact: float | None, h_far: float | None,
+                 refine_half_width: float | None, refine: int, grading: float,
+                 defaults: tuple[float, float]) -> tuple[float, float, float, float, float]:
+    """The Hertz scenes' checked block size and mesh sizes (W, H, h_contact, h_far after
+    ``refine``, and the refined zone's half-width); ``defaults``: h_contact and the zone's
+    half-width per unit R."""
+    laws.check_positive("R", R)
+    W = _default(block_half_width, 4 * R)
+    H = _default(block_height, 4 * R)
+    laws.check("block_half_width", W, isinstance(W, numbers.Real) and W >= R,
+               f"must be >= R = {R}")
+    laws.check_positive("block_height", H)
+    h_c, h_f = _default(h_contact, defaults[0] * R), _default(h_far, 0.5 * R)
+    w = _default(refine_half_width, defaults[1] * R)
+    _check_sizes(R, h_c, h_f, w, refine, grading)
+    return W, H, h_c / 2**refine, h_f / 2**refine, w
+
+
 def hertz_2d(comm: MPI.Comm, R: float = 1.0, block_half_width: float | None = None,
              block_height: float | None = None, h_contact: float | None = None,
              h_far: float | None = None, refine_half_width: float | None = None,
@@ -246,16 +265,8 @@ def hertz_2d(comm: MPI.Comm, R: float = 1.0, block_half_width: float | None = No
         ValueError: A parameter is out of range (the message names it, its value, what is
             allowed).
     """
-    laws.check_positive("R", R)
-    W = _default(block_half_width, 4 * R)
-    H = _default(block_height, 4 * R)
-    laws.check("block_half_width", W, isinstance(W, numbers.Real) and W >= R,
-               f"must be >= R = {R}")
-    laws.check_positive("block_height", H)
-    h_c, h_f = _default(h_contact, 0.005 * R), _default(h_far, 0.5 * R)
-    w = _default(refine_half_width, 0.3 * R)
-    _check_sizes(R, h_c, h_f, w, refine, grading)
-    h_c, h_f = h_c / 2**refine, h_f / 2**refine
+    W, H, h_c, h_f, w = _hertz_sizes(R, block_half_width, block_height, h_contact, h_far,
+                                     refine_half_width, refine, grading, (0.005, 0.3))
 
     def construct(gmsh: typing.Any) -> None:
         occ = gmsh.model.occ
@@ -313,16 +324,8 @@ def hertz_3d(comm: MPI.Comm, R: float = 1.0, block_half_width: float | None = No
         ValueError: A parameter is out of range (the message names it, its value, what is
             allowed).
     """
-    laws.check_positive("R", R)
-    W = _default(block_half_width, 4 * R)
-    H = _default(block_height, 4 * R)
-    laws.check("block_half_width", W, isinstance(W, numbers.Real) and W >= R,
-               f"must be >= R = {R}")
-    laws.check_positive("block_height", H)
-    h_c, h_f = _default(h_contact, 0.02 * R), _default(h_far, 0.5 * R)
-    w = _default(refine_half_width, 0.25 * R)
-    _check_sizes(R, h_c, h_f, w, refine, grading)
-    h_c, h_f = h_c / 2**refine, h_f / 2**refine
+    W, H, h_c, h_f, w = _hertz_sizes(R, block_half_width, block_height, h_contact, h_far,
+                                     refine_half_width, refine, grading, (0.02, 0.25))
 
     def construct(gmsh: typing.Any) -> None:
         occ = gmsh.model.occ
