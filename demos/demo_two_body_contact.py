@@ -72,7 +72,7 @@ if comm.rank == 0:
 #
 # Two elastic cylinders of radii $R_1$, $R_2$ pressed together by a load $P$ per unit length
 # touch over a strip of half-width $a$ under an elliptical pressure (Hertz 1882; Johnson 1985,
-# eqs. 4.43-4.45); here $R_2 \to \infty$ (the block is flat):
+# chapter 4); here $R_2 \to \infty$ (the block is flat):
 #
 # $$ p(x) = p_0\sqrt{1 - x^2/a^2}, \qquad a = \sqrt{\frac{4PR}{\pi E^*}}, \qquad
 #    p_0 = \frac{2P}{\pi a}, \qquad \frac{1}{E^*} = \frac{1-\nu_1^2}{E_1}
@@ -211,7 +211,7 @@ for dim in (2, 3):
 # problem (the slip velocity is the increment of displacement, regularised by
 # $\varepsilon = 10^{-6}$). The bodies are identical, so the normal pressure stays Hertz's
 # (Johnson 1985, section 5.4), and the contact splits into a central stick zone $|x| < c$ and
-# two slip zones (Cattaneo 1938, Mindlin 1949; Johnson 1985, eqs. 7.26-7.28):
+# two slip zones (Cattaneo 1938, Mindlin 1949; Johnson 1985, chapter 7):
 #
 # $$ \frac{c}{a} = \sqrt{1 - \frac{Q}{\mu P}}, \qquad
 #    q(x) = \mu p_0\sqrt{1 - \frac{x^2}{a^2}} - \mu p_0\frac{c}{a}\sqrt{1 - \frac{x^2}{c^2}}
