@@ -45,6 +45,11 @@ _EXPORTS: dict[str, str] = {
     # scenes
     "BlockData": "scenes", "BlockOnBelt": "scenes", "BlockModel": "scenes",
     "BlockOnSlab": "scenes", "SlabModel": "scenes",
+    "Hertz": "scenes.contact.validation", "Patch": "scenes.contact.validation",
+    "Cattaneo": "scenes.contact.validation", "TwoBodyModel": "scenes.contact.model",
+    "PressAndDrag": "scenes.contact.impact",
+    # two-body contact
+    "NodeToSegment": "contact", "solve_with_search": "contact",
     "BlockQuantities": "scenes.block", "Energies": "scenes.block", "Powers": "scenes.block",
     "ContactStates": "scenes.block", "CentreOfMass": "scenes.block",
     "ProbeValues": "scenes.block",
@@ -58,8 +63,9 @@ _EXPORTS: dict[str, str] = {
     "FloquetStability": "reduced.slider", "StabilityMap": "reduced.slider",
 }
 
-_SUBMODULES = ("dynamics", "forms", "io", "laws", "numerics", "plotting", "reduced", "results",
-               "scenes", "signals", "stability", "statistics", "steady", "timestepping")
+_SUBMODULES = ("contact", "dynamics", "forms", "io", "laws", "numerics", "plotting", "reduced",
+               "results", "scenes", "signals", "stability", "statistics", "steady",
+               "timestepping")
 
 __getattr__, __dir__, __all__ = attach(__name__, _EXPORTS, _SUBMODULES)
 __all__.append("__version__")  # the same list __dir__ returns
@@ -82,6 +88,7 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers and IDEs
         steady,
         timestepping,
     )
+    from fenicsfriction.contact import NodeToSegment, solve_with_search
     from fenicsfriction.dynamics import CentralDifference, DynamicsSolver
     from fenicsfriction.forms import NodalSpring, Residual
     from fenicsfriction.laws import (
@@ -118,6 +125,9 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers and IDEs
         Powers,
         ProbeValues,
     )
+    from fenicsfriction.scenes.contact.impact import PressAndDrag
+    from fenicsfriction.scenes.contact.model import TwoBodyModel
+    from fenicsfriction.scenes.contact.validation import Cattaneo, Hertz, Patch
     from fenicsfriction.signals import Interrupted, StopSignals
     from fenicsfriction.stability import (
         EigenSolveError,
