@@ -16,7 +16,7 @@ from dolfinx import fem
 
 from fenicsfriction import _compat
 
-__all__ = ["add_couplings", "assemble_jacobian", "assemble_residual"]
+__all__ = ["CoupledMatrix", "assemble_jacobian", "assemble_residual"]
 
 
 def assemble_residual(b: PETSc.Vec, L: fem.FormMetaClass, a: fem.FormMetaClass, bcs: list,
@@ -71,30 +71,40 @@ def assemble_jacobian(A: PETSc.Mat, a: fem.FormMetaClass, bcs: list,
     A.assemble()
 
 
-def add_couplings(A: PETSc.Mat, base: PETSc.Mat, couplings: typing.Sequence, bcs: list,
-                  pattern: tuple | None) -> tuple[tuple, bool]:
+class CoupledMatrix:
     """A = base + each coupling's Jacobian (``add_to_matrix``, Dirichlet rows and columns
-    zeroed) for terms that couple distant dofs (two-body contact).
+    zeroed), for terms that couple distant dofs (two-body contact).
 
-    A is a matrix of its own because the couplings' nonzero pattern follows the contact
-    pairing and dolfinx assembles only into the pattern it created. ``pattern`` identifies
-    the couplings' pattern A was last built for (``None``: never); while it holds, the sums go
-    into A's existing pattern. When it changed, A's pattern is rebuilt (PETSc replaces its
+    ``base`` is the matrix dolfinx assembles the integrals (and springs) into; A is a matrix of
+    its own because the couplings' nonzero pattern follows the contact pairing and dolfinx
+    assembles only into the pattern it created. While the couplings' pattern holds, the sums go
+    into A's existing pattern; when it changed, A's pattern is rebuilt (PETSc replaces its
     storage) and the caller must reset the preconditioner that factorised A: PETSc 3.22 does
     not see the new pattern by itself and would reuse the old symbolic factorisation.
 
-    Returns:
-        The pattern A now has and whether it was rebuilt.
+    Attributes:
+        base: the matrix of the integrals.
+        A: the coupled matrix (the same object for the solver's whole life).
     """
-    new = tuple(coupling.pattern for coupling in couplings)
-    structure = PETSc.Mat.Structure
-    if new == pattern:
-        A.zeroEntries()
-        A.axpy(1.0, base, structure=structure.SUBSET_NONZERO_PATTERN)
+
+    def __init__(self, base: PETSc.Mat):
+        self.base = base
+        self.A = base.duplicate()
+        self.A.assemble()
+        self._pattern: tuple | None = None  # the couplings' pattern A was last built for
+
+    def assemble(self, couplings: typing.Sequence, bcs: list) -> bool:
+        """A = base + the couplings' Jacobians; True when A's pattern was rebuilt."""
+        pattern = tuple(coupling.pattern for coupling in couplings)
+        structure = PETSc.Mat.Structure
+        if pattern == self._pattern:
+            self.A.zeroEntries()
+            self.A.axpy(1.0, self.base, structure=structure.SUBSET_NONZERO_PATTERN)
+            for coupling in couplings:
+                coupling.add_to_matrix(self.A, bcs, structure.SUBSET_NONZERO_PATTERN)
+            return False
+        self.base.copy(self.A, structure=structure.DIFFERENT_NONZERO_PATTERN)
         for coupling in couplings:
-            coupling.add_to_matrix(A, bcs, structure.SUBSET_NONZERO_PATTERN)
-        return new, False
-    base.copy(A, structure=structure.DIFFERENT_NONZERO_PATTERN)
-    for coupling in couplings:
-        coupling.add_to_matrix(A, bcs, structure.DIFFERENT_NONZERO_PATTERN)
-    return new, True
+            coupling.add_to_matrix(self.A, bcs, structure.DIFFERENT_NONZERO_PATTERN)
+        self._pattern = pattern
+        return True

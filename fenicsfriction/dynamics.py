@@ -36,7 +36,7 @@ import ufl
 from dolfinx import fem
 
 from fenicsfriction import _compat
-from fenicsfriction.assembly import add_couplings, assemble_jacobian, assemble_residual
+from fenicsfriction.assembly import CoupledMatrix, assemble_jacobian, assemble_residual
 from fenicsfriction.forms import Residual
 from fenicsfriction.laws import check
 from fenicsfriction.timestepping import DEFAULT_OPTIONS, Alpha2Integrator, DynamicsError
@@ -90,10 +90,9 @@ class DynamicsSolver(Alpha2Integrator):
         # apart from the one dolfinx assembles into (their pattern follows the pairing)
         self.couplings = [c.operator({residual.u: 1.0, residual.u_dot: self.shift_v})
                           for c in residual.couplings]
-        self._uncoupled = self.A
-        self._pattern: tuple | None = None  # the couplings' pattern A has (add_couplings)
-        if self.couplings:
-            self.A = self._uncoupled.duplicate(copy=True)
+        self._coupled = CoupledMatrix(self.A) if self.couplings else None
+        if self._coupled is not None:
+            self.A = self._coupled.A
         super().__init__(msh.comm, prefix, self.b, self.A, options, atol, predictor)
         if self.couplings:  # the pairing is searched at each step's first residual
             self.ts.setPreStep(lambda ts: _search_due(self.couplings))
@@ -118,7 +117,7 @@ class DynamicsSolver(Alpha2Integrator):
         self.shift_v.value = shift_v
         self.shift_a.value = shift_a
         bcs = self.residual.bcs
-        target = self._uncoupled if self.couplings else J
+        target = J if self._coupled is None else self._coupled.base
         if self._bulk is None:
             assemble_jacobian(target, self.a, bcs, self.residual.springs)
         elif self.a_varying is None:
@@ -127,11 +126,8 @@ class DynamicsSolver(Alpha2Integrator):
         else:
             assemble_jacobian(target, self.a_varying, bcs,
                               base=self._bulk.matrix(shift_v, shift_a))
-        if self.couplings:
-            self._pattern, rebuilt = add_couplings(J, target, self.couplings, bcs,
-                                                   self._pattern)
-            if rebuilt:
-                ts.getSNES().getKSP().getPC().reset()
+        if self._coupled is not None and self._coupled.assemble(self.couplings, bcs):
+            ts.getSNES().getKSP().getPC().reset()
         self.convergence.jacobian_assembled(J)
 
 
@@ -278,18 +274,17 @@ class CentralDifference:
 
     def _stable_step(self, residual: Residual) -> float:
         """2 / ω_max with ω_max² the largest eigenvalue of K̄ w = ω² M_L w (contact couplings
-        included at the initial state: see ``contact_stiffness``)."""
+        included at the initial state; those that close later: ``stable_dt_contact``)."""
         from slepc4py import SLEPc
         a = _compat.form(residual.derivative(residual.at_rest(residual.form), residual.u))
         K = dolfinx.fem.petsc.create_matrix(a)
         assemble_jacobian(K, a, residual.bcs, residual.springs)
         if residual.couplings:
-            coupled = K.duplicate()
-            coupled.assemble()
-            add_couplings(coupled, K, [c.operator({residual.u: 1.0}, rest=[residual.u_dot])
-                                       for c in residual.couplings], residual.bcs, None)
+            coupled = CoupledMatrix(K)
+            coupled.assemble([c.operator({residual.u: 1.0}, rest=[residual.u_dot])
+                              for c in residual.couplings], residual.bcs)
             K.destroy()
-            K = coupled
+            K = coupled.A
         inverse_mass = self.lumped.copy()
         inverse_mass.reciprocal()
         K.diagonalScale(inverse_mass, None)  # M_L^{-1} K̄: same eigenvalues ω²

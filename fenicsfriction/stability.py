@@ -34,7 +34,7 @@ import numpy as np
 import scipy.optimize
 
 from fenicsfriction import _compat
-from fenicsfriction.assembly import add_couplings, assemble_jacobian
+from fenicsfriction.assembly import CoupledMatrix, assemble_jacobian
 from fenicsfriction.forms import Residual
 from fenicsfriction.laws import check
 from fenicsfriction.numerics import bisect
@@ -120,14 +120,10 @@ class StabilitySolver:
         self._couplings = {
             "K": [c.operator({u: 1.0}, rest=[u_dot]) for c in residual.couplings],
             "C": [c.operator({u_dot: 1.0}, rest=[u_dot]) for c in residual.couplings]}
-        self._uncoupled = {}
-        self._patterns: dict[str, tuple | None] = {"K": None, "C": None}
-        if residual.couplings:
-            for name in ("K", "C"):
-                self._uncoupled[name] = getattr(self, name)
-                coupled = self._uncoupled[name].duplicate()
-                coupled.assemble()
-                setattr(self, name, coupled)
+        self._coupled = {name: CoupledMatrix(getattr(self, name))
+                         for name in ("K", "C") if residual.couplings}
+        for name, coupled in self._coupled.items():
+            setattr(self, name, coupled.A)
         self.pep = SLEPc.PEP().create(self.comm)
         self.pep.setOptionsPrefix(prefix)
         self.pep.setOperators([self.K, self.C, self.M])
@@ -146,19 +142,17 @@ class StabilitySolver:
         bcs = self.residual.bcs
         assemble_jacobian(self.M, self._forms["M"], bcs, (), 0.0)
         for name, springs, diagonal in (("K", self.residual.springs, 1.0), ("C", (), 0.0)):
-            uncoupled = self._uncoupled.get(name, getattr(self, name))
+            coupled = self._coupled.get(name)
+            integrals = getattr(self, name) if coupled is None else coupled.base
             if self._forms[name] is not None:
-                assemble_jacobian(uncoupled, self._forms[name], bcs, springs, diagonal)
+                assemble_jacobian(integrals, self._forms[name], bcs, springs, diagonal)
             else:
-                uncoupled.zeroEntries()
-                uncoupled.assemble()
-            if name in self._uncoupled:
-                self._patterns[name], rebuilt = add_couplings(
-                    getattr(self, name), uncoupled, self._couplings[name], bcs,
-                    self._patterns[name])
-                if rebuilt:  # the spectral transformation's factorisation is set up anew
-                    self.pep.setOperators([self.K, self.C, self.M])
-                    self.pep.getST().getKSP().getPC().reset()
+                integrals.zeroEntries()
+                integrals.assemble()
+            if coupled is not None and coupled.assemble(self._couplings[name], bcs):
+                # the spectral transformation's factorisation is set up anew
+                self.pep.setOperators([self.K, self.C, self.M])
+                self.pep.getST().getKSP().getPC().reset()
         self._norms = tuple(A.norm(PETSc.NormType.INFINITY) for A in (self.K, self.C, self.M))
 
     def _relative_residual(self, lam: complex, xr: PETSc.Vec, xi: PETSc.Vec) -> float:

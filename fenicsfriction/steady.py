@@ -35,7 +35,7 @@ import ufl
 from dolfinx import fem
 
 from fenicsfriction import _compat
-from fenicsfriction.assembly import add_couplings, assemble_jacobian, assemble_residual
+from fenicsfriction.assembly import CoupledMatrix, assemble_jacobian, assemble_residual
 from fenicsfriction.condensation import (
     InterfaceCondensation,
     condensation_for,
@@ -172,10 +172,9 @@ class SteadySolver:
         # integrals are assembled apart (dolfinx assembles only into its own pattern)
         self.couplings = [c.operator({self.u: 1.0}, rest=[residual.u_dot], jit_cache_dir=
                                      jit_cache_dir) for c in residual.couplings]
-        self._pattern: tuple | None = None  # the couplings' pattern A has (add_couplings)
-        if self.couplings:
-            self._uncoupled, self.A = self.A, self.A.duplicate()
-            self.A.assemble()
+        self._coupled = CoupledMatrix(self.A) if self.couplings else None
+        if self._coupled is not None:
+            self.A = self._coupled.A
         comm = self.u.function_space.mesh.comm
         split = (None if linear_solver == "lu" or self.couplings
                  else interface_split(jacobian, self.u))
@@ -263,11 +262,10 @@ class SteadySolver:
                 assert self.preconditioner is not None
                 self.preconditioner.stale = True
             assemble_jacobian(A, self._a_interface, self.residual.bcs, base=self._bulk)
-        elif self.couplings:
-            assemble_jacobian(self._uncoupled, self.a, self.residual.bcs, self.residual.springs)
-            self._pattern, rebuilt = add_couplings(A, self._uncoupled, self.couplings,
-                                                   self.residual.bcs, self._pattern)
-            if rebuilt:
+        elif self._coupled is not None:
+            assemble_jacobian(self._coupled.base, self.a, self.residual.bcs,
+                              self.residual.springs)
+            if self._coupled.assemble(self.couplings, self.residual.bcs):
                 snes.getKSP().getPC().reset()
         else:
             assemble_jacobian(A, self.a, self.residual.bcs, self.residual.springs)

@@ -324,9 +324,9 @@ def _substitute(form: ufl.Form, mapping: dict) -> ufl.Form:
 class ContactOperator:
     """A :class:`NodeToSegment`'s residual ``F + Q^T G`` and Jacobian, compiled.
 
-    It is called by :func:`fenicsfriction.assembly.assemble_residual` and
-    :func:`~fenicsfriction.assembly.assemble_jacobian` (``couplings=``): the residual searches
-    the pairing at the current state, the Jacobian chains the four blocks through ``Q``.
+    It is called by :func:`fenicsfriction.assembly.assemble_residual` (``couplings=``) and
+    :class:`~fenicsfriction.assembly.CoupledMatrix`: the residual searches the pairing at the
+    current state when a search is due, the Jacobian chains the four blocks through ``Q``.
     """
 
     def __init__(self, contact: NodeToSegment, derivatives: dict[fem.Function, Value],
@@ -407,7 +407,7 @@ class ContactOperator:
                       structure: typing.Any = None) -> None:
         """``A += dR_c/du``. With ``DIFFERENT_NONZERO_PATTERN`` (the default) A's pattern
         grows to the contact's couplings, so A must not be a matrix dolfinx assembles into
-        (see :func:`fenicsfriction.assembly.add_couplings`); ``SUBSET_NONZERO_PATTERN`` once
+        (see :class:`fenicsfriction.assembly.CoupledMatrix`); ``SUBSET_NONZERO_PATTERN`` once
         it has."""
         t0 = time.perf_counter()
         J = self.matrix(bcs)
@@ -435,7 +435,8 @@ def solve_with_search(solver: typing.Any, contacts: typing.Sequence[NodeToSegmen
     the pairing it was solved with (a fixed point of the contact search).
 
     Args:
-        solver: a solver whose ``solve()`` returns a report (e.g. ``SteadySolver``).
+        solver: a solver whose ``solve()`` returns a report and searches the pairing at its
+            first residual (``SteadySolver``).
         contacts: the couplings of its residual.
         max_rounds: how many solves may be tried.
 
@@ -448,8 +449,6 @@ def solve_with_search(solver: typing.Any, contacts: typing.Sequence[NodeToSegmen
     """
     iterations = 0
     for rounds in range(1, max_rounds + 1):
-        for contact in contacts:
-            contact.search_pending = True
         report = solver.solve()
         iterations += report.iterations
         changed = [contact.pairing.search(contact.u) for contact in contacts]
