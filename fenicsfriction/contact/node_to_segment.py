@@ -33,6 +33,7 @@ residual evaluation (finite sliding); ``frozen=True`` keeps it (for derivative t
 
 from __future__ import annotations
 
+import functools
 import time
 import typing
 
@@ -47,7 +48,8 @@ from fenicsfriction import _compat, laws
 from fenicsfriction.contact.kinematics import Projection, project
 from fenicsfriction.contact.pairing import Pairing, facet_nodes
 
-__all__ = ["FORMULATIONS", "ContactOperator", "NodeToSegment", "solve_with_search"]
+__all__ = ["FORMULATIONS", "ContactOperator", "NodalValues", "NodeToSegment",
+           "solve_with_search"]
 
 #: the contact laws: ``"compliance"`` (normal compliance, friction regularised on the slip
 #: rate: Martins & Oden 1986) and ``"perturbed-lagrangian"`` (Pop, eq. 27: normal and
@@ -196,6 +198,21 @@ class NodeToSegment:
                 dissipated = dissipated - ufl.dot(self.traction, w)
         self.dissipation = weight * dissipated * self.ds
 
+    @functools.cached_property
+    def nodal_space(self) -> fem.FunctionSpace:
+        """Scalar degree-1 Lagrange functions on the mesh: one value per node."""
+        return _compat.scalar_function_space(self.V.mesh, "Lagrange", 1)
+
+    @functools.cached_property
+    def nodal_weights(self) -> np.ndarray:
+        """Each owned node's tributary length (2D) or area (3D) on the slave surface, 0 off
+        it: the nodal rule's integral of the node's hat function."""
+        return _assemble_owned(_compat.form(ufl.TestFunction(self.nodal_space) * self.ds))
+
+    def nodal_values(self, expressions: typing.Sequence[typing.Any]) -> NodalValues:
+        """The values of UFL scalars at the slave nodes (compiled once, evaluated on call)."""
+        return NodalValues(self, expressions)
+
     def frequency_bound(self, lumped_mass: PETSc.Vec) -> float:
         """An upper bound of the contact springs' frequency² on the lumped mass, for linear
         compliance (m_n = 1, the stiffness c_n per unit length/area whatever the
@@ -203,13 +220,9 @@ class NodeToSegment:
         lighter than the lightest node of either surface, ω² <= 2 max k_i / min m."""
         laws.check("m_n", self.m_n, self.m_n == 1,
                    "a penetration-independent bound exists for m_n = 1 only")
-        S = _compat.scalar_function_space(self.V.mesh, "Lagrange", 1)
-        area = dolfinx.fem.petsc.assemble_vector(
-            _compat.form(ufl.TestFunction(S) * self.ds))
-        area.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         slave = self.pairing.slave_nodes
-        stiffness = float(self.weight * float(self.c_n) * area.array_r[slave].max(initial=0.0))
-        area.destroy()
+        stiffness = float(self.weight * float(self.c_n)
+                          * self.nodal_weights[slave].max(initial=0.0))
         d = self.dim
         masses = lumped_mass.array_r.reshape(-1, d)
         surfaces = np.concatenate([slave, self.pairing.master_facets.ravel()])
@@ -237,19 +250,15 @@ class NodeToSegment:
         if self.formulation != "perturbed-lagrangian" or self.traction is None:
             return
         self.update(search=False)
-        S = _compat.scalar_function_space(self.V.mesh, "Lagrange", 1)
-        q = ufl.TestFunction(S)
-        values = []
-        for form in [q * self.ds] + [self.traction[k] * q * self.ds for k in range(self.dim)]:
-            vec = dolfinx.fem.petsc.assemble_vector(_compat.form(form))
-            vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-            values.append(vec.array_r.copy())
-            vec.destroy()
-        weight, nodal = values[0], np.column_stack(values[1:])
-        owned = self.traction_old.x.array.reshape(-1, self.dim)[:len(weight)]
-        slave = weight > 0
-        owned[slave] = nodal[slave] / weight[slave, None]
+        nodal = self._committed_traction()
+        slave = self.nodal_weights > 0
+        self.traction_old.x.array.reshape(-1, self.dim)[:len(slave)][slave] = nodal[slave]
         self.traction_old.x.scatter_forward()
+
+    @functools.cached_property
+    def _committed_traction(self) -> NodalValues:
+        assert self.traction is not None
+        return self.nodal_values([self.traction[k] for k in range(self.dim)])
 
     def _node(self, packed: typing.Any, a: int) -> typing.Any:
         """The vector of master node ``a`` in a packed W quantity."""
@@ -415,6 +424,37 @@ class ContactOperator:
             A.axpy(1.0, J, structure=structure or PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
             J.destroy()
         self.time_s["jacobian"] += time.perf_counter() - t0
+
+
+class NodalValues:
+    """UFL scalars at the slave nodes of a :class:`NodeToSegment`: each one's integral against
+    the nodes' hat functions with the nodal rule, over the node's tributary weight — the exact
+    nodal value, the rule's points being the nodes. The forms are compiled once.
+
+    Calling it returns an array (owned nodes, expressions), zero off the slave surface.
+    """
+
+    def __init__(self, contact: NodeToSegment, expressions: typing.Sequence[typing.Any]):
+        self.contact = contact
+        q = ufl.TestFunction(contact.nodal_space)
+        self.forms = [_compat.form(e * q * contact.ds) for e in expressions]
+
+    def __call__(self) -> np.ndarray:
+        weights = self.contact.nodal_weights
+        values = np.zeros((len(weights), len(self.forms)))
+        slave = weights > 0
+        for k, form in enumerate(self.forms):
+            values[slave, k] = _assemble_owned(form)[slave] / weights[slave]
+        return values
+
+
+def _assemble_owned(form: typing.Any) -> np.ndarray:
+    """A linear form's assembled vector, its owned entries (contributions of ghosts added)."""
+    vector = dolfinx.fem.petsc.assemble_vector(form)
+    vector.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    values = vector.array_r.copy()
+    vector.destroy()
+    return values
 
 
 def _constrained_rows(V: fem.FunctionSpace, bcs: typing.Sequence[fem.DirichletBC]) -> np.ndarray:

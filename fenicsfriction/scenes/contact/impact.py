@@ -20,9 +20,7 @@ import math
 import typing
 
 from mpi4py import MPI
-from petsc4py import PETSc
 
-import dolfinx.fem.petsc
 import numpy as np
 import ufl
 
@@ -165,17 +163,6 @@ class _EnergyBalance:
         self.contact = [(_compat.form(c.potential),
                          _compat.form(c.dissipation) if c.relative_velocity is not None
                          else None) for c in model.contacts]
-        # the nodal gap of the first pass: its integral with the nodal rule over the weights
-        S = _compat.scalar_function_space(model.geometry.mesh, "Lagrange", 1)
-        q = ufl.TestFunction(S)
-        contact = model.contacts[0]
-        self.gap_form = _compat.form(contact.projection.gap * q * contact.ds)
-        weights = dolfinx.fem.petsc.assemble_vector(_compat.form(q * contact.ds))
-        weights.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        self.slave = weights.array_r > 0
-        self.weights = weights.array_r[self.slave].copy()
-        self.gap = weights.duplicate()
-        weights.destroy()
         self.last: tuple[float, float] | None = None  # t, dissipated power
         self.work = 0.0
         self.dissipated = 0.0
@@ -185,8 +172,8 @@ class _EnergyBalance:
         return self.model.comm.allreduce(fem.assemble_scalar(form))
 
     def record(self, t: float) -> dict:
-        for contact in self.model.contacts:
-            contact.update()
+        for contact in self.model.contacts:  # the pairing the step was solved with
+            contact.update(search=not contact.searched)
         values = {k: self._scalar(f) for k, f in self.forms.items()}
         stored = sum(self._scalar(p) for p, _ in self.contact)
         dissipation = sum(self._scalar(d) for _, d in self.contact if d is not None)
@@ -196,13 +183,8 @@ class _EnergyBalance:
             self.dissipated += 0.5 * (t - t0) * (d0 + dissipation)
         self.last = (t, dissipation)
         self.u_previous.x.array[:] = self.model.u.x.array
-        with self.gap.localForm() as local:
-            local.set(0.0)
-        dolfinx.fem.petsc.assemble_vector(self.gap, self.gap_form)
-        self.gap.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        gaps = self.gap.array_r[self.slave] / self.weights
-        penetration = self.model.comm.allreduce(-min(0.0, float(gaps.min(initial=0.0))),
-                                                op=MPI.MAX)
+        penetration = self.model.comm.allreduce(
+            -min(0.0, float(self.model.nodal_gap().min(initial=0.0))), op=MPI.MAX)
         total = values["kinetic"] + values["elastic"] + stored
         return {"kinetic": values["kinetic"], "elastic": values["elastic"],
                 "contact_energy": stored, "work": self.work, "dissipated": self.dissipated,

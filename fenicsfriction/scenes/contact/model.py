@@ -19,7 +19,6 @@ import logging
 import typing
 
 from mpi4py import MPI
-from petsc4py import PETSc
 
 import dolfinx.fem.petsc
 import numpy as np
@@ -39,6 +38,7 @@ from fenicsfriction.contact.geometry import (
     SYMMETRY_Y,
     TwoBodyMesh,
 )
+from fenicsfriction.contact.node_to_segment import NodalValues
 from fenicsfriction.laws import check
 from fenicsfriction.steady import SteadySolver
 
@@ -272,26 +272,14 @@ class TwoBodyModel:
         """Nodal values on the slave surface of the first pass (see :class:`SurfaceValues`)."""
         contact = self.contacts[0]
         contact.update()
-        S = _compat.scalar_function_space(self.geometry.mesh, "Lagrange", 1)
-        q = ufl.TestFunction(S)
-
-        def nodal(expr: typing.Any) -> np.ndarray:
-            vec = dolfinx.fem.petsc.assemble_vector(_compat.form(expr * q * contact.ds))
-            vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-            values = vec.getArray().copy()
-            vec.destroy()
-            return values
-
-        weight = nodal(1.0)
-        values = [nodal(contact.projection.gap), nodal(contact.pressure)]
-        traction = contact.traction
-        values += [nodal(traction[k]) if traction is not None else np.zeros_like(weight)
-                   for k in range(self.dim)]
+        weight = contact.nodal_weights
+        values = self._surface_nodal()
+        if contact.traction is None:
+            values = np.column_stack([values, np.zeros((len(weight), self.dim))])
         force = self._contact_force()
         owned = np.flatnonzero(weight > 0)
-        x = S.tabulate_dof_coordinates()[owned, :self.dim]
-        local = np.column_stack([x, weight[owned],
-                                 *(v[owned] / weight[owned] for v in values),
+        x = contact.nodal_space.tabulate_dof_coordinates()[owned, :self.dim]
+        local = np.column_stack([x, weight[owned], values[owned],
                                  force[owned] / weight[owned, None]])
         rows = np.vstack(self.comm.allgather(local))
         rows = rows[np.lexsort(rows[:, :self.dim].T[::-1])]  # by x, then y (then z)
@@ -300,33 +288,41 @@ class TwoBodyModel:
                              pressure=rows[:, d + 2], traction=rows[:, d + 3:2 * d + 3],
                              force=rows[:, 2 * d + 3:])
 
+    @functools.cached_property
+    def _surface_nodal(self) -> NodalValues:
+        """Gap, pressure and (with friction) the traction's components at the slave nodes."""
+        contact = self.contacts[0]
+        traction = contact.traction
+        return contact.nodal_values(
+            [contact.projection.gap, contact.pressure,
+             *([] if traction is None else [traction[k] for k in range(self.dim)])])
+
+    @functools.cached_property
+    def _gap_nodal(self) -> NodalValues:
+        contact = self.contacts[0]
+        return contact.nodal_values([contact.projection.gap])
+
+    def nodal_gap(self) -> np.ndarray:
+        """The gap at each owned node of the first pass's slave surface (0 off it), for the
+        contact's current pairing and mirrors (``update`` them first)."""
+        return self._gap_nodal()[:, 0]
+
     def contact_edge(self) -> np.ndarray:
         """Points where the gap changes sign along the slave facets' edges (linear
         interpolation of the nodal gaps), gathered on every rank: the contact zone's boundary
         (its two ends in 2D, a ring in 3D), second-order accurate where the gap is smooth."""
         contact = self.contacts[0]
         contact.update()
-        S = _compat.scalar_function_space(self.geometry.mesh, "Lagrange", 1)
-        q = ufl.TestFunction(S)
-        gap = fem.Function(S)
-        for expr, target in ((contact.projection.gap, gap.x.array), (1.0, None)):
-            vec = dolfinx.fem.petsc.assemble_vector(_compat.form(expr * q * contact.ds))
-            vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-            if target is not None:
-                values = vec.getArray().copy()
-            else:
-                weight = vec.getArray()
-                size = len(weight)
-                target = gap.x.array
-                target[:size] = np.divide(values, weight, out=np.zeros(size), where=weight > 0)
-            vec.destroy()
+        gap = fem.Function(contact.nodal_space)
+        owned = self.nodal_gap()
+        gap.x.array[:len(owned)] = owned
         gap.x.scatter_forward()
         facets = facet_nodes(self.V, self.geometry.facet_tags, SLAVE, outward=False)
         edges = np.vstack([facets[:, [i, j]] for i in range(self.dim)
                            for j in range(i + 1, self.dim)]).reshape(-1, 2)
         g = gap.x.array[edges]
         crossing = g[:, 0] * g[:, 1] < 0
-        x = S.tabulate_dof_coordinates()[:, :self.dim]
+        x = contact.nodal_space.tabulate_dof_coordinates()[:, :self.dim]
         a, b = edges[crossing, 0], edges[crossing, 1]
         t = (g[crossing, 0] / (g[crossing, 0] - g[crossing, 1]))[:, None]
         points = x[a] + t * (x[b] - x[a])
