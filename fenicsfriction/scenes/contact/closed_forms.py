@@ -14,7 +14,8 @@ import numpy as np
 from fenicsfriction.laws import check
 
 __all__ = ["cattaneo_stick_half_width", "cattaneo_traction", "effective_modulus",
-           "fit_hertz_pressure", "hertz_line_contact", "hertz_point_contact", "hertz_pressure"]
+           "fit_hertz_pressure", "hertz_line_contact", "hertz_load", "hertz_point_contact",
+           "hertz_pressure"]
 
 
 def effective_modulus(E1: float, nu1: float, E2: float, nu2: float) -> float:
@@ -44,6 +45,16 @@ def hertz_point_contact(load: float, radius: float, E_star: float) -> tuple[floa
     check("radius", radius, radius > 0, "the radius must be > 0")
     a = (3 * load * radius / (4 * E_star)) ** (1 / 3)
     return a, 3 * load / (2 * math.pi * a**2)
+
+
+def hertz_load(half_width: float, radius: float, E_star: float, dim: int = 2) -> float:
+    """The load that makes Hertz's contact half-width (2D: P per unit length) or radius (3D:
+    the total F) equal ``half_width``: the inverse of :func:`hertz_line_contact` and
+    :func:`hertz_point_contact`."""
+    check("dim", dim, dim in (2, 3), "2 or 3")
+    a = half_width
+    return (a**2 * math.pi * E_star / (4 * radius) if dim == 2
+            else 4 * E_star * a**3 / (3 * radius))
 
 
 def hertz_pressure(r: np.ndarray, a: float, p0: float) -> np.ndarray:

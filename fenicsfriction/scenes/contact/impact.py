@@ -16,7 +16,6 @@ order; generalized-α with ρ∞ = 1 adds no numerical dissipation).
 from __future__ import annotations
 
 import dataclasses
-import math
 import typing
 
 from mpi4py import MPI
@@ -29,6 +28,7 @@ from fenicsfriction.contact import geometry
 from fenicsfriction.contact.geometry import LOAD
 from fenicsfriction.dynamics import CentralDifference, DynamicsSolver
 from fenicsfriction.laws import check
+from fenicsfriction.scenes.contact import closed_forms
 from fenicsfriction.scenes.contact.model import TwoBodyModel
 from fenicsfriction.scenes.contact.validation import _Bodies
 
@@ -76,8 +76,7 @@ class PressAndDrag(_Bodies):
     def __post_init__(self) -> None:
         super().__post_init__()
         if self.load is None:
-            a = self.radius / 10
-            self.load = a**2 * math.pi * self.E_star / (4 * self.radius)
+            self.load = closed_forms.hertz_load(self.radius / 10, self.radius, self.E_star)
         check("load", self.load, self.load > 0, "the load must be > 0")
         check("density", self.density, self.density > 0, "must be > 0")
         check("mu", self.mu, self.mu >= 0, "must be >= 0")

@@ -17,7 +17,6 @@ giving a contact half-width (radius) of R/10.
 from __future__ import annotations
 
 import dataclasses
-import math
 import time
 import typing
 
@@ -99,9 +98,8 @@ class Hertz(_Bodies):
         check("refine", self.refine, isinstance(self.refine, int) and self.refine >= 0,
               "an integer >= 0")
         if self.load is None:
-            a = self.radius / 10
-            self.load = (a**2 * math.pi * self.E_star / (4 * self.radius) if self.dim == 2
-                         else 4 * self.E_star * a**3 / (3 * self.radius))
+            self.load = closed_forms.hertz_load(self.radius / 10, self.radius, self.E_star,
+                                                self.dim)
         check("load", self.load, self.load > 0, "the load must be > 0")
 
     def closed_form(self) -> tuple[float, float]:
