@@ -80,12 +80,16 @@ class _QuietArrayMetadata(logging.Filter):
         return "metadata value of type ndarray" not in record.getMessage()
 
 
+_QUIET_ARRAY_METADATA = _QuietArrayMetadata()
+
+
 def nodal_quadrature(facet_dim: int) -> dict:
     """Integral metadata of the nodal (trapezoidal) rule on facets: the facet's vertices with
     equal weights. FFCx's ``"vertex"`` rule is for cell integrals only, so the points are given
     as a ``"custom"`` rule on the reference facet (an interval or a triangle)."""
-    logging.getLogger("UFL").addFilter(_QuietArrayMetadata())  # UFL 2022 logs it,
-    warnings.filterwarnings("ignore", message=".*metadata value of type ndarray")  # 2024 warns
+    # UFL 2022 logs the notice, UFL 2024 warns it; neither call adds a filter twice
+    logging.getLogger("UFL").addFilter(_QUIET_ARRAY_METADATA)
+    warnings.filterwarnings("ignore", message=".*metadata value of type ndarray")
     points = np.vstack([np.zeros(facet_dim), np.eye(facet_dim)])
     weights = np.full(facet_dim + 1, 1.0 / math.factorial(facet_dim) / (facet_dim + 1))
     return {"quadrature_rule": "custom", "quadrature_degree": 1,
