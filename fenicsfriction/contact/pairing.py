@@ -1,21 +1,23 @@
 """Contact search: each slave node paired with its closest master facet, in parallel.
 
-The master surface is gathered on every rank (node global indices, reference and current
-coordinates of its facets, a few numbers per facet), so a slave node and its master facet may
-live on different ranks; each rank then pairs its own slave nodes with a k-d tree of the master
-facets' centroids (SciPy), checking the exact point-to-facet distance of the nearest few. The
-pairing is the sparse 0/1 operator ``Q`` that carries the displacements of the master nodes
-of each slave node's facet to the slave node (rows: the node's ``dim * nodes_per_facet``
+The master surface is gathered on every rank (its facets' global node indices and reference
+coordinates once, their nodes' displacements at each search), so a slave node and its master
+facet may live on different ranks; each rank then pairs its own slave nodes with a k-d tree of
+the master facets' centroids (SciPy), checking the exact point-to-facet distance of the nearest
+few. The pairing is the sparse 0/1 operator ``Q`` that carries the displacements of the master
+nodes of each slave node's facet to the slave node (rows: the node's ``dim * nodes_per_facet``
 components in the space ``W``; columns: the master dofs of ``V``), a PETSc matrix whose
 columns may belong to any rank.
 
-Cost per search: an all-gather of the master surface (O(master facets)), one k-d tree build
-(O(m log m)) and O(s log m) queries for s slave nodes, against the O(n) assembly of the bulk.
+Cost per search: an all-gather of the master facets' displacements (O(master facets)), one
+k-d tree build (O(m log m)) and O(s log m) queries for s slave nodes, against the O(n)
+assembly of the bulk.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import time
 
 from mpi4py import MPI
@@ -168,23 +170,29 @@ class Pairing:
         self.time_s = {"search": 0.0, "build": 0.0}
         self._surface: _MasterSurface | None = None
 
-    def gather(self, u: fem.Function) -> _MasterSurface:
-        """The master surface of every rank at displacement ``u`` (an all-gather)."""
+    @functools.cached_property
+    def _fixed(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """What of the master surface never changes, gathered from every rank once: the
+        facets' global node indices and reference coordinates, and which rows of the gathered
+        pieces to keep (a facet on a process boundary may be listed by two ranks)."""
         d, nen = self.dim, self.nodes_per_facet
         nodes = self.master_facets
-        index_map = self.V.dofmap.index_map
-        global_nodes = index_map.local_to_global(nodes.ravel()).reshape(nodes.shape)
-        reference = self.x_nodes[nodes]
-        displacement = u.x.array.reshape(-1, d)[nodes]
-        pieces = self.comm.allgather((global_nodes.astype(np.int64), reference,
-                                      reference + displacement))
+        global_nodes = self.V.dofmap.index_map.local_to_global(nodes.ravel()).reshape(nodes.shape)
+        pieces = self.comm.allgather((global_nodes.astype(np.int64), self.x_nodes[nodes]))
         g = np.concatenate([p[0] for p in pieces]).reshape(-1, nen)
         ref = np.concatenate([p[1] for p in pieces]).reshape(-1, nen, d)
-        cur = np.concatenate([p[2] for p in pieces]).reshape(-1, nen, d)
-        # a facet on a process boundary may be listed by two ranks: keep one copy
         _, first = np.unique(np.sort(g, axis=1), axis=0, return_index=True)
         first = np.sort(first)
-        return _MasterSurface(g[first], ref[first], cur[first])
+        return g[first], ref[first], first
+
+    def gather(self, u: fem.Function) -> _MasterSurface:
+        """The master surface of every rank at displacement ``u``: an all-gather of the
+        facets' nodal displacements, in the same order at every search."""
+        global_nodes, reference, first = self._fixed
+        displacement = u.x.array.reshape(-1, self.dim)[self.master_facets]
+        pieces = self.comm.allgather(displacement)
+        moved = np.concatenate(pieces).reshape(-1, self.nodes_per_facet, self.dim)[first]
+        return _MasterSurface(global_nodes, reference, reference + moved)
 
     def search(self, u: fem.Function) -> bool:
         """Pair every slave node with its closest master facet at displacement ``u``.
@@ -207,10 +215,9 @@ class Pairing:
             distance = point_facet_distance(x_slave[:, None, :], surface.current[candidates])
             best = _closest_by_geometry(distance, surface.reference[candidates].mean(axis=2))
             facet = candidates[np.arange(len(x_slave)), best]
-            if self._surface is not None:
+            if self.Q is not None:
                 facet = self._keep_ties(facet, x_slave, surface)
-        changed = self.Q is None or not np.array_equal(
-            surface.global_nodes[facet], self._paired_nodes())
+        changed = self.Q is None or not np.array_equal(facet, self.facet)
         self._surface = surface
         changed = bool(self.comm.allreduce(changed, op=MPI.LOR))
         self.facet = facet
@@ -227,21 +234,10 @@ class Pairing:
         """Keep a slave node's facet while its projection stays on it (surface coordinates in
         the facet, to :data:`KEEP_TOLERANCE`): a node over a master edge or vertex is about as
         close to every facet there, and switching between them at each residual evaluation
-        would stall Newton on the kink of the master surface."""
-        index = {tuple(row): i for i, row in enumerate(np.sort(surface.global_nodes, axis=1))}
-        previous = np.array([index.get(tuple(row), -1)
-                             for row in np.sort(self._paired_nodes(), axis=1)], dtype=np.int64)
-        found = previous >= 0
-        if not found.any():
-            return facet
-        shape = surface_coordinates(x_slave[found], surface.current[previous[found]])
-        keep = np.zeros(len(facet), dtype=bool)
-        keep[found] = np.all(shape >= -KEEP_TOLERANCE, axis=1)
-        return np.where(keep, previous, facet)
-
-    def _paired_nodes(self) -> np.ndarray:
-        assert self._surface is not None
-        return self._surface.global_nodes[self.facet]
+        would stall Newton on the kink of the master surface. (The gathered surface keeps its
+        order, so the last search's facet indices still name the same facets.)"""
+        shape = surface_coordinates(x_slave, surface.current[self.facet])
+        return np.where(np.all(shape >= -KEEP_TOLERANCE, axis=1), self.facet, facet)
 
     def _build(self, surface: _MasterSurface) -> None:
         """Q and the master reference coordinates for the current ``facet``."""
@@ -267,10 +263,3 @@ class Pairing:
             csr=(indptr, cols[order].astype(PETSc.IntType), np.ones(len(rows))),
             comm=self.comm)
         self.Q = Q
-
-    def gap_to_surface(self, u: fem.Function) -> np.ndarray:
-        """Distance of each slave node to its paired facet (current configuration)."""
-        assert self._surface is not None
-        d = self.dim
-        x_slave = self.x_nodes[self.slave_nodes] + u.x.array.reshape(-1, d)[self.slave_nodes]
-        return point_facet_distance(x_slave, self._surface.current[self.facet])
