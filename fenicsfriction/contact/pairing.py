@@ -94,13 +94,9 @@ def point_facet_distance(p: np.ndarray, x: np.ndarray) -> np.ndarray:
     if x.shape[-2] == 2:
         return _point_segment_distance(p, x[..., 0, :], x[..., 1, :])
     x1, x2, x3 = x[..., 0, :], x[..., 1, :], x[..., 2, :]
-    t1, t2, r = x2 - x1, x3 - x1, p - x1
-    a11, a12, a22 = (t1 * t1).sum(-1), (t1 * t2).sum(-1), (t2 * t2).sum(-1)
-    r1, r2 = (r * t1).sum(-1), (r * t2).sum(-1)
-    det = a11 * a22 - a12 * a12
-    xi1, xi2 = (a22 * r1 - a12 * r2) / det, (a11 * r2 - a12 * r1) / det
-    inside = (xi1 >= 0) & (xi2 >= 0) & (xi1 + xi2 <= 1)
-    plane = np.linalg.norm(r - xi1[..., None] * t1 - xi2[..., None] * t2, axis=-1)
+    shape = surface_coordinates(p, x)
+    inside = np.all(shape >= 0, axis=-1)
+    plane = np.linalg.norm(p - np.einsum("...a,...ak->...k", shape, x), axis=-1)
     edges = np.minimum(np.minimum(_point_segment_distance(p, x1, x2),
                                   _point_segment_distance(p, x2, x3)),
                        _point_segment_distance(p, x3, x1))
