@@ -21,7 +21,7 @@ from mpi4py import MPI
 import numpy as np
 
 from fenicsfriction import io, plotting, results
-from fenicsfriction.cli.common import output_folder, stop_line
+from fenicsfriction.cli.common import flag, output_folder, scene_from_flags, stop_line
 from fenicsfriction.laws import check
 from fenicsfriction.results import CsvRows
 from fenicsfriction.scenes import SCENES
@@ -39,13 +39,12 @@ def _scene(args: argparse.Namespace, **fixed: typing.Any) -> BlockOnBelt:
     from fenicsfriction.cli.arguments import SLAB_FLAGS
 
     scene_cls = SCENES[args.scene]
-    names = {f.name for f in dataclasses.fields(scene_cls)} - set(fixed)
+    names = {f.name for f in dataclasses.fields(scene_cls)}
     for name in SLAB_FLAGS:
         given = getattr(args, name, None)
-        check("--" + name.replace("_", "-"), given, given is None or name in names,
+        check(flag(name), given, given is None or name in names,
               f"the scene {args.scene} has no slab (use block-on-slab)")
-    return scene_cls(**fixed, **{k: v for k, v in vars(args).items()
-                                 if k in names and v is not None})
+    return scene_from_flags(scene_cls, args, **fixed)
 
 
 def _build(args: argparse.Namespace) -> tuple[BlockOnBelt, BlockModel, SteadySolver, np.ndarray]:

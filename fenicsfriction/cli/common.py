@@ -6,12 +6,27 @@ stops a run at the next step (:mod:`fenicsfriction.signals`).
 
 from __future__ import annotations
 
+import argparse
+import dataclasses
 import pathlib
 import sys
+import typing
 
 from mpi4py import MPI
 
-__all__ = ["output_folder", "stop_line"]
+__all__ = ["flag", "output_folder", "scene_from_flags", "stop_line"]
+
+
+def flag(name: str) -> str:
+    """The command-line flag of a field: ``slab_E`` -> ``--slab-E``."""
+    return "--" + name.replace("_", "-")
+
+
+def scene_from_flags(cls: type, args: argparse.Namespace, **fixed: typing.Any) -> typing.Any:
+    """The scene dataclass ``cls`` from the flags that name its fields (unset flags keep its
+    defaults), with ``fixed`` fields set by the command."""
+    names = {f.name for f in dataclasses.fields(cls)} - set(fixed)
+    return cls(**fixed, **{k: v for k, v in vars(args).items() if k in names and v is not None})
 
 
 def output_folder(path: pathlib.Path, comm: MPI.Comm = MPI.COMM_WORLD) -> pathlib.Path:

@@ -23,7 +23,7 @@ from mpi4py import MPI
 import numpy as np
 
 from fenicsfriction import _compat, plotting, results
-from fenicsfriction.cli.common import output_folder, stop_line
+from fenicsfriction.cli.common import flag, output_folder, scene_from_flags, stop_line
 from fenicsfriction.laws import check
 from fenicsfriction.results import CsvRows
 
@@ -39,23 +39,13 @@ _MODEL_LOGGER = "fenicsfriction.scenes.contact.model"
 _WINDOW = (2.5, 1.2)
 
 
-def _flag(name: str) -> str:
-    return "--" + name.replace("_", "-")
-
-
-def _scene(cls: type, args: argparse.Namespace, **fixed: typing.Any) -> typing.Any:
-    """The scene from the flags that name its fields (unset flags keep its defaults)."""
-    names = {f.name for f in dataclasses.fields(cls)} - set(fixed)
-    return cls(**fixed, **{k: v for k, v in vars(args).items() if k in names and v is not None})
-
-
 def _named_by_flag(message: str, args: argparse.Namespace) -> str:
     """A scene's or mesh's ``name=value is invalid: ...`` with ``name`` replaced by its flag,
     when the user gave that flag."""
     given = [k for k, v in vars(args).items() if v is not None]
     for name in sorted(given, key=len, reverse=True):
         if message.startswith(f"{name}="):
-            return _flag(name) + message[len(name):]
+            return flag(name) + message[len(name):]
     return message
 
 
@@ -196,7 +186,7 @@ def _hertz_outputs(scene: typing.Any, summary: dict, model: TwoBodyModel, out: p
 def _run_hertz(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
     from fenicsfriction.scenes.contact.validation import Hertz
 
-    scene = _scene(Hertz, args)
+    scene = scene_from_flags(Hertz, args)
     out = output_folder(args.out)
     a, p0 = scene.closed_form()
     model = scene.build(comm)
@@ -227,7 +217,7 @@ def _run_cattaneo(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm)
         check("--eps-sequence", args.eps_sequence, len(sequence) >= 1 and all(
             np.isfinite(e) and e > 0 for e in sequence), "every ε must be > 0")
         check("--eps", args.eps, args.eps is None, "give --eps or --eps-sequence, not both")
-    scene = _scene(Cattaneo, args, **({"eps": sequence[-1]} if sequence else {}))
+    scene = scene_from_flags(Cattaneo, args, **({"eps": sequence[-1]} if sequence else {}))
     out = output_folder(args.out)
     a, _ = scene.closed_form()
     model = scene.build(comm)
@@ -276,7 +266,8 @@ def _run_patch(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) ->
 
     pairings = {"1": {"one_pass": 1}, "2": {"two_pass": 2},
                 "both": {"one_pass": 1, "two_pass": 2}}[args.passes]
-    scenes = {name: _scene(Patch, args, passes=passes) for name, passes in pairings.items()}
+    scenes = {name: scene_from_flags(Patch, args, passes=passes)
+              for name, passes in pairings.items()}
     out = output_folder(args.out)
     summaries, models = {}, {}
     for name, scene in scenes.items():
