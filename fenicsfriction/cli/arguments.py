@@ -14,7 +14,8 @@ import pathlib
 import typing
 
 __all__ = ["SLAB_FLAGS", "LazyChoices", "Parser", "add_block_parsers", "add_contact_parsers",
-           "add_oscillator_parsers", "floats", "omega_range"]
+           "add_oscillator_parsers", "add_rolling_parsers", "creep_range", "floats",
+           "omega_range"]
 
 
 class Parser(argparse.ArgumentParser):
@@ -293,3 +294,74 @@ def add_contact_parsers(commands: typing.Any) -> None:
     cattaneo.add_argument("--eps-T", dest="eps_T", type=float,
                           help="tangential penalty of the perturbed Lagrangian "
                                "[force/length^3] (1e4)")
+
+
+def creep_range(text: str) -> list[float]:
+    """``"0:3e-3:31"`` -> 31 creepages from 0 to 3e-3 (both ends included)."""
+    try:
+        lo, hi, count = text.split(":")
+        n = int(count)
+        values = [float(lo) + (float(hi) - float(lo)) * i / max(n - 1, 1) for i in range(n)]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected LO:HI:N, got {text!r}") from None
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"expected N >= 1 points in LO:HI:N, got {text!r}")
+    return values
+
+
+def _rolling_flags() -> argparse.ArgumentParser:
+    """The Hertzian contact, the creepages and the methods' discretisations, shared by the
+    rolling commands (None: the defaults given in the help)."""
+    flags = Parser(add_help=False)
+    contact = flags.add_argument_group("the contact (any consistent units)")
+    for flag, text in (("--a", "semi-axis along the rolling direction x [length]"),
+                       ("--b", "lateral semi-axis [length] (3D; default: a, a circle)"),
+                       ("--G", "shear modulus of the (quasi-identical) bodies [force/length²]"),
+                       ("--nu", "Poisson's ratio, in [0, 0.5]"),
+                       ("--mu", "friction coefficient"),
+                       ("--Fn", "normal force [force] (2D: per unit length)")):
+        contact.add_argument(flag, type=float, dest=flag[2:], required=flag not in ("--b",),
+                             help=text)
+    creep = flags.add_argument_group("creepages (rigid slip over rolling distance)")
+    creep.add_argument("--eta", type=float, default=0.0, help="lateral creepage η (0)")
+    creep.add_argument("--phi", type=float, default=0.0, help="spin φ [1/length] (0)")
+    fastsim = flags.add_argument_group("fastsim (Kalker's simplified theory)")
+    fastsim.add_argument("--nx", type=int, help="elements per strip along x")
+    fastsim.add_argument("--ny", type=int, help="strips across the contact")
+    fastsim.add_argument("--pressure", choices=["ellipsoidal", "parabolic"],
+                         help="the traction bound's pressure profile")
+    fe = flags.add_argument_group("fe (Kalker's complete theory by finite elements)")
+    fe.add_argument("--dim", type=int, choices=[2, 3], default=3,
+                    help="2: Carter's cylinders (plane strain); 3: the Hertzian ellipse (3)")
+    fe.add_argument("--refine", type=int, help="mesh refinement level (each halves the element "
+                                               "size at the contact)")
+    fe.add_argument("--eps-sequence", type=floats, metavar="E1,E2,...",
+                    help="Kalker's sequential process: the regularisation ε of the slip, "
+                         "decreasing, each solve from the previous one")
+    flags.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    return flags
+
+
+def add_rolling_parsers(commands: typing.Any) -> None:
+    """``rolling fastsim|fe|curve``: Kalker's steady rolling of a Hertzian contact."""
+    rolling = commands.add_parser(
+        "rolling", help="steady rolling contact: creep forces by Kalker's theories",
+        description="Steady rolling of two quasi-identical elastic bodies with a Hertzian "
+                    "contact: the creep forces, the traction and the adhesion area by the "
+                    "simplified theory (FASTSIM) or by the complete theory (finite elements, "
+                    "the sequential ε process). Each writes rolling.json, figures and (fe) "
+                    "rolling.xdmf to --out; PETSc options as -rolling_<option> after the flags.")
+    methods = rolling.add_subparsers(dest="method", required=True, parser_class=Parser)
+    flags = _rolling_flags()
+    for name, text in (("fastsim", "Kalker's FASTSIM (no mesh): one creepage"),
+                       ("fe", "the complete theory by finite elements: one creepage")):
+        one = methods.add_parser(name, parents=[flags], help=text, description=text + ".")
+        one.add_argument("--xi", type=float, default=0.0, help="longitudinal creepage ξ (0)")
+    curve = methods.add_parser(
+        "curve", parents=[flags], help="the creep-force curve over a range of ξ",
+        description="The creep-force curve Fx(ξ) by one method, beside FASTSIM and Kalker's "
+                    "linear theory; one rolling.json record per point.")
+    curve.add_argument("--method", choices=["fastsim", "fe"], dest="curve_method",
+                       default="fastsim", help="the theory computing the curve (fastsim)")
+    curve.add_argument("--xi-range", type=creep_range, required=True, metavar="LO:HI:N",
+                       help="N longitudinal creepages from LO to HI")
