@@ -7,7 +7,8 @@ import sys
 import pytest
 
 MODULES = ["fenicsfriction.reduced.slider", "fenicsfriction.reduced.belt",
-           "fenicsfriction.reduced.events", "fenicsfriction.statistics"]
+           "fenicsfriction.reduced.events", "fenicsfriction.statistics",
+           "fenicsfriction.reduced.rolling.fastsim", "fenicsfriction.reduced.rolling.hertz"]
 
 
 @pytest.mark.parametrize("module", MODULES)
