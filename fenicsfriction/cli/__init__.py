@@ -3,7 +3,8 @@
 One module per family of commands: :mod:`~fenicsfriction.cli.block` (the finite element block:
 ``steady``, ``stability``, ``dynamics``), :mod:`~fenicsfriction.cli.oscillators` (the reduced
 oscillators: ``stability-map``, ``oscillator``) and :mod:`~fenicsfriction.cli.contact` (two
-elastic bodies in contact: ``contact hertz|patch|cattaneo``); :mod:`~fenicsfriction.cli.common`
+elastic bodies in contact: ``contact hertz|patch|cattaneo``), :mod:`~fenicsfriction.cli.rolling`
+(steady rolling: ``rolling fastsim|fe|curve``); :mod:`~fenicsfriction.cli.common`
 holds what they share. The flags are in :mod:`~fenicsfriction.cli.arguments`, which imports
 nothing heavy: the command's module (MPI, PETSc, dolfinx) is imported after the flags parse,
 so ``--help`` and a flag error answer at once.
@@ -25,6 +26,7 @@ from fenicsfriction.cli.arguments import (
     add_block_parsers,
     add_contact_parsers,
     add_oscillator_parsers,
+    add_rolling_parsers,
 )
 
 __all__ = ["main"]
@@ -34,7 +36,7 @@ COMMANDS = {"steady": ("block", "run_steady"), "stability": ("block", "run_stabi
             "dynamics": ("block", "run_dynamics"),
             "stability-map": ("oscillators", "run_stability_map"),
             "oscillator": ("oscillators", "run_oscillator"),
-            "contact": ("contact", "run_contact")}
+            "contact": ("contact", "run_contact"), "rolling": ("rolling", "run_rolling")}
 
 
 def _parser() -> Parser:
@@ -43,6 +45,7 @@ def _parser() -> Parser:
     add_block_parsers(commands)
     add_oscillator_parsers(commands)
     add_contact_parsers(commands)
+    add_rolling_parsers(commands)
     return parser
 
 

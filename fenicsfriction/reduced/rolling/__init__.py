@@ -14,10 +14,6 @@ The name ``fastsim`` of this package is the module; the function is
 ``fenicsfriction.reduced.rolling.fastsim.fastsim``.
 """
 
-# the package re-exports lazily (fenicsfriction._lazy); its eager imports are for type checkers
-# only (as pyproject.toml's per-file-ignores says for the other packages)
-# ruff: noqa: F401
-
 from __future__ import annotations
 
 import typing

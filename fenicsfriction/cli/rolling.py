@@ -1,0 +1,199 @@
+"""``fenicsfriction rolling fastsim|fe|curve``: steady rolling of a Hertzian contact by Kalker's
+simplified theory (FASTSIM, no mesh) or by the complete theory (finite elements).
+
+Each command writes to ``--out``: ``rolling.json`` (one record, or one per point of a curve:
+``Fx``, ``Fy``, ``Mz``, ``Fn``, ``mu``, ``creepage`` (ξ, η, φ), ``adhesion_fraction``,
+``method``, ``parameters``, ``wall_time_s``), ``traction.png`` (the traction against its bound
+with the adhesion area), ``creep_curve.png`` (curves: the methods side by side with Kalker's
+linear theory) and, for the finite elements, ``rolling.xdmf`` (the displacement and the surface
+traction). Every point of a curve prints one progress line.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import logging
+import pathlib
+import typing
+
+from mpi4py import MPI
+
+import numpy as np
+
+from fenicsfriction import plotting, results
+from fenicsfriction.cli.common import flag, output_folder, stop_line
+from fenicsfriction.laws import check
+
+__all__ = ["run_rolling"]
+
+
+#: the flags of each method's discretisation
+_METHOD_FLAGS = {"fastsim": ("nx", "ny", "pressure"), "fe": ("dim", "refine", "eps_sequence")}
+
+
+def _parameters(args: argparse.Namespace) -> dict[str, typing.Any]:
+    """The contact's data and the method's discretisation, as given (b: a when not given)."""
+    names = ("a", "b", "G", "nu", "mu", "Fn") + _METHOD_FLAGS[args.method]
+    values = {k: getattr(args, k, None) for k in names}
+    if values["b"] is None:
+        values["b"] = values["a"]
+    return {k: v for k, v in values.items() if v is not None}
+
+
+def _record(method: str, parameters: dict, Fx: float, Fy: float, Mz: float | None, Fn: float,
+            creepage: tuple[float, float, float], adhesion_fraction: float,
+            wall_time_s: float, **extra: typing.Any) -> dict[str, typing.Any]:
+    xi, eta, phi = creepage
+    return {"method": method, "Fx": Fx, "Fy": Fy, "Mz": Mz, "Fn": Fn, "mu": parameters["mu"],
+            "creepage": {"xi": xi, "eta": eta, "phi": phi},
+            "adhesion_fraction": adhesion_fraction, "wall_time_s": wall_time_s,
+            "parameters": parameters, **extra}
+
+
+# --- FASTSIM ------------------------------------------------------------------------------------
+
+def _fastsim_options(args: argparse.Namespace) -> dict[str, typing.Any]:
+    return {k: getattr(args, k) for k in ("nx", "ny", "pressure") if getattr(args, k) is not None}
+
+
+def _fastsim_records(args: argparse.Namespace, xi: typing.Sequence[float]) -> tuple[list, list]:
+    """(records, FASTSIM results) at the creepages ``xi`` (with the flags' η and φ)."""
+    from fenicsfriction.reduced.rolling.fastsim import creep_curve
+
+    p = _parameters(args)
+    points = creep_curve(p["a"], p["b"], p["G"], p["nu"], p["mu"], p["Fn"], xi=np.asarray(xi),
+                         eta=np.full(len(xi), args.eta), phi=np.full(len(xi), args.phi),
+                         **_fastsim_options(args))
+    records = [_record("fastsim", p, r.Fx, r.Fy, r.Mz, r.Fn, (r.xi, r.eta, r.phi),
+                       r.adhesion_fraction, r.wall_time_s) for r in points]
+    return records, points
+
+
+def _fastsim_traction(result: typing.Any, p: dict, path: pathlib.Path) -> None:
+    plotting.plot_rolling_traction_map(
+        result.x.ravel(), result.y.ravel(), result.px.ravel(), result.py.ravel(),
+        p["mu"] * result.pn.ravel(), result.adhesion.ravel(), p["a"], p["b"], path,
+        f"FASTSIM: ξ = {result.xi:.4g}, η = {result.eta:.4g}, φ = {result.phi:.4g};\n"
+        f"Fx/(μFn) = {result.Fx / (p['mu'] * result.Fn):.4f}, adhesion "
+        f"{result.adhesion_fraction:.1%} of the area")
+
+
+# --- the finite element complete theory -------------------------------------------------------
+
+def _fe_model(args: argparse.Namespace, comm: MPI.Comm) -> typing.Any:
+    """The finite element model of the flags' contact (built once, re-solved per creepage)."""
+    from fenicsfriction.scenes.rolling import RollingContact
+
+    p = _parameters(args)
+    fields = {f.name for f in dataclasses.fields(RollingContact)}
+    scene = RollingContact(**{k: v for k, v in p.items() if k in fields})
+    return scene.build(comm)
+
+
+def _fe_records(model: typing.Any, args: argparse.Namespace, xi: typing.Sequence[float],
+                log: logging.Logger) -> tuple[list, list]:
+    p = _parameters(args)
+    records, solutions = [], []
+    for k, value in enumerate(xi):
+        solution = model.solve(xi=value, eta=args.eta, phi=args.phi)
+        log.info(f"point {k + 1}/{len(xi)}: ξ = {value:.4g}  Fx/(μFn) = "
+                 f"{solution.Fx / (p['mu'] * solution.Fn):+.5f}  adhesion "
+                 f"{solution.adhesion_fraction:.3f}  Newton {solution.newton_iterations}  "
+                 f"{solution.wall_time_s:.1f} s")
+        records.append(_record("fe", p, solution.Fx, solution.Fy, solution.Mz, solution.Fn,
+                               (value, args.eta, args.phi), solution.adhesion_fraction,
+                               solution.wall_time_s, newton_iterations=solution.newton_iterations,
+                               dofs=model.dofs))
+        solutions.append(solution)
+    return records, solutions
+
+
+# --- outputs ------------------------------------------------------------------------------------
+
+def _creep_curve_png(records: list[dict], args: argparse.Namespace, path: pathlib.Path) -> None:
+    """Fx/(μFn) against ξ: the records' method, FASTSIM beside it (cheap), Kalker's linear
+    theory (3D) or Carter's closed form (2D)."""
+    p = _parameters(args)
+    xi = np.array([r["creepage"]["xi"] for r in records])
+    scale = p["mu"] * p["Fn"]
+    fine = np.linspace(min(xi.min(), 0.0), xi.max(), 200)
+    method = records[0]["method"]
+    curves = [(xi, np.array([r["Fx"] for r in records]) / scale,
+               "FASTSIM" if method == "fastsim" else "finite elements (complete theory)",
+               "o-" if method == "fastsim" else "s")]
+    if method == "fastsim" or p["dim"] == 3:
+        from fenicsfriction.reduced.rolling.fastsim import creep_curve, linear_theory
+        if method != "fastsim":
+            others = creep_curve(p["a"], p["b"], p["G"], p["nu"], p["mu"], p["Fn"], xi=fine,
+                                 eta=np.full(len(fine), args.eta),
+                                 phi=np.full(len(fine), args.phi))
+            curves.append((fine, np.array([r.Fx for r in others]) / scale, "FASTSIM", "-"))
+        slope = linear_theory(p["a"], p["b"], p["G"], p["nu"], xi=1.0).Fx
+        if args.eta == 0 and args.phi == 0:
+            linear = np.clip(slope * fine / scale, -1.0, 1.0)
+            curves.append((fine, linear, "Kalker's linear theory (C11), clipped at μFn", "k:"))
+    else:
+        from fenicsfriction.scenes.rolling.closed_forms import carter_force
+        curves.append((fine, carter_force(fine, p["a"], p["G"], p["nu"], p["mu"], p["Fn"])
+                       / scale, "Carter (1926)", "k-"))
+    plotting.plot_creep_curves(
+        curves, path, "longitudinal creepage ξ", "Fx / (μ Fn)",
+        f"creep-force curve: a = {p['a']:.4g}, b = {p['b']:.4g}, ν = {p['nu']:g}, "
+        f"μ = {p['mu']:g}, η = {args.eta:g}, φ = {args.phi:g}")
+
+
+def _write(out: pathlib.Path, records: list[dict], curve: bool, comm: MPI.Comm) -> None:
+    data: typing.Any = {"records": records} if curve else records[0]
+    results.write_summary(out / "rolling.json", data, comm)
+
+
+def _validate(args: argparse.Namespace) -> None:
+    for name in ("a", "G", "Fn"):
+        check(flag(name), getattr(args, name), np.isfinite(getattr(args, name))
+              and getattr(args, name) > 0, "must be a finite number > 0")
+    if args.b is not None:
+        check("--b", args.b, np.isfinite(args.b) and args.b > 0, "must be a finite number > 0")
+    check("--nu", args.nu, 0 <= args.nu <= 0.5, "must be in [0, 0.5]")
+    check("--mu", args.mu, np.isfinite(args.mu) and args.mu > 0, "must be a finite number > 0")
+
+
+def run_rolling(args: argparse.Namespace, log: logging.Logger) -> int:
+    """``rolling fastsim|fe|curve``: the creep forces, the traction, the outputs."""
+    comm = MPI.COMM_WORLD
+    _validate(args)
+    curve = args.method == "curve"
+    method = args.curve_method if curve else args.method
+    args.method = method
+    xi = args.xi_range if curve else [args.xi]
+    out = output_folder(args.out)
+    if method == "fastsim":
+        records, points = _fastsim_records(args, xi)
+        if comm.rank == 0:
+            _fastsim_traction(points[-1], _parameters(args), out / "traction.png")
+        for r in records:
+            log.info(f"ξ = {r['creepage']['xi']:.4g}  Fx = {r['Fx']:.6g}  Fy = {r['Fy']:.6g}  "
+                     f"Fx/(μFn) = {r['Fx'] / (r['mu'] * r['Fn']):+.5f}  adhesion "
+                     f"{r['adhesion_fraction']:.3f}")
+        written = ["rolling.json", "traction.png"]
+    else:
+        model = _fe_model(args, comm)
+        log.info(f"rolling fe {model.dim}D: {model.dofs} dofs on {comm.size} rank(s)")
+        try:
+            records, solutions = _fe_records(model, args, xi, log)
+        except RuntimeError as err:
+            results.write_summary(out / "rolling.json", {
+                "method": "fe", "parameters": _parameters(args), "failure": str(err)}, comm)
+            stop_line(f"rolling fe: {err}", comm)
+            return 1
+        model.write_xdmf(out / "rolling.xdmf")
+        model.plot_traction(solutions[-1], out / "traction.png")
+        written = ["rolling.json", "traction.png", "rolling.xdmf"]
+    _write(out, records, curve, comm)
+    if curve:
+        if comm.rank == 0:
+            _creep_curve_png(records, args, out / "creep_curve.png")
+        written.append("creep_curve.png")
+    comm.Barrier()
+    log.info(f"results in {out}/: {', '.join(written)}")
+    return 0
