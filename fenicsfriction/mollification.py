@@ -84,7 +84,7 @@ class SurfaceMollifier:
             rows = scipy.sparse.diags(1.0 / np.asarray(rows.sum(axis=1)).ravel()) @ rows
         self.matrix = rows.tocsr()
 
-    def __call__(self, values: typing.Sequence[float]) -> np.ndarray:
+    def __call__(self, values: np.ndarray | typing.Sequence[float]) -> np.ndarray:
         """The mollified values at the owned nodes, from the values at the owned nodes
         (collective)."""
         everywhere = np.concatenate(self.comm.allgather(np.asarray(values, dtype=float)))

@@ -194,7 +194,7 @@ class PanagiotopoulosSolver:
         self.mollified_bound: fem.Function | None = None
         V = residual.V
         self.bound_state = fem.Function(V, name="bound_state")
-        solver_args = {"prefix": prefix, "options": options, "linear_solver": linear_solver,
+        solver_args: dict[str, typing.Any] = {"prefix": prefix, "options": options, "linear_solver": linear_solver,
                        "jit_cache_dir": jit_cache_dir}
         if method == "newton":
             self.solver = SteadySolver(residual, **solver_args)
