@@ -185,8 +185,7 @@ def mollified_study(comm: MPI.Comm, refines: list[int]) -> list[dict]:
                    "local_corner_penetration": float(local[corner]),
                    "max_change": float(np.abs(d - local).max() / local.max())}
             if r > 0:
-                x, bound = process.nodal_bound()
-                mollified = process.mollified_bound.x.array[process._surface]
+                x, bound, mollified = process.nodal_bound()
                 i = np.argmin(np.abs(x[:, 0]))  # the loaded corner is at x = 0
                 both = comm.allgather((abs(x[i, 0]), bound[i], mollified[i]) if len(x)
                                       else (np.inf, 0.0, 0.0))

@@ -194,8 +194,9 @@ class PanagiotopoulosSolver:
         self.mollified_bound: fem.Function | None = None
         V = residual.V
         self.bound_state = fem.Function(V, name="bound_state")
-        solver_args: dict[str, typing.Any] = {"prefix": prefix, "options": options, "linear_solver": linear_solver,
-                       "jit_cache_dir": jit_cache_dir}
+        solver_args: dict[str, typing.Any] = {"prefix": prefix, "options": options,
+                                              "linear_solver": linear_solver,
+                                              "jit_cache_dir": jit_cache_dir}
         if method == "newton":
             self.solver = SteadySolver(residual, **solver_args)
             return
@@ -266,23 +267,25 @@ class PanagiotopoulosSolver:
         vector.destroy()
         return values
 
-    def nodal_bound(self) -> tuple[np.ndarray, np.ndarray]:
-        """(coordinates, local friction bound c_T d^{m_T}) at the owned surface nodes of the
-        mollified bound's space, at the current ``u`` (lumped projection: the exact nodal
-        value under the nodal quadrature rule). Mollified solvers only."""
+    def nodal_bound(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(coordinates, local bound c_T d^{m_T} at the current ``u``, the mollified bound
+        frozen for the next solve) at the surface nodes this rank owns, for a mollified solver.
+        The local bound is the lumped projection on the nodes: their exact values under the
+        nodal contact rule."""
         check("mollification_radius", 0.0, self.mollified_bound is not None,
               "nodal values are kept by a mollified solver (radius > 0)")
         assert self.mollified_bound is not None
-        values = self._assemble_owned(self._bound_form)[self._surface] / self._weights
+        local = self._assemble_owned(self._bound_form)[self._surface] / self._weights
         S = self.mollified_bound.function_space
-        return S.tabulate_dof_coordinates()[self._surface], values
+        return (S.tabulate_dof_coordinates()[self._surface], local,
+                self.mollified_bound.x.array[self._surface].copy())
 
     def _freeze(self) -> None:
         """Evaluate the bound at the current state and keep it for the next solve."""
         if self.mollified_bound is None:
             self.bound_state.x.array[:] = self.u.x.array  # same layout, ghosts included
             return
-        _, local = self.nodal_bound()
+        _, local, _ = self.nodal_bound()
         self.mollified_bound.x.array[self._surface] = self.mollifier(local)
         self.mollified_bound.x.scatter_forward()
 

@@ -111,6 +111,8 @@ def test_bad_options_are_rejected():
         PanagiotopoulosSolver(model.residual, method="gauss-seidel")
     with pytest.raises(ValueError, match="mollification_radius=1.0"):
         PanagiotopoulosSolver(model.residual, method="newton", mollification_radius=1.0)
+    with pytest.raises(ValueError, match="layer_thickness=40"):
+        LayeredBlockOnBelt(layer_thickness=40.0)
     frictionless = ff.BlockOnBelt().build(COMM)
     with pytest.raises(ValueError, match="needs a friction term"):
         PanagiotopoulosSolver(frictionless.residual)
