@@ -25,8 +25,10 @@ import typing
 
 import numpy as np
 import ufl
+from ufl.variable import Label
 
 __all__ = [
+    "FRICTION_BOUND",
     "ConstantFriction",
     "InterfaceLaw",
     "PiecewiseLinearFriction",
@@ -115,6 +117,16 @@ def normal_damping_pressure(d: Scalar, u_n_dot: Scalar, b_n: Scalar, l_n: Scalar
 def friction_bound(d: Scalar, c_T: Scalar, m_T: Scalar) -> Scalar:
     """Maximum friction stress :math:`c_T d^{m_T}` (Martins & Oden 1986, eq. 2)."""
     return c_T * d**m_T
+
+
+FRICTION_BOUND = Label()
+"""The label of the friction bound inside :func:`friction_traction`'s UFL expressions.
+
+The bound is wrapped in a :class:`ufl.variable.Variable` with this label, which changes
+nothing in the forms or their derivatives but lets a solver find it in a residual and
+evaluate it elsewhere: :mod:`fenicsfriction.panagiotopoulos` freezes it at the last iterate
+(Kalker 1986, section 3) or replaces it by its mollification (Kalker 1986, eq. 27).
+"""
 
 
 # --- regularisations of |w| (Pop, eq. 15; Kalker 1986, eq. 40) -----------------------------------
@@ -219,7 +231,10 @@ def friction_traction(d: Scalar, w: typing.Any, c_T: typing.Any, m_T: Scalar, ep
     if is_speed_law(c_T):
         c_T = c_T(_norm(w))
     direction = REGULARISATIONS[regularisation][1](w, eps)
-    return -friction_bound(d, c_T, m_T) * direction
+    bound = friction_bound(d, c_T, m_T)
+    if _is_ufl(bound):  # labelled, so that a solver can freeze or mollify it
+        bound = ufl.classes.Variable(bound, FRICTION_BOUND)
+    return -bound * direction
 
 
 # --- velocity-dependent friction coefficients ---------------------------------------------------

@@ -9,10 +9,12 @@ import typing
 from fenicsfriction.scenes.block.data import BlockData, BlockOnBelt
 
 __all__ = ["BlockData", "BlockModel", "BlockOnBelt", "BlockQuantities", "CentreOfMass",
-           "ContactStates", "Energies", "Powers", "ProbeValues"]
+           "ContactStates", "Energies", "LayeredBlockModel", "LayeredBlockOnBelt", "Powers",
+           "ProbeValues"]
 
 _LAZY = {"BlockModel": "model", "BlockQuantities": "observables", "CentreOfMass": "observables",
-         "ContactStates": "observables", "Energies": "observables", "Powers": "observables",
+         "ContactStates": "observables", "Energies": "observables",
+         "LayeredBlockModel": "layered", "LayeredBlockOnBelt": "layered", "Powers": "observables",
          "ProbeValues": "observables"}
 
 

@@ -149,7 +149,7 @@ class BlockModel:
         u, u_dot, u_ddot = fem.Function(V, name="displacement"), fem.Function(V), fem.Function(V)
         v = ufl.TestFunction(V)
         terms = inertia(self.rho, u_ddot, v, self.dx) \
-            + elasticity(u, v, s.E, s.nu, self.dx) \
+            + elasticity(u, v, *self._moduli(), self.dx) \
             + body_force(self.gravity, v, self.dx)
         if s.top_pressure > 0:
             terms += surface_traction(self.top_traction, v, ds(TOP))
@@ -197,6 +197,11 @@ class BlockModel:
         indices, tags = np.concatenate(facets), np.concatenate(values)
         order = np.argsort(indices)
         return msh, mesh.meshtags(msh, fdim, indices[order], tags[order]), None
+
+    def _moduli(self) -> tuple[typing.Any, typing.Any]:
+        """Young's modulus and Poisson's ratio of the block: the scene's E and ν (a layered
+        block returns cell-wise fields)."""
+        return self.scene.E, self.scene.nu
 
     def _block_measure(self) -> ufl.Measure:
         """The volume measure of the block (the whole mesh here)."""
@@ -248,7 +253,7 @@ class BlockModel:
         """Kinetic and strain energies per unit breadth (UFL) of every body of the model."""
         u, u_dot = self.residual.u, self.residual.u_dot
         return {"kinetic": 0.5 * self.rho * ufl.inner(u_dot, u_dot) * self.dx,
-                "strain": 0.5 * elasticity(u, u, self.scene.E, self.scene.nu, self.dx)}
+                "strain": 0.5 * elasticity(u, u, *self._moduli(), self.dx)}
 
     def interface_power_forms(self) -> dict[str, ufl.Form]:
         """Power per unit breadth (UFL) of the friction and normal-damping tractions on the

@@ -13,7 +13,7 @@ import numpy as np
 
 from fenicsfriction.laws import check
 
-__all__ = ["cattaneo_stick_half_width", "cattaneo_traction", "effective_modulus",
+__all__ = ["cattaneo_stick_half_width", "cattaneo_traction", "dundurs_beta", "effective_modulus",
            "fit_hertz_pressure", "hertz_line_contact", "hertz_load", "hertz_point_contact",
            "hertz_pressure"]
 
@@ -25,6 +25,20 @@ def effective_modulus(E1: float, nu1: float, E2: float, nu2: float) -> float:
     for name, value in (("nu1", nu1), ("nu2", nu2)):
         check(name, value, -1 < value < 0.5, "Poisson's ratio must be in (-1, 0.5)")
     return 1.0 / ((1 - nu1**2) / E1 + (1 - nu2**2) / E2)
+
+
+def dundurs_beta(E1: float, nu1: float, E2: float, nu2: float) -> float:
+    """The second Dundurs constant (plane strain; Johnson 1985, chapter 5):
+
+    .. math:: \\beta = \\frac{(1-2\\nu_1)/G_1 - (1-2\\nu_2)/G_2}
+                       {2\\,[(1-\\nu_1)/G_1 + (1-\\nu_2)/G_2]},
+
+    :math:`G_i = E_i / (2(1+\\nu_i))`. The normal and tangential contact problems of two
+    half-spaces uncouple when β = 0 (quasi-identical bodies: De Pater 1962; Kalker 1986, §4).
+    """
+    effective_modulus(E1, nu1, E2, nu2)  # validates the four, naming each
+    G1, G2 = E1 / (2 * (1 + nu1)), E2 / (2 * (1 + nu2))
+    return ((1 - 2 * nu1) / G1 - (1 - 2 * nu2) / G2) / (2 * ((1 - nu1) / G1 + (1 - nu2) / G2))
 
 
 def hertz_line_contact(load: float, radius: float, E_star: float) -> tuple[float, float]:

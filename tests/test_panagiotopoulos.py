@@ -1,0 +1,118 @@
+"""The Panagiotopoulos process against coupled Newton on the block on the belt (Kalker 1986, §3).
+
+The process solves the residual with the friction bound frozen at the last iterate; at its fixed
+point the frozen and the coupled residuals coincide, so it must reproduce Newton's solution.
+Its convergence is a contraction of the map bound → state → bound, whose factor grows with μ
+and with how strongly the tangential traction moves the normal one; for an elastic layer on
+the rigid belt that coupling is the layer's second Dundurs constant β = (1 - 2ν)/(2(1 - ν)),
+and the process stops converging near μβ = 1 while Newton goes on.
+"""
+
+from mpi4py import MPI
+
+import numpy as np
+import pytest
+
+import fenicsfriction as ff
+from fenicsfriction.panagiotopoulos import PanagiotopoulosSolver, ProcessError
+from fenicsfriction.scenes.block import LayeredBlockOnBelt
+
+COMM = MPI.COMM_WORLD
+
+
+def _solvers(scene, *methods, **kwargs):
+    model = scene.build(COMM, with_friction=True)
+    solvers = [PanagiotopoulosSolver(model.residual, method=m, prefix=f"test_{m}_",
+                                     options=model.solver_options(),
+                                     parameters={"mu": model.mu}, **kwargs) for m in methods]
+    return model, solvers
+
+
+def _solve(model, solver, mu):
+    model.mu.value = mu
+    model.initial_guess()
+    report = solver.solve()
+    return report, model.residual.u.x.array.copy()
+
+
+def _penetrations(model, u):
+    model.residual.u.x.array[:] = u
+    return np.concatenate(COMM.allgather(model.nodal_contact()[0]))
+
+
+def test_process_at_zero_friction_is_newton_in_one_step():
+    model, (newton, process) = _solvers(ff.BlockOnBelt(), "newton", "panagiotopoulos")
+    _, u_newton = _solve(model, newton, 0.0)
+    report, u_process = _solve(model, process, 0.0)
+    assert report.converged and report.outer_iterations == 1
+    # the same problem solved twice by Newton to snes_rtol 1e-10
+    assert np.allclose(u_process, u_newton, rtol=0, atol=1e-9 * np.abs(u_newton).max())
+
+
+@pytest.mark.parametrize("mu", [0.4, 1.2])
+def test_process_converges_to_newton_at_moderate_mu(mu):
+    model, (newton, process) = _solvers(ff.BlockOnBelt(), "newton", "panagiotopoulos",
+                                        rtol=1e-8)
+    _, u_newton = _solve(model, newton, mu)
+    report, u_process = _solve(model, process, mu)
+    assert report.converged and 2 < report.outer_iterations < 15
+    assert report.changes[-1] <= 1e-8
+    d_newton, d_process = _penetrations(model, u_newton), _penetrations(model, u_process)
+    # the last change is the coupled residual relative to the friction forces (1e-8); the map
+    # contracts by < 0.1 per iteration here, so the traction is within ~1e-8 of the fixed
+    # point, and d ∝ bound^(1/m_n) with m_n = 2.5; 1e-6 leaves a factor 100 for the condition
+    # of the elastic solve and Newton's own tolerance
+    assert np.max(np.abs(d_process - d_newton)) < 1e-6 * d_newton.max()
+
+
+def test_johnson_is_the_first_process_iterate():
+    model, (johnson, process) = _solvers(ff.BlockOnBelt(), "johnson", "panagiotopoulos",
+                                         max_iterations=2)
+    report, u_johnson = _solve(model, johnson, 1.0)
+    assert report.outer_iterations == 2 and not report.converged
+    with pytest.raises(ProcessError, match="max_iterations") as caught:
+        _solve(model, process, 1.0)
+    u_process = model.residual.u.x.array
+    assert caught.value.report.changes == pytest.approx(report.changes, rel=1e-8)
+    assert np.allclose(u_process, u_johnson, rtol=0, atol=1e-12 * np.abs(u_johnson).max())
+    # Johnson's step is an approximation: its friction traction is the frictionless
+    # pressure's, which the tipping moment at μ = 1 changes by far more than the tolerance
+    assert report.changes[-1] > 0.1
+
+
+@pytest.mark.parametrize("layer_nu", [0.0, 0.25])
+def test_process_stops_converging_near_the_dundurs_limit_where_newton_does_not(layer_nu):
+    """A soft layer (E/1000) under the block, the spring low (tipping limit 9.6): the process
+    converges at μβ = 0.8, fails at μβ = 1.3 in bounded time with the last iterate kept, and
+    Newton converges at both."""
+    scene = LayeredBlockOnBelt(layer_nu=layer_nu, spring_height=30.5 / 12)
+    beta = (1 - 2 * layer_nu) / (2 * (1 - layer_nu))
+    model, (newton, process) = _solvers(scene, "newton", "panagiotopoulos", max_iterations=100,
+                                        patience=4)
+    report, _ = _solve(model, process, 0.8 / beta)
+    assert report.converged
+    mu = 1.3 / beta
+    assert _solve(model, newton, mu)[0].converged
+    model.initial_guess()
+    with pytest.raises(ProcessError, match="mu=") as caught:
+        process.solve()
+    failed = caught.value.report
+    assert not failed.converged and failed.outer_iterations <= 100
+    assert failed.wall_time_s < 20  # bounded: at most 100 Newton solves of a 4 x 3 mesh
+    u = model.residual.u.x.array
+    assert np.all(np.isfinite(u))
+    # the last iterate is a converged frozen solve: its normal force balances the weight
+    assert model.quantities().normal_force == pytest.approx(scene.weight, rel=1e-8)
+
+
+def test_bad_options_are_rejected():
+    model = ff.BlockOnBelt().build(COMM, with_friction=True)
+    with pytest.raises(ValueError, match="method='gauss-seidel'"):
+        PanagiotopoulosSolver(model.residual, method="gauss-seidel")
+    with pytest.raises(ValueError, match="mollification_radius=1.0"):
+        PanagiotopoulosSolver(model.residual, method="newton", mollification_radius=1.0)
+    with pytest.raises(ValueError, match="layer_thickness=40"):
+        LayeredBlockOnBelt(layer_thickness=40.0)
+    frictionless = ff.BlockOnBelt().build(COMM)
+    with pytest.raises(ValueError, match="needs a friction term"):
+        PanagiotopoulosSolver(frictionless.residual)
