@@ -242,7 +242,9 @@ def test_isotropic_rules_reproduce_the_coulomb_term(dim, associated, regularisat
             assert J_ref.norm() > 0
     # the band is crossed: some slips are inside it, some outside
     slips = np.abs(u_dot.x.array.reshape(-1, dim)[:, 0])
-    assert slips.min() < EPS < slips.max()
+    comm = MPI.COMM_WORLD
+    assert comm.allreduce(slips.min(), op=MPI.MIN) < EPS < comm.allreduce(slips.max(),
+                                                                            op=MPI.MAX)
 
 
 def _sliding(x: np.ndarray) -> np.ndarray:
@@ -299,8 +301,10 @@ def test_friction_jacobian_at_rest_is_finite_and_the_band_stiffness(associated):
     rule = laws.EllipticSlipRule(MU_X, MU_Y, associated=associated, frame=frame)
     c_T = rule.mu_ref * 50.0
     _, (J,) = _assemble(_friction_form(u, u_dot, n, ds, c_T, rule, "c1"), (u_dot,))
-    values = J.getValuesCSR()[2]
-    assert np.all(np.isfinite(values)) and np.abs(values).max() > 0
+    values = J.getValuesCSR()[2]  # this rank's rows: a rank may hold no contact facet
+    comm = MPI.COMM_WORLD
+    assert comm.allreduce(np.all(np.isfinite(values)), op=MPI.LAND)
+    assert comm.allreduce(np.abs(values).max(initial=0.0), op=MPI.MAX) > 0
     # inside the band the associated traction is linear, -c_T d^m A² w / (μ_ref² ε): its
     # stiffness, written out; the non-associated one at w = 0 (where it has no derivative,
     # being homogeneous of degree 1 but not linear) is the Coulomb band's at μ_ref
@@ -318,3 +322,72 @@ def test_friction_jacobian_at_rest_is_finite_and_the_band_stiffness(associated):
 
 
 # --- a 3D block sliding on an oblique belt --------------------------------------------------------
+
+def _block_on_oblique_belt(rule: laws.EllipticSlipRule, belt_angle: float, pressure: float
+                           ) -> tuple[np.ndarray, float]:
+    """An elastic block 1 x 0.25 x 1 pressed by ``pressure`` on its top (y = 0.25) onto a rigid
+    belt (y = 0) that moves at unit speed at ``belt_angle`` from e_x in the x-z plane; the top
+    face is held in x and z (free in y, so the belt carries the whole load). Steady sliding
+    (u̇ = 0) solved with Newton; returns the friction force on the block, minus the reaction
+    of the holding face, and the normal force."""
+    comm = MPI.COMM_WORLD
+    L, H, B = 1.0, 0.25, 1.0
+    msh = _compat.create_box(comm, (0.0, 0.0, 0.0), (L, H, B), (4, 2, 4))
+    fdim = 2
+    contact = mesh.locate_entities_boundary(msh, fdim, lambda x: np.isclose(x[1], 0.0))
+    top = mesh.locate_entities_boundary(msh, fdim, lambda x: np.isclose(x[1], H))
+    facets = np.concatenate([contact, top])
+    order = np.argsort(facets)
+    tags = mesh.meshtags(msh, fdim, facets[order], np.concatenate(
+        [np.full(len(contact), 1, dtype=np.int32), np.full(len(top), 2, dtype=np.int32)])[order])
+    ds = ufl.Measure("ds", domain=msh, subdomain_data=tags, metadata={"quadrature_degree": 2})
+    V = _compat.vector_function_space(msh, 1)
+    u, u_dot, u_ddot = (fem.Function(V, name=name) for name in ("u", "u_dot", "u_ddot"))
+    v = ufl.TestFunction(V)
+    c_n, m_n = 1e4, 1.0
+    belt = fem.Constant(msh, np.array([np.cos(belt_angle), 0.0, np.sin(belt_angle)]))
+    n = ufl.FacetNormal(msh)
+    terms = forms.elasticity(u, v, 1e3, 0.3, ufl.dx(domain=msh)) \
+        + forms.normal_compliance(u, v, n, c_n, m_n, 0.0, ds(1)) \
+        + forms.friction(u, u_dot, v, n, rule.mu_ref * c_n, m_n, 0.0, belt, EPS, ds(1),
+                         slip_rule=rule) \
+        + forms.surface_traction(ufl.as_vector([0.0, -pressure, 0.0]), v, ds(2))
+    held = [fem.locate_dofs_topological(V.sub(i), fdim, top) for i in (0, 2)]
+    bcs = [fem.dirichletbc(PETSc.ScalarType(0), dofs, V.sub(i))
+           for i, dofs in zip((0, 2), held, strict=True)]
+    residual = forms.Residual(form=terms, u=u, u_dot=u_dot, u_ddot=u_ddot, v=v, bcs=bcs)
+    # start at the uniform penetration the pressure makes: the compliance is stiff at once
+    u.x.array.reshape(-1, 3)[:, 1] = -pressure / c_n
+    u.x.scatter_forward()
+    SteadySolver(residual, prefix="slip_rule_block_", linear_solver="lu").solve()
+    # the residual without its Dirichlet rows: the holding face's reaction on its dofs
+    R = dolfinx.fem.petsc.assemble_vector(_compat.form(residual.steady()))
+    R.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    owned = V.dofmap.index_map.size_local * V.dofmap.index_map_bs
+    reaction = np.zeros(3)
+    for i, dofs in zip((0, 2), held, strict=True):
+        reaction[i] = R.array[dofs[dofs < owned]].sum()
+    return -comm.allreduce(reaction), pressure * L * B
+
+
+@pytest.mark.parametrize("associated", [True, False])
+def test_block_on_oblique_belt_feels_the_friction_force_of_the_slip_rule(associated):
+    belt_angle, pressure = 0.5, 10.0
+    rule = laws.EllipticSlipRule(MU_X, MU_Y, associated=associated,
+                                 frame=((1.0, 0.0, 0.0), (0.0, 0.0, 1.0)))
+    force, normal_force = _block_on_oblique_belt(rule, belt_angle, pressure)
+    # the slip of the block on the belt is -U: the friction force on the block, opposite the
+    # slip (non-associated) or at tan θ = (μ_y/μ_x)² tan(belt angle) (normality)
+    expected_angle = np.arctan2(MU_Y**2 * np.sin(belt_angle), MU_X**2 * np.cos(belt_angle)) \
+        if associated else belt_angle
+    angle = np.arctan2(force[2], force[0])
+    # every contact point slips at the belt's velocity, far outside the band (|A U|/μ_ref ≥
+    # 0.4 ≫ ε): each traction is exactly μ(θ) p_n along the closed-form direction, and the
+    # sum of the p_n balances the top load; what is left is Newton's residual (atol 1e-9)
+    # against forces of order 1
+    assert angle == pytest.approx(expected_angle, abs=1e-8)
+    assert np.hypot(force[0], force[2]) == pytest.approx(
+        _polar_radius(expected_angle) * normal_force, rel=1e-8)
+    assert force[1] == 0.0  # nothing holds the block in y but the belt
+    # normality turns the force away from the belt (here by 0.79 rad); the other rule does not
+    assert (abs(angle - belt_angle) > 0.5) == associated
