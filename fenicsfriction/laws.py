@@ -246,7 +246,7 @@ class CoulombSlipRule:
 
 @dataclasses.dataclass(frozen=True)
 class EllipticSlipRule:
-    """Orthotropic friction: the elliptic slip surface of Michałowski & Mróz (1978),
+    """Orthotropic friction: the elliptic slip surface
     :math:`g(p_\\tau, p_n) = \\sqrt{(p_1/\\mu_x)^2 + (p_2/\\mu_y)^2} - p_n \\le 0`, with
     :math:`p_1, p_2` the friction resistance :math:`p = -t` in the tangent frame (t1, t2).
 
@@ -258,8 +258,10 @@ class EllipticSlipRule:
       :math:`|A w| < \\mu_{ref}\\varepsilon` it is :math:`t = -p_n A^2 w / |A w|`, on the
       ellipse, at the angle :math:`\\tan\\theta_p = (\\mu_y/\\mu_x)^2 \\tan\\theta_s` from t1
       when the slip is at :math:`\\theta_s`: not opposite the slip unless it is along an axis.
-    * ``associated=False`` (Michałowski & Mróz 1978): the traction opposes the slip with the
-      magnitude on the slip surface, :math:`t = -\\mu(\\theta_s) p_n \\phi_\\varepsilon'(w)`,
+    * ``associated=False`` (a non-associated rule in the sense of Michałowski & Mróz 1978,
+      "Associated and non-associated sliding rules in contact friction problems"): the
+      traction opposes the slip with the magnitude on the slip surface,
+      :math:`t = -\\mu(\\theta_s) p_n \\phi_\\varepsilon'(w)`,
       :math:`1/\\mu(\\theta)^2 = \\cos^2\\theta/\\mu_x^2 + \\sin^2\\theta/\\mu_y^2`.
 
     The bound handed to :meth:`traction` is :math:`c_T d^{m_T} = \\mu_{ref} p_n` with
