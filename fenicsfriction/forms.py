@@ -124,7 +124,7 @@ def normal_damping(u: Field, u_dot: Field, v: Field, n: Field, b_n: Value, l_n: 
 
 def friction(u: Field, u_dot: Field, v: Field, n: Field, c_T: Value | typing.Callable,
              m_T: Value, g: Value, U_T: Field, eps: Value, ds: ufl.Measure,
-             regularisation: str = "c1") -> ufl.Form:
+             regularisation: str = "c1", slip_rule: laws.SlipRule | None = None) -> ufl.Form:
     """Regularised friction power :math:`\\langle J_\\varepsilon(u,\\dot u), v\\rangle`.
 
     .. math:: \\int_{\\Gamma_C} c_T\\, d^{m_T}\\, \\phi_\\varepsilon'(\\dot u_T - U_T)\\cdot v_T
@@ -134,10 +134,13 @@ def friction(u: Field, u_dot: Field, v: Field, n: Field, c_T: Value | typing.Cal
     ``c_T`` is a number/UFL value (Coulomb: :math:`\\mu c_n`), or a callable of the relative
     slip speed :math:`|\\dot u_T - U_T|` for a velocity-dependent law, e.g.
     ``lambda s: c_n * PiecewiseLinearFriction()(s)``; its slope then enters every derivative.
+    ``slip_rule`` (:data:`fenicsfriction.laws.SLIP_RULES`, default isotropic Coulomb) shapes
+    the traction, e.g. orthotropic friction with
+    :class:`~fenicsfriction.laws.EllipticSlipRule` (then ``c_T`` is its ``mu_ref * c_n``).
     """
     d = laws.penetration(normal_part(u, n), g)
     w = tangential_part(u_dot, n) - U_T
-    traction = laws.friction_traction(d, w, c_T, m_T, eps, regularisation)
+    traction = laws.friction_traction(d, w, c_T, m_T, eps, regularisation, slip_rule)
     return -ufl.inner(traction, tangential_part(v, n)) * ds
 
 

@@ -7,6 +7,9 @@ reduced models and post-processing) and returns the same kind. Notation (see doc
 * normal compliance :math:`c_n d^{m_n}`, normal damping :math:`b_n d^{l_n} \dot u_n`;
 * friction bound :math:`c_T d^{m_T}`; Coulomb is :math:`m_T = m_n`, :math:`c_T = \mu c_n`;
 * regularised friction direction :math:`\phi_\varepsilon'(w)` with :math:`w = \dot u_T - U_T`.
+* slip rules (:class:`CoulombSlipRule`, :class:`EllipticSlipRule`): the slip surface
+  :math:`g(p_\tau, p_n) \le 0` and the direction of the traction on it (Frederiksson 1976;
+  Kalker 1986, §7).
 
 The two tractions of the interface on the body are defined here once, :func:`normal_traction`
 and :func:`friction_traction`; the residual's terms (:mod:`fenicsfriction.forms`), the scenes'
@@ -30,9 +33,13 @@ from ufl.variable import Label
 __all__ = [
     "FRICTION_BOUND",
     "ConstantFriction",
+    "CoulombSlipRule",
+    "EllipticSlipRule",
     "InterfaceLaw",
     "PiecewiseLinearFriction",
     "REGULARISATIONS",
+    "SLIP_RULES",
+    "SlipRule",
     "StribeckFriction",
     "abs_c1",
     "abs_c1_derivative",
@@ -185,6 +192,195 @@ REGULARISATIONS: dict[str, tuple[typing.Callable[..., typing.Any], ...]] = {
 """φ_ε, φ'_ε and φ''_ε (scalar slip) of each regularisation, by name."""
 
 
+# --- slip rules (Frederiksson 1976; Michałowski & Mróz 1978; Kalker 1986, §7) ------------------
+
+def _components(w: typing.Any, frame: tuple[typing.Any, ...] | None) -> list[Scalar]:
+    """The slip's components (w·t1, w·t2) in ``frame``; with no frame, ``w``'s own components
+    (the last axis of a NumPy array)."""
+    if frame is None:
+        if _is_ufl(w):
+            return [w[i] for i in range(w.ufl_shape[0])]
+        w = np.asarray(w, dtype=float)
+        return [w[..., i] for i in range(w.shape[-1])]
+    if _is_ufl(w, *frame):
+        return [ufl.dot(w, t if _is_ufl(t) else ufl.as_vector(t)) for t in frame]
+    return [np.asarray(w, dtype=float) @ np.asarray(t) for t in frame]
+
+
+def _vector(components: list[Scalar], frame: tuple[typing.Any, ...] | None) -> typing.Any:
+    """The vector Σ c_i t_i of components in ``frame`` (the inverse of :func:`_components`)."""
+    if frame is None:
+        if _is_ufl(*components):
+            return ufl.as_vector(components)
+        return np.stack(np.broadcast_arrays(*components), axis=-1)
+    if _is_ufl(*components, *frame):
+        return sum(c * (t if _is_ufl(t) else ufl.as_vector(t))
+                   for c, t in zip(components, frame, strict=True))
+    return sum(np.asarray(c)[..., None] * np.asarray(t)
+               for c, t in zip(components, frame, strict=True))
+
+
+def _direction(components: list[Scalar], eps: Scalar, regularisation: str) -> list[Scalar]:
+    """The components of the regularised direction :math:`\\phi_\\varepsilon'(z)` of the vector
+    z with these components (:data:`REGULARISATIONS`)."""
+    _, derivative, second_derivative = REGULARISATIONS[regularisation]
+    if _is_ufl(*components, eps):
+        direction = derivative(ufl.as_vector(components), eps)
+        return [direction[i] for i in range(len(components))]
+    r = np.sqrt(sum(np.asarray(c, dtype=float) ** 2 for c in components))
+    # φ'_ε(z) = z φ'_ε(|z|)/|z|, whose limit at z = 0 is z φ''_ε(0)
+    scale = np.where(r > 0, derivative(r, eps) / np.where(r > 0, r, 1.0),
+                     second_derivative(0.0, eps))
+    return [c * scale for c in components]
+
+
+@dataclasses.dataclass(frozen=True)
+class CoulombSlipRule:
+    """Isotropic Coulomb friction, the associated rule of the circular slip surface
+    :math:`g = |p_\\tau| - \\mu p_n` (Kalker 1986, eqs. 50-52): the traction of
+    :func:`friction_traction` as it was before slip rules, the default."""
+
+    def traction(self, bound: Scalar, w: typing.Any, eps: Scalar,
+                 regularisation: str = "c1") -> typing.Any:
+        """:math:`-c_T d^{m_T} \\phi_\\varepsilon'(w)` with ``bound`` :math:`= c_T d^{m_T}`.
+
+        Args:
+            bound: the friction bound (:func:`friction_bound`).
+            w: the slip velocity (UFL vector, or NumPy scalars: one tangent direction).
+            eps: regularisation parameter ε.
+            regularisation: ``"c1"`` or ``"smooth"`` (:data:`REGULARISATIONS`).
+
+        Returns:
+            The traction on the body, a vector like ``w``.
+        """
+        return -bound * REGULARISATIONS[regularisation][1](w, eps)
+
+
+@dataclasses.dataclass(frozen=True)
+class EllipticSlipRule:
+    """Orthotropic friction: the elliptic slip surface
+    :math:`g(p_\\tau, p_n) = \\sqrt{(p_1/\\mu_x)^2 + (p_2/\\mu_y)^2} - p_n \\le 0`, with
+    :math:`p_1, p_2` the friction resistance :math:`p = -t` in the tangent frame (t1, t2).
+
+    * ``associated=True`` (Frederiksson 1976; Kalker 1986, eqs. 45-47): the slip is normal to
+      the slip surface, :math:`w = \\lambda\\, \\partial g/\\partial p`, :math:`\\lambda \\ge 0`.
+      The traction is :math:`t = -\\partial D_\\varepsilon/\\partial w` with the regularised
+      dissipation :math:`D_\\varepsilon(w) = p_n \\mu_{ref}\\, \\phi_\\varepsilon(A w /
+      \\mu_{ref})`, :math:`A = \\mathrm{diag}(\\mu_x, \\mu_y)`; outside the band
+      :math:`|A w| < \\mu_{ref}\\varepsilon` it is :math:`t = -p_n A^2 w / |A w|`, on the
+      ellipse, at the angle :math:`\\tan\\theta_p = (\\mu_y/\\mu_x)^2 \\tan\\theta_s` from t1
+      when the slip is at :math:`\\theta_s`: not opposite the slip unless it is along an axis.
+    * ``associated=False`` (a non-associated rule in the sense of Michałowski & Mróz 1978,
+      "Associated and non-associated sliding rules in contact friction problems"): the
+      traction opposes the slip with the magnitude on the slip surface,
+      :math:`t = -\\mu(\\theta_s) p_n \\phi_\\varepsilon'(w)`,
+      :math:`1/\\mu(\\theta)^2 = \\cos^2\\theta/\\mu_x^2 + \\sin^2\\theta/\\mu_y^2`.
+
+    The bound handed to :meth:`traction` is :math:`c_T d^{m_T} = \\mu_{ref} p_n` with
+    :math:`\\mu_{ref} = \\max(\\mu_x, \\mu_y)` (:attr:`mu_ref`): it stays the largest
+    traction, as the bound of Martins & Oden (1986, eq. 2); pass ``c_T = mu_ref * c_n``. With
+    :math:`\\mu_x = \\mu_y = \\mu` both rules are Coulomb's, :class:`CoulombSlipRule`.
+
+    Args:
+        mu_x: friction coefficient along t1 [-], > 0.
+        mu_y: friction coefficient along t2 [-], > 0 (not used on a 2D contact line).
+        associated: normality (True) or traction opposite the slip (False).
+        frame: the tangent unit vectors (t1, t2) of Γ_C in the global frame (``(t1,)`` on the
+            contact line of a 2D body), constant sequences of floats or UFL vectors (a curved
+            Γ_C); ``None``: the slip's own components are (w·t1, w·t2) (NumPy: the last axis).
+    """
+
+    mu_x: float
+    mu_y: float
+    associated: bool = True
+    frame: tuple[typing.Any, ...] | None = None
+
+    def __post_init__(self) -> None:
+        check_positive("mu_x", self.mu_x)
+        check_positive("mu_y", self.mu_y)
+        check("associated", self.associated, isinstance(self.associated, bool),
+              "must be True (normality) or False (traction opposite the slip)")
+        if self.frame is None:
+            return
+        frame = tuple(self.frame)
+        check("frame", self.frame, len(frame) in (1, 2),
+              "must hold the tangent vectors (t1, t2), or (t1,) in 2D")
+        if _is_ufl(*frame):
+            object.__setattr__(self, "frame", frame)
+            return
+        vectors = [np.asarray(t, dtype=float) for t in frame]
+        gram = np.array([[a @ b for b in vectors] for a in vectors]) \
+            if all(v.shape == vectors[0].shape and v.ndim == 1 for v in vectors) else None
+        check("frame", self.frame,
+              gram is not None and len(vectors[0]) in (2, 3)
+              and np.allclose(gram, np.eye(len(vectors)), rtol=0, atol=1e-12),
+              "the tangent vectors must be orthonormal, 2 or 3 components each")
+        object.__setattr__(self, "frame", tuple(tuple(float(x) for x in v) for v in vectors))
+
+    @property
+    def mu_ref(self) -> float:
+        """:math:`\\mu_{ref} = \\max(\\mu_x, \\mu_y)`: the bound :math:`c_T d^{m_T}` is
+        :math:`\\mu_{ref} p_n`."""
+        return max(self.mu_x, self.mu_y)
+
+    def _coefficients(self, count: int) -> tuple[float, ...]:
+        check("w", f"{count} tangent components", count in (1, 2),
+              "the slip needs 1 or 2 components in the frame (give a frame for 3D vectors)")
+        return (self.mu_x, self.mu_y)[:count]
+
+    def coefficient(self, w: typing.Any) -> Scalar:
+        """:math:`\\mu(\\theta)` along the tangent direction of ``w``: the radius of the slip
+        surface there per unit p_n, :math:`|w| / |A^{-1} w|` (μ_ref at w = 0)."""
+        components = _components(w, self.frame)
+        mu = self._coefficients(len(components))
+        r2 = sum(c**2 for c in components)
+        s2 = sum((c / m) ** 2 for c, m in zip(components, mu, strict=True))
+        if _is_ufl(s2):
+            # a conditional, not a guarded ratio: at w = 0 the ratio's derivative is 0/0 (see
+            # abs_c1_derivative), a conditional's unused branch is never evaluated
+            return ufl.conditional(ufl.gt(s2, 0), ufl.sqrt(r2 / s2), self.mu_ref)
+        return np.where(s2 > 0, np.sqrt(r2 / np.where(s2 > 0, s2, 1.0)), self.mu_ref)
+
+    def slip_function(self, p: typing.Any, p_n: Scalar) -> Scalar:
+        """Kalker's (1986, eq. 46) slip function
+        :math:`g = \\sqrt{(p_1/\\mu_x)^2 + (p_2/\\mu_y)^2} - p_n` of the friction resistance
+        :math:`p = -t` (≤ 0; = 0 on the slip surface)."""
+        components = _components(p, self.frame)
+        mu = self._coefficients(len(components))
+        return _sqrt(sum((c / m) ** 2 for c, m in zip(components, mu, strict=True))) - p_n
+
+    def traction(self, bound: Scalar, w: typing.Any, eps: Scalar,
+                 regularisation: str = "c1") -> typing.Any:
+        """The regularised traction on the body at slip velocity ``w``.
+
+        Args:
+            bound: the friction bound :math:`c_T d^{m_T} = \\mu_{ref} p_n`.
+            w: the slip velocity: a UFL vector or a NumPy array (last axis: components), in
+                the global frame when :attr:`frame` is given, else in (t1, t2).
+            eps: regularisation parameter ε.
+            regularisation: ``"c1"`` or ``"smooth"`` (:data:`REGULARISATIONS`).
+
+        Returns:
+            The traction, a vector like ``w`` (tangent to Γ_C).
+        """
+        components = _components(w, self.frame)
+        scale = [m / self.mu_ref for m in self._coefficients(len(components))]
+        if self.associated:
+            # -∂D_ε/∂w with D_ε = bound φ_ε(A w / μ_ref): the chain rule's A / μ_ref
+            z = [k * c for k, c in zip(scale, components, strict=True)]
+            direction = [k * c for k, c in zip(scale, _direction(z, eps, regularisation),
+                                                strict=True)]
+        else:
+            ratio = self.coefficient(w) / self.mu_ref
+            direction = [ratio * c for c in _direction(components, eps, regularisation)]
+        return -bound * _vector(direction, self.frame)
+
+
+SlipRule = CoulombSlipRule | EllipticSlipRule
+SLIP_RULES = (CoulombSlipRule, EllipticSlipRule)
+"""The slip rules :func:`friction_traction` takes."""
+
+
 # --- the interface tractions (Martins & Oden 1986, eqs. 1-2) --------------------------------------
 
 def normal_traction(d: Scalar, c_n: Scalar, m_n: Scalar, approach_rate: Scalar = 0.0,
@@ -211,7 +407,8 @@ def is_speed_law(c_T: typing.Any) -> bool:
 
 
 def friction_traction(d: Scalar, w: typing.Any, c_T: typing.Any, m_T: Scalar, eps: Scalar,
-                      regularisation: str = "c1") -> typing.Any:
+                      regularisation: str = "c1", slip_rule: SlipRule | None = None
+                      ) -> typing.Any:
     """Regularised friction traction on the body :math:`-c_T d^{m_T} \\phi_\\varepsilon'(w)`.
 
     Args:
@@ -224,17 +421,23 @@ def friction_traction(d: Scalar, w: typing.Any, c_T: typing.Any, m_T: Scalar, ep
         m_T: friction exponent.
         eps: regularisation parameter ε.
         regularisation: ``"c1"`` or ``"smooth"`` (:data:`REGULARISATIONS`).
+        slip_rule: the slip surface and rule (:data:`SLIP_RULES`); ``None``: isotropic
+            Coulomb, :class:`CoulombSlipRule`. An :class:`EllipticSlipRule` reads the bound
+            :math:`c_T d^{m_T}` as :math:`\\mu_{ref} p_n`.
 
     Returns:
-        The traction, a vector like ``w`` opposing the slip (Martins & Oden 1986, eq. 2).
+        The traction, a vector like ``w`` opposing the slip (Martins & Oden 1986, eq. 2), or
+        the one of ``slip_rule``.
     """
+    check("slip_rule", slip_rule, slip_rule is None or isinstance(slip_rule, SLIP_RULES),
+          f"must be None or one of {', '.join(r.__name__ for r in SLIP_RULES)}")
     if is_speed_law(c_T):
         c_T = c_T(_norm(w))
-    direction = REGULARISATIONS[regularisation][1](w, eps)
     bound = friction_bound(d, c_T, m_T)
     if _is_ufl(bound):  # labelled, so that a solver can freeze or mollify it
         bound = ufl.classes.Variable(bound, FRICTION_BOUND)
-    return -bound * direction
+    rule = CoulombSlipRule() if slip_rule is None else slip_rule
+    return rule.traction(bound, w, eps, regularisation)
 
 
 # --- velocity-dependent friction coefficients ---------------------------------------------------

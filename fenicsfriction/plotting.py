@@ -15,10 +15,10 @@ from fenicsfriction import _compat
 PathLike = str | os.PathLike
 
 __all__ = ["body_cells", "cell_outlines", "plot_contact_deformed", "plot_contact_pressure",
-           "plot_contact_traction", "plot_creep_curves", "plot_deformed", "plot_growth", "plot_loci",
-           "plot_oscillator", "plot_rolling_traction_line", "plot_rolling_traction_map",
-           "plot_stability_map", "plot_steady_forces", "plot_stick_slip",
-           "plot_stroboscopic_growth"]
+           "plot_contact_traction", "plot_creep_curves", "plot_deformed", "plot_growth",
+           "plot_loci", "plot_oscillator", "plot_rolling_traction_line",
+           "plot_rolling_traction_map", "plot_stability_map", "plot_steady_forces",
+           "plot_stick_slip", "plot_stroboscopic_growth"]
 
 
 def _pyplot() -> typing.Any:
