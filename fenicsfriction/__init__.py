@@ -25,7 +25,7 @@ except _metadata.PackageNotFoundError:  # running from a source tree
 _EXPORTS: dict[str, str] = {
     # pointwise laws (NumPy and UFL)
     "InterfaceLaw": "laws", "ConstantFriction": "laws", "PiecewiseLinearFriction": "laws",
-    "StribeckFriction": "laws",
+    "StribeckFriction": "laws", "CoulombSlipRule": "laws", "EllipticSlipRule": "laws",
     # the one residual
     "Residual": "forms", "NodalSpring": "forms",
     # solvers on the finite element residual
@@ -35,6 +35,8 @@ _EXPORTS: dict[str, str] = {
     "EigenSolveError": "stability", "unstable_intervals": "stability", "Onset": "stability",
     "DynamicsSolver": "dynamics", "CentralDifference": "dynamics",
     "DynamicsError": "timestepping",
+    "PanagiotopoulosSolver": "panagiotopoulos", "ProcessError": "panagiotopoulos",
+    "ProcessReport": "panagiotopoulos", "SurfaceMollifier": "mollification",
     # post-processing and output
     "stick_slip_statistics": "statistics", "StickSlipStatistics": "statistics",
     "mode_intervals": "statistics", "limit_cycle": "statistics", "LimitCycle": "statistics",
@@ -44,7 +46,7 @@ _EXPORTS: dict[str, str] = {
     "StopSignals": "signals", "Interrupted": "signals",
     # scenes
     "BlockData": "scenes", "BlockOnBelt": "scenes", "BlockModel": "scenes",
-    "BlockOnSlab": "scenes", "SlabModel": "scenes",
+    "BlockOnSlab": "scenes", "SlabModel": "scenes", "LayeredBlockOnBelt": "scenes.block",
     "Hertz": "scenes.contact.validation", "Patch": "scenes.contact.validation",
     "Cattaneo": "scenes.contact.validation", "TwoBodyModel": "scenes.contact.model",
     "PressAndDrag": "scenes.contact.impact",
@@ -61,11 +63,14 @@ _EXPORTS: dict[str, str] = {
     "integrate_hybrid": "reduced", "HybridError": "reduced", "HybridResult": "reduced",
     "BeltResult": "reduced", "AveragedStability": "reduced.slider",
     "FloquetStability": "reduced.slider", "StabilityMap": "reduced.slider",
+    "fastsim": "reduced.rolling.fastsim", "creep_curve": "reduced.rolling",
+    "linear_theory": "reduced.rolling", "creep_coefficients": "reduced.rolling",
+    "HertzEllipse": "reduced.rolling", "FastsimResult": "reduced.rolling",
 }
 
-_SUBMODULES = ("contact", "dynamics", "forms", "io", "laws", "numerics", "plotting", "reduced",
-               "results", "scenes", "signals", "stability", "statistics", "steady",
-               "timestepping")
+_SUBMODULES = ("contact", "dynamics", "forms", "io", "laws", "mollification", "numerics",
+               "panagiotopoulos", "plotting", "reduced", "results", "scenes", "signals",
+               "stability", "statistics", "steady", "timestepping")
 
 __getattr__, __dir__, __all__ = attach(__name__, _EXPORTS, _SUBMODULES)
 __all__.append("__version__")  # the same list __dir__ returns
@@ -77,7 +82,9 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers and IDEs
         forms,
         io,
         laws,
+        mollification,
         numerics,
+        panagiotopoulos,
         plotting,
         reduced,
         results,
@@ -93,11 +100,15 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers and IDEs
     from fenicsfriction.forms import NodalSpring, Residual
     from fenicsfriction.laws import (
         ConstantFriction,
+        CoulombSlipRule,
+        EllipticSlipRule,
         InterfaceLaw,
         PiecewiseLinearFriction,
         StribeckFriction,
     )
+    from fenicsfriction.mollification import SurfaceMollifier
     from fenicsfriction.numerics import bisect, dense_eigenvalues
+    from fenicsfriction.panagiotopoulos import PanagiotopoulosSolver, ProcessError, ProcessReport
     from fenicsfriction.reduced import (
         BeltOscillator,
         BeltResult,
@@ -114,6 +125,14 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers and IDEs
         table2_slider,
     )
     from fenicsfriction.reduced.rigid_block import RigidLoci, rigid_loci
+    from fenicsfriction.reduced.rolling import (
+        FastsimResult,
+        HertzEllipse,
+        creep_coefficients,
+        creep_curve,
+        linear_theory,
+    )
+    from fenicsfriction.reduced.rolling.fastsim import fastsim
     from fenicsfriction.reduced.slider import AveragedStability, FloquetStability, StabilityMap
     from fenicsfriction.results import CsvRows, Record, get_logger, write_json
     from fenicsfriction.scenes import BlockData, BlockModel, BlockOnBelt, BlockOnSlab, SlabModel
@@ -122,6 +141,7 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers and IDEs
         CentreOfMass,
         ContactStates,
         Energies,
+        LayeredBlockOnBelt,
         Powers,
         ProbeValues,
     )
