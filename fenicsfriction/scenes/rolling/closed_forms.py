@@ -7,13 +7,15 @@ radius of curvature :math:`1/R = 1/R_1 + 1/R_2` (two cylinders of radius :math:`
 
 * Carter's rolling cylinders (Carter 1926, "On the action of a locomotive driving wheel";
   Johnson 1985, *Contact Mechanics*, section 8.3), derived here for the conventions of the
-  package: rolling in +x, leading edge at x = +a, slip :math:`s = \xi - \partial\Delta u_x/\partial x`.
+  package: rolling in +x, leading edge at x = +a, slip
+  :math:`s = \xi - \partial\Delta u_x/\partial x`.
   The traction on body 1 is :math:`q = -\mathrm{sgn}(\xi)\mu p_0 [\sqrt{1 - x^2/a^2} -
   (c/a)\sqrt{1 - (x - a + c)^2/c^2}]`: the second term alone is the stick zone's,
   :math:`a - 2c \le x \le a`. The half-plane's surface gradient under a tangential traction q
   (Johnson 1985, chapter 2), doubled for the pair, is :math:`\partial\Delta u_x/\partial x =
   -(2/(\pi E^*)) \int q(s)/(x - s) ds`, and with :math:`\int \sqrt{a^2 - s^2}/(x - s) ds = \pi x`
-  (|x| < a) it is constant over the stick zone, :math:`\mathrm{sgn}(\xi)\, 2\mu p_0 (a - c)/(a E^*)`;
+  (|x| < a) it is constant over the stick zone,
+  :math:`\mathrm{sgn}(\xi)\, 2\mu p_0 (a - c)/(a E^*)`;
   stick (s = 0) there and Hertz's :math:`p_0 = a E^*/(2R)` give
   :math:`|\xi| = (\mu a/R)(1 - c/a)` and the force :math:`F_x = -\mathrm{sgn}(\xi)\mu P
   (1 - c^2/a^2)`, :math:`P = \pi a p_0/2`. Small creepage: :math:`F_x = -(\pi/2) a E^* \xi`.

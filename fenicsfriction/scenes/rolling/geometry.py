@@ -134,7 +134,8 @@ def half_space(comm: MPI.Comm, dim: int, zone: typing.Sequence[float], h: float,
             entity = [out[1]]  # the extruded entity (out[0] is the translated copy)
         geo.synchronize()
         body = entity[0][1]
-        top, far = [], []
+        top: list[int] = []
+        far: list[int] = []
         for _, face in gmsh.model.getBoundary([(dim, body)], oriented=False):
             box = gmsh.model.getBoundingBox(dim - 1, face)
             flat_top = abs(box[dim - 1]) < 1e-9 * length and abs(box[dim + 2]) < 1e-9 * length
