@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from fenicsfriction.scenes.rolling import closed_forms
-from fenicsfriction.scenes.rolling.model import RollingContact
+from fenicsfriction.scenes.rolling.model import RollingContact, write_xdmf
 
 #: Carter's problem: μ p0/G = 3e-3, saturation at ξ = μ a/R = 6e-3 (ν = 0)
 CARTER = {"dim": 2, "nu": 0.0, "mu": 0.3, "p0": 0.01, "block_size": 100.0}
@@ -154,3 +154,13 @@ def test_parallel_solve_matches_the_serial_one():
     assert here.Fx == pytest.approx(alone.Fx, rel=1e-6)
     assert here.adhesion_fraction == pytest.approx(alone.adhesion_fraction, abs=1e-12)
     assert np.allclose(here.traction, alone.traction, atol=1e-8)
+
+
+def test_xdmf_holds_the_displacement_and_the_traction(shared_tmp_path):
+    scene = RollingContact(**CARTER, cells_per_a=4, eps=(10.0, 1.0))
+    model = scene.build()
+    model.solve((3e-3, 0.0, 0.0))
+    path = shared_tmp_path / "rolling.xdmf"
+    write_xdmf(path, model)
+    text = path.read_text()
+    assert 'Name="displacement"' in text and 'Name="contact_traction"' in text
