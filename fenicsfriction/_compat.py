@@ -83,15 +83,21 @@ class _QuietArrayMetadata(logging.Filter):
 _QUIET_ARRAY_METADATA = _QuietArrayMetadata()
 
 
-def nodal_quadrature(facet_dim: int) -> dict:
+def nodal_quadrature(facet_dim: int, simplex: bool = True) -> dict:
     """Integral metadata of the nodal (trapezoidal) rule on facets: the facet's vertices with
     equal weights. FFCx's ``"vertex"`` rule is for cell integrals only, so the points are given
-    as a ``"custom"`` rule on the reference facet (an interval or a triangle)."""
+    as a ``"custom"`` rule on the reference facet (an interval or a triangle; with
+    ``simplex=False`` in 3D, the unit square of a hexahedron's facet)."""
     # UFL 2022 logs the notice, UFL 2024 warns it; neither call adds a filter twice
     logging.getLogger("UFL").addFilter(_QUIET_ARRAY_METADATA)
     warnings.filterwarnings("ignore", message=".*metadata value of type ndarray")
-    points = np.vstack([np.zeros(facet_dim), np.eye(facet_dim)])
-    weights = np.full(facet_dim + 1, 1.0 / math.factorial(facet_dim) / (facet_dim + 1))
+    if simplex or facet_dim == 1:
+        points = np.vstack([np.zeros(facet_dim), np.eye(facet_dim)])
+        volume = 1.0 / math.factorial(facet_dim)
+    else:
+        points = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
+        volume = 1.0
+    weights = np.full(len(points), volume / len(points))
     return {"quadrature_rule": "custom", "quadrature_degree": 1,
             "quadrature_points": points, "quadrature_weights": weights}
 

@@ -1,0 +1,141 @@
+r"""Closed forms of the rolling and shift scenes (two identical elastic bodies).
+
+Notation: :math:`G, \nu` the bodies' shear modulus and Poisson ratio, :math:`E^*` the contact
+modulus of the pair, :math:`1/E^* = 2(1-\nu^2)/E`, i.e. :math:`E^* = G/(1-\nu)`; R the relative
+radius of curvature :math:`1/R = 1/R_1 + 1/R_2` (two cylinders of radius :math:`R_1`:
+:math:`R = R_1/2`); a (b) the contact's semi-axis along (across) the rolling direction x.
+
+* Carter's rolling cylinders (Carter 1926, "On the action of a locomotive driving wheel";
+  Johnson 1985, *Contact Mechanics*, section 8.3), derived here for the conventions of the
+  package: rolling in +x, leading edge at x = +a, slip
+  :math:`s = \xi - \partial\Delta u_x/\partial x`.
+  The traction on body 1 is :math:`q = -\mathrm{sgn}(\xi)\mu p_0 [\sqrt{1 - x^2/a^2} -
+  (c/a)\sqrt{1 - (x - a + c)^2/c^2}]`: the second term alone is the stick zone's,
+  :math:`a - 2c \le x \le a`. The half-plane's surface gradient under a tangential traction q
+  (Johnson 1985, chapter 2), doubled for the pair, is :math:`\partial\Delta u_x/\partial x =
+  -(2/(\pi E^*)) \int q(s)/(x - s) ds`, and with :math:`\int \sqrt{a^2 - s^2}/(x - s) ds = \pi x`
+  (|x| < a) it is constant over the stick zone,
+  :math:`\mathrm{sgn}(\xi)\, 2\mu p_0 (a - c)/(a E^*)`;
+  stick (s = 0) there and Hertz's :math:`p_0 = a E^*/(2R)` give
+  :math:`|\xi| = (\mu a/R)(1 - c/a)` and the force :math:`F_x = -\mathrm{sgn}(\xi)\mu P
+  (1 - c^2/a^2)`, :math:`P = \pi a p_0/2`. Small creepage: :math:`F_x = -(\pi/2) a E^* \xi`.
+* Cattaneo-Mindlin's shifted spheres (Cattaneo 1938; Mindlin 1949; Johnson 1985, section
+  7.2): under a monotonically rising tangential force Q the stick disc has the radius
+  :math:`c = a(1 - Q/(\mu P))^{1/3}` and the traction :math:`\mu p_0 [\sqrt{1 - r^2/a^2} -
+  (c/a)\sqrt{1 - r^2/c^2}]` along Q, exact for ν = 0 (for ν ≠ 0 it neglects the traction
+  perpendicular to Q that the stick condition needs).
+* Kalker's creepage coefficients of the linear theory (full adhesion, Kalker 1990,
+  *Three-dimensional elastic bodies in rolling contact*, Table E.3): :math:`F_x = -G ab
+  C_{11}\xi`, :math:`F_y = -G ab (C_{22}\eta + \sqrt{ab} C_{23}\phi)`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from fenicsfriction.laws import check, check_positive
+
+__all__ = ["KALKER_TABLE_A_OVER_B", "carter_force", "carter_stick_half_width",
+           "carter_traction", "contact_modulus", "ellipse_load", "ellipse_pressure",
+           "hertz_line_radius", "kalker_coefficients", "mindlin_stick_radius",
+           "mindlin_traction"]
+
+#: the a/b values (a <= b) of Kalker's table (Kalker 1990, Table E.3, first half)
+KALKER_TABLE_A_OVER_B = tuple(round(0.1 * k, 1) for k in range(1, 11))
+
+#: Kalker 1990, Table E.3 (a <= b): per a/b, (C11, C22, C23) for ν = 0, 0.25, 0.5
+_KALKER = {
+    0.1: ((2.51, 3.31, 4.85), (2.51, 2.52, 2.53), (0.334, 0.473, 0.731)),
+    0.2: ((2.59, 3.37, 4.81), (2.59, 2.63, 2.66), (0.483, 0.603, 0.809)),
+    0.3: ((2.68, 3.44, 4.80), (2.68, 2.75, 2.81), (0.607, 0.715, 0.889)),
+    0.4: ((2.78, 3.53, 4.82), (2.78, 2.88, 2.98), (0.720, 0.823, 0.977)),
+    0.5: ((2.88, 3.62, 4.83), (2.88, 3.01, 3.14), (0.827, 0.929, 1.07)),
+    0.6: ((2.98, 3.72, 4.91), (2.98, 3.14, 3.31), (0.930, 1.03, 1.18)),
+    0.7: ((3.09, 3.81, 4.97), (3.09, 3.28, 3.48), (1.03, 1.14, 1.29)),
+    0.8: ((3.19, 3.91, 5.05), (3.19, 3.41, 3.65), (1.13, 1.25, 1.40)),
+    0.9: ((3.29, 4.01, 5.12), (3.29, 3.54, 3.82), (1.23, 1.36, 1.51)),
+    1.0: ((3.40, 4.12, 5.20), (3.40, 3.67, 3.98), (1.33, 1.47, 1.63)),
+}
+_KALKER_NU = (0.0, 0.25, 0.5)
+
+
+def contact_modulus(G: float, nu: float) -> float:
+    """:math:`E^* = G/(1-\\nu)` of two identical bodies (:math:`1/E^* = 2(1-\\nu^2)/E`)."""
+    check_positive("G", G)
+    check("nu", nu, -1 < nu < 0.5, "Poisson's ratio must be in (-1, 0.5)")
+    return G / (1 - nu)
+
+
+def hertz_line_radius(a: float, p0: float, E_star: float) -> float:
+    """The relative radius R of the cylinders whose Hertz contact has half-width a and peak
+    pressure p0: :math:`p_0 = a E^*/(2R)` (Johnson 1985, chapter 4)."""
+    for name, value in (("a", a), ("p0", p0), ("E_star", E_star)):
+        check_positive(name, value)
+    return a * E_star / (2 * p0)
+
+
+def ellipse_pressure(x: np.ndarray, y: np.ndarray | float, a: float, b: float,
+                     p0: float) -> np.ndarray:
+    """Hertz's :math:`p_0\\sqrt{1 - x^2/a^2 - y^2/b^2}`, 0 outside (2D: y = 0, any b)."""
+    r2 = (np.asarray(x) / a) ** 2 + (np.asarray(y) / b) ** 2
+    return p0 * np.sqrt(np.clip(1 - r2, 0.0, None))
+
+
+def ellipse_load(a: float, b: float | None, p0: float) -> float:
+    """The total force of Hertz's pressure: :math:`2\\pi a b p_0/3` on an ellipse,
+    :math:`\\pi a p_0/2` per unit length on a strip (``b=None``)."""
+    return math.pi * a * p0 / 2 if b is None else 2 * math.pi * a * b * p0 / 3
+
+
+def carter_stick_half_width(creepage: float, mu: float, a: float, R: float) -> float:
+    """The stick zone's half-width :math:`c = a - |\\xi| R/\\mu` (0 once it has vanished:
+    full slip from :math:`|\\xi| = \\mu a/R`)."""
+    check_positive("mu", mu)
+    return max(a - abs(creepage) * R / mu, 0.0)
+
+
+def carter_force(creepage: float, mu: float, a: float, p0: float, R: float) -> float:
+    """Carter's longitudinal force per unit length on body 1,
+    :math:`-\\mathrm{sgn}(\\xi)\\mu P (1 - c^2/a^2)`."""
+    c = carter_stick_half_width(creepage, mu, a, R)
+    return -float(np.sign(creepage)) * mu * ellipse_load(a, None, p0) * (1 - (c / a) ** 2)
+
+
+def carter_traction(x: np.ndarray, creepage: float, mu: float, a: float, p0: float,
+                    R: float) -> np.ndarray:
+    """Carter's traction on body 1 at x (0 outside the contact)."""
+    c = carter_stick_half_width(creepage, mu, a, R)
+    q = ellipse_pressure(x, 0.0, a, 1.0, p0)
+    if c > 0:
+        q = q - (c / a) * ellipse_pressure(np.asarray(x) - (a - c), 0.0, c, 1.0, p0)
+    return -float(np.sign(creepage)) * mu * q
+
+
+def mindlin_stick_radius(a: float, q_ratio: float) -> float:
+    """Cattaneo-Mindlin's stick radius :math:`c = a(1 - Q/(\\mu P))^{1/3}`."""
+    check("q_ratio", q_ratio, 0 <= q_ratio <= 1, "Q/(mu P) must be in [0, 1]")
+    return a * (1 - q_ratio) ** (1 / 3)
+
+
+def mindlin_traction(r: np.ndarray, a: float, p0: float, mu: float,
+                     q_ratio: float) -> np.ndarray:
+    """Cattaneo-Mindlin's traction along Q at the distance r from the centre."""
+    c = mindlin_stick_radius(a, q_ratio)
+    q = mu * ellipse_pressure(r, 0.0, a, 1.0, p0)
+    if c > 0:
+        q = q - mu * (c / a) * ellipse_pressure(r, 0.0, c, 1.0, p0)
+    return q
+
+
+def kalker_coefficients(a_over_b: float, nu: float) -> tuple[float, float, float]:
+    """(C11, C22, C23) of Kalker's table (Kalker 1990, Table E.3) at a tabulated a/b <= 1
+    (:data:`KALKER_TABLE_A_OVER_B`) and ν in {0, 0.25, 0.5}; no interpolation."""
+    key = round(a_over_b, 6)
+    check("a_over_b", a_over_b, key in _KALKER,
+          f"one of the tabulated {', '.join(map(str, KALKER_TABLE_A_OVER_B))}")
+    check("nu", nu, nu in _KALKER_NU, "one of the tabulated 0, 0.25, 0.5")
+    column = _KALKER_NU.index(nu)
+    c11, c22, c23 = (row[column] for row in _KALKER[key])
+    return c11, c22, c23
