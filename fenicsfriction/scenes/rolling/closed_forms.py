@@ -24,9 +24,9 @@ radius of curvature :math:`1/R = 1/R_1 + 1/R_2` (two cylinders of radius :math:`
   :math:`c = a(1 - Q/(\mu P))^{1/3}` and the traction :math:`\mu p_0 [\sqrt{1 - r^2/a^2} -
   (c/a)\sqrt{1 - r^2/c^2}]` along Q, exact for ν = 0 (for ν ≠ 0 it neglects the traction
   perpendicular to Q that the stick condition needs).
-* Kalker's creepage coefficients of the linear theory (full adhesion, Kalker 1990,
-  *Three-dimensional elastic bodies in rolling contact*, Table E.3): :math:`F_x = -G ab
-  C_{11}\xi`, :math:`F_y = -G ab (C_{22}\eta + \sqrt{ab} C_{23}\phi)`.
+
+Kalker's creepage coefficients of the linear theory (:math:`F_x = -G ab C_{11}\xi`, ...) are
+in :mod:`fenicsfriction.reduced.rolling.kalker`.
 """
 
 from __future__ import annotations
@@ -37,29 +37,9 @@ import numpy as np
 
 from fenicsfriction.laws import check, check_positive
 
-__all__ = ["KALKER_TABLE_A_OVER_B", "carter_force", "carter_stick_half_width",
-           "carter_traction", "contact_modulus", "ellipse_load", "ellipse_pressure",
-           "hertz_line_radius", "kalker_coefficients", "mindlin_stick_radius",
+__all__ = ["carter_force", "carter_stick_half_width", "carter_traction", "contact_modulus",
+           "ellipse_load", "ellipse_pressure", "hertz_line_radius", "mindlin_stick_radius",
            "mindlin_traction"]
-
-#: the a/b values (a <= b) of Kalker's table (Kalker 1990, Table E.3, first half)
-KALKER_TABLE_A_OVER_B = tuple(round(0.1 * k, 1) for k in range(1, 11))
-
-#: Kalker 1990, Table E.3 (a <= b): per a/b, (C11, C22, C23) for ν = 0, 0.25, 0.5
-_KALKER = {
-    0.1: ((2.51, 3.31, 4.85), (2.51, 2.52, 2.53), (0.334, 0.473, 0.731)),
-    0.2: ((2.59, 3.37, 4.81), (2.59, 2.63, 2.66), (0.483, 0.603, 0.809)),
-    0.3: ((2.68, 3.44, 4.80), (2.68, 2.75, 2.81), (0.607, 0.715, 0.889)),
-    0.4: ((2.78, 3.53, 4.82), (2.78, 2.88, 2.98), (0.720, 0.823, 0.977)),
-    0.5: ((2.88, 3.62, 4.83), (2.88, 3.01, 3.14), (0.827, 0.929, 1.07)),
-    0.6: ((2.98, 3.72, 4.91), (2.98, 3.14, 3.31), (0.930, 1.03, 1.18)),
-    0.7: ((3.09, 3.81, 4.97), (3.09, 3.28, 3.48), (1.03, 1.14, 1.29)),
-    0.8: ((3.19, 3.91, 5.05), (3.19, 3.41, 3.65), (1.13, 1.25, 1.40)),
-    0.9: ((3.29, 4.01, 5.12), (3.29, 3.54, 3.82), (1.23, 1.36, 1.51)),
-    1.0: ((3.40, 4.12, 5.20), (3.40, 3.67, 3.98), (1.33, 1.47, 1.63)),
-}
-_KALKER_NU = (0.0, 0.25, 0.5)
-
 
 def contact_modulus(G: float, nu: float) -> float:
     """:math:`E^* = G/(1-\\nu)` of two identical bodies (:math:`1/E^* = 2(1-\\nu^2)/E`)."""
@@ -128,14 +108,3 @@ def mindlin_traction(r: np.ndarray, a: float, p0: float, mu: float,
         q = q - mu * (c / a) * ellipse_pressure(r, 0.0, c, 1.0, p0)
     return q
 
-
-def kalker_coefficients(a_over_b: float, nu: float) -> tuple[float, float, float]:
-    """(C11, C22, C23) of Kalker's table (Kalker 1990, Table E.3) at a tabulated a/b <= 1
-    (:data:`KALKER_TABLE_A_OVER_B`) and ν in {0, 0.25, 0.5}; no interpolation."""
-    key = round(a_over_b, 6)
-    check("a_over_b", a_over_b, key in _KALKER,
-          f"one of the tabulated {', '.join(map(str, KALKER_TABLE_A_OVER_B))}")
-    check("nu", nu, nu in _KALKER_NU, "one of the tabulated 0, 0.25, 0.5")
-    column = _KALKER_NU.index(nu)
-    c11, c22, c23 = (row[column] for row in _KALKER[key])
-    return c11, c22, c23
