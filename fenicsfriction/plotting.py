@@ -469,9 +469,12 @@ def plot_rolling_traction_map(x: np.ndarray, y: np.ndarray, px: np.ndarray, py: 
                               path: PathLike, title: str) -> None:
     """An elliptic contact in steady rolling (3D): the traction's share of its bound
     |p_τ|/(μ p_n) in colour at the points (x, y), the traction as arrows, the adhesion
-    points ringed and the contact ellipse (a along x, b along y) drawn. Call on rank 0."""
+    points ringed and the contact ellipse (a along x, b along y) drawn; points where the bound
+    is zero (outside the contact) are left out. Call on rank 0."""
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(7.0, float(np.clip(5.0 * b / a, 3.5, 7.5))))
+    inside = bound > 0  # the contact area: where the pressure is positive
+    x, y, px, py, bound, adhesion = (v[inside] for v in (x, y, px, py, bound, adhesion))
     share = np.divide(np.hypot(px, py), bound, out=np.zeros_like(bound), where=bound > 0)
     dots = ax.scatter(x, y, c=share, s=12, cmap="viridis", vmin=0.0, vmax=1.0)
     stuck = adhesion.astype(bool)

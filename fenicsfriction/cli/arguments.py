@@ -333,11 +333,17 @@ def _rolling_flags() -> argparse.ArgumentParser:
     fe = flags.add_argument_group("fe (Kalker's complete theory by finite elements)")
     fe.add_argument("--dim", type=int, choices=[2, 3], default=3,
                     help="2: Carter's cylinders (plane strain); 3: the Hertzian ellipse (3)")
-    fe.add_argument("--refine", type=int, help="mesh refinement level (each halves the element "
-                                               "size at the contact)")
+    fe.add_argument("--cells-per-a", type=int,
+                    help="cells over the semi-axis a in the contact zone (8)")
+    fe.add_argument("--block-size", type=float,
+                    help="the half-space block's half-width and depth over a (20)")
+    fe.add_argument("--normal", choices=["hertz", "contact"], dest="normal",
+                    help="2D: Hertz's pressure, or a frictionless contact against a rigid "
+                         "parabola (hertz)")
     fe.add_argument("--eps-sequence", type=floats, metavar="E1,E2,...",
                     help="Kalker's sequential process: the regularisation ε of the slip, "
-                         "decreasing, each solve from the previous one")
+                         "relative to the creepage, decreasing, each solve from the previous "
+                         "one (10 down to 0.01 in steps of √10)")
     flags.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
     return flags
 

@@ -12,7 +12,6 @@ traction). Every point of a curve prints one progress line.
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import logging
 import pathlib
 import typing
@@ -29,7 +28,8 @@ __all__ = ["run_rolling"]
 
 
 #: the flags of each method's discretisation
-_METHOD_FLAGS = {"fastsim": ("nx", "ny", "pressure"), "fe": ("dim", "refine", "eps_sequence")}
+_METHOD_FLAGS = {"fastsim": ("nx", "ny", "pressure"),
+                 "fe": ("dim", "cells_per_a", "block_size", "normal", "eps_sequence")}
 
 
 def _parameters(args: argparse.Namespace) -> dict[str, typing.Any]:
@@ -38,6 +38,8 @@ def _parameters(args: argparse.Namespace) -> dict[str, typing.Any]:
     values = {k: getattr(args, k, None) for k in names}
     if values["b"] is None:
         values["b"] = values["a"]
+    if values.get("dim") == 2:  # a line contact: no lateral semi-axis
+        del values["b"]
     return {k: v for k, v in values.items() if v is not None}
 
 
@@ -81,32 +83,64 @@ def _fastsim_traction(result: typing.Any, p: dict, path: pathlib.Path) -> None:
 
 # --- the finite element complete theory -------------------------------------------------------
 
+def _cylinders(p: dict) -> tuple[float, float]:
+    """Hertz's peak pressure p0 and the relative radius R of Carter's cylinders (2D)."""
+    from fenicsfriction.scenes.rolling import RollingContact
+
+    scene = RollingContact(dim=2, a=p["a"], G=p["G"], nu=p["nu"], mu=p["mu"], Fn=p["Fn"])
+    return scene.peak_pressure, scene.radius
+
+
 def _fe_model(args: argparse.Namespace, comm: MPI.Comm) -> typing.Any:
     """The finite element model of the flags' contact (built once, re-solved per creepage)."""
     from fenicsfriction.scenes.rolling import RollingContact
 
     p = _parameters(args)
-    fields = {f.name for f in dataclasses.fields(RollingContact)}
-    scene = RollingContact(**{k: v for k, v in p.items() if k in fields})
+    renamed = {"normal": "pressure", "eps_sequence": "eps"}
+    fields: dict[str, typing.Any] = {renamed.get(k, k): (tuple(v) if k == "eps_sequence" else v)
+                                     for k, v in p.items()}
+    scene = RollingContact(**fields)
     return scene.build(comm)
 
 
 def _fe_records(model: typing.Any, args: argparse.Namespace, xi: typing.Sequence[float],
                 log: logging.Logger) -> tuple[list, list]:
+    """(records, results) of the creepages ``xi`` in turn, each from the last."""
     p = _parameters(args)
     records, solutions = [], []
     for k, value in enumerate(xi):
-        solution = model.solve(xi=value, eta=args.eta, phi=args.phi)
+        solution = model.solve((value, args.eta, args.phi))
         log.info(f"point {k + 1}/{len(xi)}: ξ = {value:.4g}  Fx/(μFn) = "
                  f"{solution.Fx / (p['mu'] * solution.Fn):+.5f}  adhesion "
-                 f"{solution.adhesion_fraction:.3f}  Newton {solution.newton_iterations}  "
-                 f"{solution.wall_time_s:.1f} s")
+                 f"{solution.adhesion_fraction:.3f}  Newton {solution.newton_iterations} over "
+                 f"{len(solution.eps_records)} ε  {solution.wall_time_s:.1f} s")
         records.append(_record("fe", p, solution.Fx, solution.Fy, solution.Mz, solution.Fn,
                                (value, args.eta, args.phi), solution.adhesion_fraction,
                                solution.wall_time_s, newton_iterations=solution.newton_iterations,
-                               dofs=model.dofs))
+                               eps=solution.eps, dofs=model.dofs))
         solutions.append(solution)
     return records, solutions
+
+
+def _fe_traction(result: typing.Any, p: dict, dim: int, path: pathlib.Path) -> None:
+    """traction.png of a finite element solution: the line contact against Carter (2D), the
+    elliptic map (3D)."""
+    xi = result.creepage[0]
+    title = (f"complete theory (FE): ξ = {xi:.4g}; Fx/(μFn) = "
+             f"{result.Fx / (p['mu'] * result.Fn):.4f}, adhesion {result.adhesion_fraction:.1%}")
+    bound = p["mu"] * result.pressure
+    if dim == 2:
+        from fenicsfriction.scenes.rolling import closed_forms
+        p0, radius = _cylinders(p)
+        grid = np.linspace(-p["a"], p["a"], 401)
+        exact = (grid, closed_forms.carter_traction(grid, xi, p["mu"], p["a"], p0, radius),
+                 "Carter (1926)")
+        plotting.plot_rolling_traction_line(result.x[:, 0], result.traction[:, 0], bound,
+                                            result.stick(), path, title, exact)
+    else:
+        plotting.plot_rolling_traction_map(
+            result.x[:, 0], result.x[:, 1], result.traction[:, 0], result.traction[:, 1], bound,
+            result.stick(), p["a"], p["b"], path, title.replace("; ", ";\n"))
 
 
 # --- outputs ------------------------------------------------------------------------------------
@@ -135,8 +169,9 @@ def _creep_curve_png(records: list[dict], args: argparse.Namespace, path: pathli
             curves.append((fine, linear, "Kalker's linear theory (C11), clipped at μFn", "k:"))
     else:
         from fenicsfriction.scenes.rolling.closed_forms import carter_force
-        curves.append((fine, carter_force(fine, p["a"], p["G"], p["nu"], p["mu"], p["Fn"])
-                       / scale, "Carter (1926)", "k-"))
+        p0, radius = _cylinders(p)
+        curves.append((fine, np.array([carter_force(x, p["mu"], p["a"], p0, radius)
+                                       for x in fine]) / scale, "Carter (1926)", "k-"))
     plotting.plot_creep_curves(
         curves, path, "longitudinal creepage ξ", "Fx / (μ Fn)",
         f"creep-force curve: a = {p['a']:.4g}, b = {p['b']:.4g}, ν = {p['nu']:g}, "
@@ -186,8 +221,10 @@ def run_rolling(args: argparse.Namespace, log: logging.Logger) -> int:
                 "method": "fe", "parameters": _parameters(args), "failure": str(err)}, comm)
             stop_line(f"rolling fe: {err}", comm)
             return 1
-        model.write_xdmf(out / "rolling.xdmf")
-        model.plot_traction(solutions[-1], out / "traction.png")
+        from fenicsfriction.scenes.rolling import write_xdmf
+        write_xdmf(out / "rolling.xdmf", model)
+        if comm.rank == 0:
+            _fe_traction(solutions[-1], _parameters(args), model.dim, out / "traction.png")
         written = ["rolling.json", "traction.png", "rolling.xdmf"]
     _write(out, records, curve, comm)
     if curve:
