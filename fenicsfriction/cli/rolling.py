@@ -174,7 +174,8 @@ def _creep_curve_png(records: list[dict], args: argparse.Namespace, path: pathli
                                        for x in fine]) / scale, "Carter (1926)", "k-"))
     plotting.plot_creep_curves(
         curves, path, "longitudinal creepage ξ", "Fx / (μ Fn)",
-        f"creep-force curve: a = {p['a']:.4g}, b = {p['b']:.4g}, ν = {p['nu']:g}, "
+        f"creep-force curve: a = {p['a']:.4g}"
+        + (f", b = {p['b']:.4g}" if "b" in p else " (line contact)") + f", ν = {p['nu']:g}, "
         f"μ = {p['mu']:g}, η = {args.eta:g}, φ = {args.phi:g}")
 
 
@@ -193,8 +194,28 @@ def _validate(args: argparse.Namespace) -> None:
     check("--mu", args.mu, np.isfinite(args.mu) and args.mu > 0, "must be a finite number > 0")
 
 
+#: the scenes' and models' parameter names whose flag is not ``--name``
+_FLAGS = {"eps": "--eps-sequence", "pressure": "--normal", "xi": "--xi", "eta": "--eta",
+          "phi": "--phi"}
+
+
+def _named_by_flag(message: str) -> str:
+    """A model's ``name=value is invalid: ...`` with ``name`` replaced by its flag."""
+    name = message.split("=", 1)[0]
+    if name.isidentifier():
+        return _FLAGS.get(name, flag(name)) + message[len(name):]
+    return message
+
+
 def run_rolling(args: argparse.Namespace, log: logging.Logger) -> int:
     """``rolling fastsim|fe|curve``: the creep forces, the traction, the outputs."""
+    try:
+        return _run(args, log)
+    except ValueError as err:  # the models name their parameters: name the flags
+        raise ValueError(_named_by_flag(str(err))) from None
+
+
+def _run(args: argparse.Namespace, log: logging.Logger) -> int:
     comm = MPI.COMM_WORLD
     _validate(args)
     curve = args.method == "curve"
