@@ -73,6 +73,10 @@ benchmark: setup
 	$(MPIRUN) $(PY) benchmarks/bench_scaling.py --out $(OUT)/benchmarks
 	$(PY) benchmarks/bench_getfem.py --out $(OUT)/benchmarks
 	$(PY) benchmarks/bench_contact.py --out $(OUT)/benchmarks
+	$(PY) benchmarks/bench_rolling.py --out $(OUT)/benchmarks
+	$(PY) benchmarks/bench_rolling_fe.py --out $(OUT)/benchmarks
+	$(PY) benchmarks/bench_rolling_methods.py --out $(OUT)/benchmarks
+	$(PY) benchmarks/bench_panagiotopoulos.py --out $(OUT)/benchmarks
 
 clean:
 	rm -rf .venv .venv-debian13 results *.egg-info
