@@ -12,11 +12,22 @@ import typing
 from petsc4py import PETSc
 
 import dolfinx.fem.petsc
+import numpy as np
 from dolfinx import fem
 
 from fenicsfriction import _compat
 
-__all__ = ["CoupledMatrix", "assemble_jacobian", "assemble_residual"]
+__all__ = ["CoupledMatrix", "assemble_jacobian", "assemble_owned", "assemble_residual"]
+
+
+def assemble_owned(form: typing.Any) -> np.ndarray:
+    """A linear form's assembled vector: its owned entries, the ghosts' contributions added
+    (a copy; e.g. nodal forces or the tributary areas of the nodes)."""
+    vector = dolfinx.fem.petsc.assemble_vector(form)
+    vector.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    values = vector.array_r.copy()
+    vector.destroy()
+    return values
 
 
 def assemble_residual(b: PETSc.Vec, L: fem.FormMetaClass, a: fem.FormMetaClass, bcs: list,

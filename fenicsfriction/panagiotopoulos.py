@@ -53,6 +53,7 @@ from ufl.corealg.multifunction import MultiFunction
 from ufl.corealg.traversal import unique_pre_traversal
 
 from fenicsfriction import _compat
+from fenicsfriction.assembly import assemble_owned
 from fenicsfriction.forms import Residual
 from fenicsfriction.laws import FRICTION_BOUND, check, check_positive
 from fenicsfriction.mollification import SurfaceMollifier
@@ -254,18 +255,10 @@ class PanagiotopoulosSolver:
         self._surface = dofs[dofs < S.dofmap.index_map.size_local]
         q = ufl.TestFunction(S)
         self._bound_form = _compat.form(self._bound * q * ds)
-        self._weights = self._assemble_owned(_compat.form(q * ds))[self._surface]
+        self._weights = assemble_owned(_compat.form(q * ds))[self._surface]
         points = S.tabulate_dof_coordinates()[self._surface, :msh.geometry.dim]
         self.mollifier = SurfaceMollifier(points, self._weights, radius, msh.comm)
         self.mollified_bound = fem.Function(S, name="mollified_bound")
-
-    @staticmethod
-    def _assemble_owned(form: typing.Any) -> np.ndarray:
-        vector = dolfinx.fem.petsc.assemble_vector(form)
-        vector.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        values = vector.array_r.copy()
-        vector.destroy()
-        return values
 
     def nodal_bound(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(coordinates, local bound c_T d^{m_T} at the current ``u``, the mollified bound
@@ -275,7 +268,7 @@ class PanagiotopoulosSolver:
         check("mollification_radius", 0.0, self.mollified_bound is not None,
               "nodal values are kept by a mollified solver (radius > 0)")
         assert self.mollified_bound is not None
-        local = self._assemble_owned(self._bound_form)[self._surface] / self._weights
+        local = assemble_owned(self._bound_form)[self._surface] / self._weights
         S = self.mollified_bound.function_space
         return (S.tabulate_dof_coordinates()[self._surface], local,
                 self.mollified_bound.x.array[self._surface].copy())

@@ -4,10 +4,9 @@ a bad value as one line and exit status 2. Serial and under ``mpirun -n 2``."""
 
 import json
 
-from mpi4py import MPI
-
 import numpy as np
 import pytest
+from cli_errors import assert_one_error_line
 
 from fenicsfriction.cli import main
 from fenicsfriction.reduced.rolling.kalker import creep_coefficients
@@ -89,13 +88,7 @@ def test_fe_carter_curve_against_the_closed_form(shared_tmp_path):
 def test_bad_value_is_one_line_naming_the_flag_and_exit_2(shared_tmp_path, capsys, argv, name):
     code = main(["rolling", *argv, "--out", str(shared_tmp_path / "bad")])
     assert code == 2
-    err = capsys.readouterr().err
-    lines = [line for line in err.splitlines() if "error" in line]
-    if MPI.COMM_WORLD.rank == 0:
-        assert len(lines) == 1 and lines[0].startswith("fenicsfriction: error: ")
-        assert f"{name}=" in lines[0], lines[0]
-    else:
-        assert not lines
+    assert_one_error_line(capsys.readouterr().err, name)
 
 
 @pytest.mark.parametrize("argv", [["rolling", "curve", *WHEEL, "--xi-range", "0:1"],

@@ -45,6 +45,7 @@ import ufl
 from dolfinx import fem, mesh
 
 from fenicsfriction import _compat, laws
+from fenicsfriction.assembly import assemble_owned
 from fenicsfriction.contact.kinematics import Projection, project
 from fenicsfriction.contact.pairing import Pairing, facet_nodes
 
@@ -207,7 +208,7 @@ class NodeToSegment:
     def nodal_weights(self) -> np.ndarray:
         """Each owned node's tributary length (2D) or area (3D) on the slave surface, 0 off
         it: the nodal rule's integral of the node's hat function."""
-        return _assemble_owned(_compat.form(ufl.TestFunction(self.nodal_space) * self.ds))
+        return assemble_owned(_compat.form(ufl.TestFunction(self.nodal_space) * self.ds))
 
     def nodal_values(self, expressions: typing.Sequence[typing.Any]) -> NodalValues:
         """The values of UFL scalars at the slave nodes (compiled once, evaluated on call)."""
@@ -444,17 +445,8 @@ class NodalValues:
         values = np.zeros((len(weights), len(self.forms)))
         slave = weights > 0
         for k, form in enumerate(self.forms):
-            values[slave, k] = _assemble_owned(form)[slave] / weights[slave]
+            values[slave, k] = assemble_owned(form)[slave] / weights[slave]
         return values
-
-
-def _assemble_owned(form: typing.Any) -> np.ndarray:
-    """A linear form's assembled vector, its owned entries (contributions of ghosts added)."""
-    vector = dolfinx.fem.petsc.assemble_vector(form)
-    vector.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-    values = vector.array_r.copy()
-    vector.destroy()
-    return values
 
 
 def _constrained_rows(V: fem.FunctionSpace, bcs: typing.Sequence[fem.DirichletBC]) -> np.ndarray:
