@@ -39,6 +39,12 @@ COMMANDS = {"steady": ("block", "run_steady"), "stability": ("block", "run_stabi
             "contact": ("contact", "run_contact"), "rolling": ("rolling", "run_rolling")}
 
 
+#: the root logger's handler while a command runs: warnings and errors only
+_WARNINGS_ONLY = logging.StreamHandler()
+_WARNINGS_ONLY.setLevel(logging.WARNING)
+_WARNINGS_ONLY.setFormatter(logging.Formatter("%(levelname)s:%(name)s:%(message)s"))
+
+
 def _parser() -> Parser:
     parser = Parser(prog="fenicsfriction", description=__doc__.splitlines()[0])
     commands = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
@@ -62,6 +68,11 @@ def main(argv: list[str] | None = None) -> int:
     logging.getLogger("ffcx").setLevel(logging.WARNING)
     logging.getLogger("UFL").setLevel(logging.WARNING)
     logging.getLogger().setLevel(logging.WARNING)
+    # the just-in-time compiler's build (setuptools) configures the root logger at INFO the
+    # first time a form is compiled, unless it has a handler already: one that passes only
+    # warnings keeps its build lines off the terminal
+    if _WARNINGS_ONLY not in logging.getLogger().handlers:  # once: main() may run many times
+        logging.getLogger().addHandler(_WARNINGS_ONLY)
     from mpi4py import MPI
 
     from fenicsfriction.results import blas_library, get_logger
