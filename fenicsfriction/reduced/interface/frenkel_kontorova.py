@@ -60,10 +60,11 @@ runs as a domino faster than :math:`c_0`. A front at :math:`v > c_0` has no cont
 λ > 0), but the chain, with :math:`4 g \sinh^2(\lambda a/2)` in place of
 :math:`a^2 g \lambda^2`, has a steep precursor at any speed.
 
-The slides cite for the FK model O.M. Braun and Yu.S. Kivshar (2004), "The Frenkel-Kontorova
-Model: Concepts, Methods, and Applications", and for the EQ contacts O.M. Braun and
-M. Peyrard (2008), "Modeling friction on a mesoscale: master equation for the earthquakelike
-model", Phys. Rev. Lett. 100, 125501.
+The slides cite for slip fronts the experiments of S.M. Rubinstein, G. Cohen and J. Fineberg
+(2004), "Detachment fronts and the onset of dynamic friction", Nature 430, 1005, and (2007),
+"Dynamics of precursors to frictional sliding", Phys. Rev. Lett. 98, 226103, and the
+simulations of O.M. Braun, I. Barel and M. Urbakh (2009), "Dynamics of transition from static
+to kinetic friction", Phys. Rev. Lett. 103, 194301.
 """
 
 from __future__ import annotations
