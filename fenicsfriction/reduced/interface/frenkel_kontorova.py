@@ -292,20 +292,20 @@ class FKChain:
     # --- the chain ------------------------------------------------------------------------
 
     def _laplacian(self, u: np.ndarray) -> np.ndarray:
-        """u_{i+1} + u_{i-1} − 2u_i with free ends (no neighbour beyond them)."""
-        d = np.diff(u)
+        """u_{i+1} + u_{i-1} − 2u_i along the last axis, with free ends (no neighbour beyond
+        them)."""
+        d = np.diff(u, axis=-1)
         lap = np.zeros_like(u)
-        lap[:-1] += d
-        lap[1:] -= d
+        lap[..., :-1] += d
+        lap[..., 1:] -= d
         return lap
 
     def equilibrium(self, f: float, anchors: np.ndarray) -> np.ndarray:
         """The static displacements at force f with contact anchors b:
         (K + k) u − g Δu = f + k b."""
-        lap = np.diag(np.full(self.n - 1, 1.0), 1) + np.diag(np.full(self.n - 1, 1.0), -1)
-        lap -= np.diag(np.r_[1.0, np.full(self.n - 2, 2.0), 1.0])
-        matrix = (self.k + self.K) * np.eye(self.n) - self.g * lap
-        return np.linalg.solve(matrix, f + self.k * anchors)
+        identity = np.eye(self.n)
+        matrix = (self.k + self.K) * identity - self.g * self._laplacian(identity)
+        return np.linalg.solve(matrix, f + self.k * np.asarray(anchors, dtype=float))
 
     def energy(self, u: np.ndarray, v: np.ndarray, anchors: np.ndarray) -> np.ndarray:
         """Kinetic + chain + substrate + contact energy (last axis: the blocks)."""
@@ -357,7 +357,7 @@ class FKChain:
         first = np.full(n, np.nan)
         for i, t in zip(sites[::-1], times[::-1], strict=True):
             first[i] = t
-        # breaks up to each recorded time (the state after a break is recorded at its time)
+        # breaks up to each recorded time (both records at a break's time count it)
         count = np.searchsorted(times, hybrid.t, side="right")
         rightmost = np.maximum.accumulate(sites) if sites.size else np.zeros(1, dtype=int)
         front = np.where(count > 0, self.a * rightmost[np.maximum(count - 1, 0)], np.nan)
