@@ -99,8 +99,9 @@ class InterfaceSlider:
     seed: int = 0
 
     def __post_init__(self) -> None:
-        for name in ("L", "H", "E", "rho", "k", "threshold"):
+        for name in ("L", "H", "E", "rho", "k"):
             check_positive(name, getattr(self, name))
+        check("threshold", self.threshold, self.threshold > 0, "must be > 0 (inf: unbreakable)")
         for name in ("nx", "ny"):
             check(name, getattr(self, name), int(getattr(self, name)) >= 1, "must be >= 1")
         check("nu", self.nu, -1 < self.nu < 0.5, "must lie in (-1, 0.5)")
@@ -276,11 +277,15 @@ class InterfaceSliderModel:
         self._base_nodes(Q, fdim)
         self._push_force = _compat.form(
             s.k_push * (s.push_speed * self.time - u[0]) * self.ds_left)
-        self._energy = {"kinetic": 0.5 * s.rho * ufl.inner(u_dot, u_dot) * ufl.dx(domain=msh),
+        energy = {"kinetic": 0.5 * s.rho * ufl.inner(u_dot, u_dot) * ufl.dx(domain=msh),
                         "strain": 0.5 * elasticity(u, u, s.E, s.nu, ufl.dx(domain=msh),
                                                    s.plane_stress),
                         "contacts": 0.5 * s.k * self.attached * (u[0] - self.anchor) ** 2
                         * self.ds_base}
+        self._energy = {name: _compat.form(f) for name, f in energy.items()}
+        self._contact_force = _compat.form(
+            s.k * self.attached * (self.anchor - u[0]) * self.ds_base)
+        self._momentum = _compat.form(s.rho * u_dot[0] * ufl.dx(domain=msh))
         self.breaks: list[Break] = []
 
     def _base_nodes(self, Q: fem.FunctionSpace, fdim: int) -> None:
@@ -291,8 +296,8 @@ class InterfaceSliderModel:
         x = Q.tabulate_dof_coordinates()
         # the vector space numbers its nodes as the scalar one (same element, same mesh)
         assert np.allclose(self.V.tabulate_dof_coordinates()[self.dofs], x[self.dofs])
-        self.x = x[self.dofs, 0]
-        self.node = np.rint(self.x / s.h).astype(np.int64)
+        self.node = np.rint(x[self.dofs, 0] / s.h).astype(np.int64)
+        self.x = self.node * s.h  # exact abscissae: the same on any partition
         self.weight = np.where((self.node == 0) | (self.node == s.nx), 0.5 * s.h, s.h)
         self.breaks_so_far = np.zeros(len(self.dofs), dtype=np.int64)
         self.threshold = s.draw_threshold(self.node, self.breaks_so_far)
@@ -335,9 +340,17 @@ class InterfaceSliderModel:
         """Force per unit breadth the pusher exerts on the slider [N/m]."""
         return self.msh.comm.allreduce(fem.assemble_scalar(self._push_force))
 
+    def contact_force(self) -> float:
+        """Tangential force per unit breadth the attached contacts exert on the slider [N/m]."""
+        return self.msh.comm.allreduce(fem.assemble_scalar(self._contact_force))
+
+    def momentum(self) -> float:
+        """Tangential momentum of the slider per unit breadth [kg/s]."""
+        return self.msh.comm.allreduce(fem.assemble_scalar(self._momentum))
+
     def energies(self) -> dict[str, float]:
         """Kinetic, strain and contact-spring energies per unit breadth [J/m]."""
-        return {name: self.msh.comm.allreduce(fem.assemble_scalar(_compat.form(f)))
+        return {name: self.msh.comm.allreduce(fem.assemble_scalar(f))
                 for name, f in self._energy.items()}
 
     def front_position(self) -> float:
@@ -389,7 +402,8 @@ class InterfaceSliderModel:
         def force_at(t: float) -> float:
             return float(np.interp(t, times, force))
 
-        found = fronts(self.breaks, force_at, front_gap or 5 * dt, self.scene.L - 0.5 * self.scene.h)
+        far_edge = self.scene.L - 0.5 * self.scene.h
+        found = fronts(self.breaks, force_at, front_gap or 5 * dt, far_edge)
         spanning = [f for f in found if not f.arrested]
         return SliderHistory(time=times, front_position=[r["front_position"] for r in records],
                              push_force=force, attached=[r["attached"] for r in records],
