@@ -91,7 +91,7 @@ def test_momentum_changes_by_the_impulse_of_the_contacts_and_the_pusher():
     # the trapezoidal rule: M (v_n+1 - v_n) = dt F(u_n+1/2) and the forces are linear in u
     # and t, so the momentum gained is dt times the mean of the forces at both ends of the
     # step (the springs as they were over it); elastic forces sum to zero: round-off only
-    for old, new in zip(records, records[1:]):
+    for old, new in zip(records[:-1], records[1:], strict=True):
         impulse = 0.5 * new["dt"] * (old["after"] + new["before"] + old["push"] + new["push"])
         assert new["momentum"] - old["momentum"] == pytest.approx(
             impulse, rel=1e-8, abs=1e-10 * PUSHED.rho * PUSHED.L * PUSHED.H * 1e-3)
