@@ -31,7 +31,8 @@ Modelling choices the papers leave open (Braun, Barel & Urbakh 2009 describe a 1
   is at most :math:`|\dot u_x|\,\Delta t`, so the step must be small against
   :math:`x_s/\dot u_x`.
 * **Re-attachment.** A broken contact stays off for ``delay`` and then re-forms relaxed: its
-  anchor is the node's position at that moment (with ``delay = 0``, at once, at the break).
+  anchor is the node's position at that moment (with ``delay = 0``, at once, at the break):
+  the distribution R(x) of new-born stretchings in the slides' master equation is δ(x).
   Each (re-)formed contact draws a new threshold, uniform in
   :math:`\bar x_s\,[1 - \delta, 1 + \delta]`.
 * **Reproducible under MPI.** A threshold is a function of (seed, the node's number
@@ -187,7 +188,7 @@ class SliderHistory(Record):
             the first break), per step.
         push_force: pusher force per unit breadth [N/m], per step.
         attached: number of attached contacts, per step.
-        breaks: every break, in order.
+        breaks: every break since the model was built, in order.
         fronts: the breaks grouped into fronts (:func:`fronts`).
         slip_force: the pusher force when the first front reached the far edge (the whole
             interface slipped) [N/m]; ``nan`` if none did.
