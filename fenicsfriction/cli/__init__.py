@@ -25,6 +25,7 @@ from fenicsfriction.cli.arguments import (
     Parser,
     add_block_parsers,
     add_contact_parsers,
+    add_interface_parsers,
     add_oscillator_parsers,
     add_rolling_parsers,
 )
@@ -36,7 +37,8 @@ COMMANDS = {"steady": ("block", "run_steady"), "stability": ("block", "run_stabi
             "dynamics": ("block", "run_dynamics"),
             "stability-map": ("oscillators", "run_stability_map"),
             "oscillator": ("oscillators", "run_oscillator"),
-            "contact": ("contact", "run_contact"), "rolling": ("rolling", "run_rolling")}
+            "contact": ("contact", "run_contact"), "rolling": ("rolling", "run_rolling"),
+            "interface": ("interface", "run_interface")}
 
 
 #: the root logger's handler while a command runs: warnings and errors only
@@ -52,6 +54,7 @@ def _parser() -> Parser:
     add_oscillator_parsers(commands)
     add_contact_parsers(commands)
     add_rolling_parsers(commands)
+    add_interface_parsers(commands)
     return parser
 
 

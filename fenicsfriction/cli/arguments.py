@@ -14,8 +14,8 @@ import pathlib
 import typing
 
 __all__ = ["SLAB_FLAGS", "LazyChoices", "Parser", "add_block_parsers", "add_contact_parsers",
-           "add_oscillator_parsers", "add_rolling_parsers", "creep_range", "floats",
-           "omega_range"]
+           "add_interface_parsers", "add_oscillator_parsers", "add_rolling_parsers", "creep_range",
+           "floats", "omega_range"]
 
 
 class Parser(argparse.ArgumentParser):
@@ -371,3 +371,49 @@ def add_rolling_parsers(commands: typing.Any) -> None:
                        default="fastsim", help="the theory computing the curve (fastsim)")
     curve.add_argument("--xi-range", type=creep_range, required=True, metavar="LO:HI:N",
                        help="N longitudinal creepages from LO to HI")
+
+
+def add_interface_parsers(commands: typing.Any) -> None:
+    """``interface fk|slider|...``: Braun's nonhomogeneous frictional interface."""
+    interface = commands.add_parser(
+        "interface", help="a nonhomogeneous frictional interface of many contacts (Braun)",
+        description="Braun's earthquake-like interface: contacts that break at thresholds and "
+                    "re-form; each command writes interface.json, CSV tables and figures to "
+                    "--out.")
+    models = interface.add_subparsers(dest="model", required=True, parser_class=Parser)
+    fk = models.add_parser(
+        "fk", help="Frenkel-Kontorova slip fronts (PETSc TS, breaks as events)",
+        description="m ü + m η u̇ − g(u_{i+1} + u_{i−1} − 2u_i) + F_s(u_i) + K u_i = f: a front "
+                    "of breaking contacts from the relaxed left part, its speed against the "
+                    "continuum travelling wave.")
+    for name, kind, default, text in (
+            ("--n", int, 200, "contacts"), ("--m", float, 1.0, "mass per contact"),
+            ("--eta", float, 1.0, "damping rate η"), ("--g", float, 100.0, "chain stiffness"),
+            ("--k", float, 1.0, "contact stiffness"), ("--K", float, 0.25, "substrate stiffness"),
+            ("--u-s", float, 1.0, "contact threshold"), ("--force", float, 1.0, "driving force f"),
+            ("--t-end", float, 100.0, "final time"),
+            ("--spread", float, 0.0, "relative spread of the thresholds (defects)"),
+            ("--seed", int, 1, "seed of the thresholds")):
+        fk.add_argument(name, type=kind, default=default, help=f"{text} ({default})")
+    fk.add_argument("--forces", type=floats, metavar="F1,F2,...",
+                    help="also measure the front speed at each of these forces")
+    fk.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    slider = models.add_parser(
+        "slider", help="an elastic slider on EQ contacts, pushed at its trailing edge (dolfinx)",
+        description="A 2D elastic slider whose base is held by breaking contacts, pushed at its "
+                    "trailing edge: detachment fronts, precursors, the force of global slip.")
+    for name, kind, text in (
+            ("--L", float, "length [m] (0.1)"), ("--H", float, "height [m] (0.01)"),
+            ("--nx", int, "cells along L (40)"), ("--ny", int, "cells along H (4)"),
+            ("--E", float, "Young's modulus [Pa] (1e9)"), ("--nu", float, "Poisson's ratio (0.3)"),
+            ("--rho", float, "density [kg/m³] (1000)"),
+            ("--k", float, "contact stiffness per base length [N/m²] (1e10)"),
+            ("--threshold", float, "mean threshold stretch [m] (1e-6)"),
+            ("--spread", float, "relative spread of the thresholds (0.5)"),
+            ("--delay", float, "time a broken contact stays off [s] (0)"),
+            ("--push-speed", float, "speed of the pushing stage [m/s] (0.01)"),
+            ("--seed", int, "seed of the thresholds (0)")):
+        slider.add_argument(name, type=kind, help=text)
+    slider.add_argument("--t-end", type=float, default=5e-3, help="final time [s] (5e-3)")
+    slider.add_argument("--dt", type=float, default=1e-6, help="time step [s] (1e-6)")
+    slider.add_argument("--out", type=pathlib.Path, required=True, help="output folder")

@@ -1,0 +1,161 @@
+"""``fenicsfriction interface eq|master-equation|stability-map|interaction|fk|slider``: Braun's
+nonhomogeneous frictional interface — the earthquake-like (EQ) model of many contacts, its master
+equation, the elastic instability, the elastic interaction of contacts, Frenkel-Kontorova slip
+fronts and an elastic slider on an EQ interface.
+
+Each command writes ``interface.json`` (the parameters and the command's numbers), CSV tables
+and PNG figures to ``--out``; the slider also ``slider.xdmf``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import pathlib
+import typing
+
+from mpi4py import MPI
+
+import numpy as np
+
+from fenicsfriction import results
+from fenicsfriction.cli.common import output_folder
+from fenicsfriction.results import CsvRows
+
+__all__ = ["run_interface"]
+
+
+def _pyplot() -> typing.Any:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def _csv(path: pathlib.Path, rows: typing.Iterable[dict], comm: MPI.Comm) -> None:
+    with CsvRows(path, comm) as table:
+        for row in rows:
+            table.write(row)
+
+
+# --- Frenkel-Kontorova slip fronts --------------------------------------------------------------
+
+def _run_fk(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
+    from fenicsfriction.reduced.interface.frenkel_kontorova import FKChain, front_speeds
+
+    chain = FKChain(n=args.n, m=args.m, eta=args.eta, g=args.g, k=args.k, K=args.K,
+                    u_s=args.u_s)
+    if args.spread > 0:
+        chain = chain.with_defects(args.spread, args.seed)
+    out = output_folder(args.out, comm)
+    relaxed = max(1, args.n // 10)
+    log.info(f"fk: {args.n} contacts, f_min = {chain.f_min:.6g}, f_max = {chain.f_max:.6g}, "
+             f"sound speed {chain.sound_speed:.6g}; f = {args.force:g}, t_end = {args.t_end:g}")
+    run = chain.simulate(args.force, args.t_end, relaxed, sample_dt=args.t_end / 400)
+    broken = np.isfinite(run.break_time)
+    summary: dict[str, typing.Any] = {
+        "command": "fk", "parameters": {k: getattr(args, k) for k in (
+            "n", "m", "eta", "g", "k", "K", "u_s", "force", "t_end", "spread", "seed")},
+        "relaxed": relaxed, "f_min": chain.f_min, "f_max": chain.f_max,
+        "sound_speed": chain.sound_speed,
+        "continuum_front_speed": float(chain.continuum_front_speed(args.force))
+        if args.force > chain.f_min else None,
+        "contacts_broken": int(broken.sum()),
+        "energy_residual": float(np.abs(run.energy_residual()).max())}
+    first, last = relaxed + 5, relaxed + 5 + max(5, (args.n - relaxed) // 3)
+    if last < args.n and np.all(broken[first:last + 1]):
+        summary["front_speed"] = run.front_speed(first, last)
+    if args.forces:
+        sweep = front_speeds(chain, args.forces, relaxed=relaxed, first=first,
+                             last=min(last, args.n - 1))
+        summary["front_speeds"] = sweep.to_json()
+        _csv(out / "front_speeds.csv", sweep.rows(), comm)
+    _csv(out / "fk.csv", run.rows(), comm)
+    results.write_summary(out / "interface.json", summary, comm)
+    if comm.rank == 0:
+        plt = _pyplot()
+        panels = 2 if args.forces else 1
+        fig, axes = plt.subplots(1, panels, figsize=(5.5 * panels, 4), squeeze=False)
+        ax = axes[0, 0]
+        sites = np.flatnonzero(broken)
+        ax.plot(run.break_time[sites], sites * chain.a, ".", ms=3)
+        ax.set(xlabel="t", ylabel="x of the contact (first break)",
+               title=f"front in the x–t plane, f = {args.force:g}")
+        if args.forces:
+            ax = axes[0, 1]
+            s = summary["front_speeds"]
+            fine = np.linspace(chain.f_min, chain.f_max, 201)[1:-1]
+            ax.plot(s["force"], s["measured"], "o", label="chain")
+            ax.plot(fine, chain.continuum_front_speed(fine), "k-",
+                    label="continuum travelling wave")
+            ax.plot(fine, chain.low_velocity_speed(fine), "k--", lw=0.8,
+                    label="low-velocity limit")
+            ax.plot(fine, chain.high_velocity_speed(fine), "k:", lw=0.8,
+                    label="high-velocity limit")
+            ax.set_ylim(0, 1.2 * chain.sound_speed)
+            ax.axhline(chain.sound_speed, color="gray", ls=":", label="sound speed")
+            ax.set(xlabel="f", ylabel="front speed", title="front speed against the force")
+            ax.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(out / "fk.png", dpi=120)
+        plt.close(fig)
+    log.info(f"{summary['contacts_broken']} contacts broken; front speed "
+             f"{summary.get('front_speed', float('nan')):.6g} (continuum "
+             f"{summary['continuum_front_speed'] or float('nan'):.6g}); results in {out}/: "
+             "interface.json, fk.csv, fk.png" + (", front_speeds.csv" if args.forces else ""))
+    return 0
+
+
+# --- the elastic slider on an EQ interface ------------------------------------------------------
+
+def _run_slider(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
+    from fenicsfriction.io import FieldWriter
+    from fenicsfriction.scenes.interface_slider import InterfaceSlider, InterfaceSliderModel
+
+    names = ("L", "H", "nx", "ny", "E", "nu", "rho", "k", "threshold", "spread", "delay",
+             "push_speed", "seed")
+    scene = InterfaceSlider(**{n: getattr(args, n) for n in names if getattr(args, n) is not None})
+    out = output_folder(args.out, comm)
+    model = InterfaceSliderModel(scene, comm)
+    log.info(f"slider: {scene.nx} x {scene.ny} cells, {scene.nx + 1} EQ contacts on the base, "
+             f"pushed at {scene.push_speed:g}; t_end = {args.t_end:g}, dt = {args.dt:g}")
+    steps = {"n": 0}
+
+    def progress(*_: typing.Any) -> None:
+        steps["n"] += 1
+        if steps["n"] % max(1, int(args.t_end / args.dt) // 20) == 0:
+            log.info(f"step {steps['n']}  t = {float(model.time.value):.4g}  front at "
+                     f"{model.front_position():.4g}  push force {model.push_force():.4g}")
+
+    history = model.run(args.t_end, args.dt, on_step=progress)
+    history.write_csv(out / "slider.csv")
+    summary = {"command": "slider", "parameters": {**scene.__dict__, "t_end": args.t_end,
+                                                   "dt": args.dt},
+               "breaks": len(history.breaks), "fronts": [f.to_json() for f in history.fronts],
+               "slip_force": history.slip_force,
+               "peak_push_force": float(np.max(history.push_force))}
+    results.write_summary(out / "interface.json", summary, comm)
+    with FieldWriter(out / "slider.xdmf", model) as writer:
+        writer.write(float(model.time.value))
+    if comm.rank == 0:
+        plt = _pyplot()
+        fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4))
+        a1.plot(np.array(history.time) * 1e3, np.array(history.front_position) / scene.L, "-")
+        for b in history.breaks:
+            a1.plot(b.time * 1e3, b.x / scene.L, ".", color="tab:red", ms=2)
+        a1.set(xlabel="t [ms]", ylabel="x / L", title="detachment fronts (breaks in red)")
+        a2.plot(np.array(history.time) * 1e3, history.push_force, "-")
+        a2.set(xlabel="t [ms]", ylabel="push force [N/m]", title="the force on the trailing edge")
+        fig.tight_layout()
+        fig.savefig(out / "fronts.png", dpi=120)
+        plt.close(fig)
+    log.info(f"{len(history.breaks)} breaks, {len(history.fronts)} fronts, slip force "
+             f"{history.slip_force}; results in {out}/: interface.json, slider.csv, fronts.png, "
+             "slider.xdmf")
+    return 0
+
+
+def run_interface(args: argparse.Namespace, log: logging.Logger) -> int:
+    """``interface COMMAND``: the model, its numbers and figures."""
+    run = {"fk": _run_fk, "slider": _run_slider}[args.model]
+    return run(args, log, MPI.COMM_WORLD)
