@@ -10,7 +10,8 @@ transient from all contacts relaxed; for thresholds spread by σ around x_c the 
 static peak has slope ~ N k x_c/σ, and K* grows as the spread narrows.
 
 :func:`instability_map` runs the spring-driven model over K and σ/x_c and classifies each run
-by the fraction of the late-time window the slider spends stuck.
+by whether the slider jumped, max Ẋ > 10 v (see
+:class:`~fenicsfriction.reduced.interface.eq_model.SpringDrivenResult`).
 """
 
 from __future__ import annotations
@@ -22,7 +23,10 @@ import numpy as np
 
 from fenicsfriction.laws import check, check_positive
 from fenicsfriction.reduced.interface.eq_model import EQModel
-from fenicsfriction.reduced.interface.master_equation import MasterEquation
+from fenicsfriction.reduced.interface.master_equation import (
+    MasterEquation,
+    MasterEquationResult,
+)
 from fenicsfriction.results import Record
 
 __all__ = ["InstabilityMap", "critical_stiffness", "instability_map"]
@@ -39,8 +43,12 @@ def critical_stiffness(model: EQModel, h: float | None = None) -> float:
     The transient is followed to X = 2 x_c + 10 σ, past the first collective break, where F
     falls fastest (later breaks are spread wider).
     """
+    return _first_breaks(model, h).K_star
+
+
+def _first_breaks(model: EQModel, h: float | None) -> MasterEquationResult:
     step = model.x_s_std / 50 if h is None else h
-    return MasterEquation(model, step).solve(2 * model.x_s_mean + 10 * model.x_s_std).K_star
+    return MasterEquation(model, step).solve(2 * model.x_s_mean + 10 * model.x_s_std)
 
 
 @dataclasses.dataclass
@@ -52,7 +60,7 @@ class InstabilityMap(Record):
         relative_spread: σ/x_c of the Gaussian thresholds.
         K_star: the critical stiffness of each row (:func:`critical_stiffness`).
         stick_slip: the classification of each run.
-        stuck_fraction, velocity_spread, force_spread: the measures of each run
+        max_speed, stuck_fraction, velocity_spread, force_spread: the measures of each run
             (see :class:`~fenicsfriction.reduced.interface.eq_model.SpringDrivenResult`).
         drive: v, the mass, the damping ratio, t_end and the steps per period used.
         parameters: N, k, x_s_mean (the rows vary x_s_std).
@@ -62,6 +70,7 @@ class InstabilityMap(Record):
     relative_spread: np.ndarray
     K_star: np.ndarray
     stick_slip: np.ndarray
+    max_speed: np.ndarray
     stuck_fraction: np.ndarray
     velocity_spread: np.ndarray
     force_spread: np.ndarray
@@ -72,7 +81,7 @@ class InstabilityMap(Record):
 def instability_map(K: typing.Sequence[float], relative_spread: typing.Sequence[float],
                     n_contacts: int = 300, k: float = 1.0, x_s_mean: float = 1.0,
                     v: float = 1.0, mass: float | None = None, damping_ratio: float = 0.1,
-                    drive_distance: float = 12.0, steps_per_period: int = 20,
+                    drive_distance: float = 6.0, steps_per_period: int = 20,
                     seed: int = 0) -> InstabilityMap:
     """Classify spring-driven runs over K × σ/x_c and give K* for each σ.
 
@@ -84,7 +93,9 @@ def instability_map(K: typing.Sequence[float], relative_spread: typing.Sequence[
         mass: the slider's mass; None: 1e-5 N k x_c/v², so that the slider's period on its
             contacts, 2π √(m/(N k)) ≈ 0.02 x_c/v, is short against the loading.
         damping_ratio: ζ, the damping η = 2 ζ √(m (N k + K)).
-        drive_distance: v t_end in units of x_c; the late window is its second half.
+        drive_distance: v t_end beyond the drive's stretch at the static peak,
+            F_s/K (F_s of the master equation), in units of x_c; the late window is the
+            second half of the run.
         steps_per_period: time steps per period 2π √(m/(N k + K)).
         seed: seeds every run (the same thresholds for every K of a row).
     """
@@ -101,24 +112,27 @@ def instability_map(K: typing.Sequence[float], relative_spread: typing.Sequence[
     check_positive("mass", m)
     shape = (spreads.size, K_values.size)
     stick_slip = np.zeros(shape, dtype=bool)
-    stuck, velocity, force = (np.zeros(shape) for _ in range(3))
+    speed, stuck, velocity, force = (np.zeros(shape) for _ in range(4))
     K_star = np.zeros(spreads.size)
     for i, spread in enumerate(spreads):
         model = EQModel(n_contacts=n_contacts, k=k, x_s_mean=x_s_mean,
                         x_s_std=float(spread * x_s_mean))
-        K_star[i] = critical_stiffness(model)
+        master = _first_breaks(model, None)
+        K_star[i] = master.K_star
         for j, K_j in enumerate(K_values):
             period = 2 * np.pi * np.sqrt(m / (stiffness + K_j))
             run = model.spring_driven(K=float(K_j), v=v, mass=m,
                                       damping=2 * damping_ratio * np.sqrt(m * (stiffness + K_j)),
-                                      t_end=drive_distance * x_s_mean / v,
+                                      t_end=(drive_distance * x_s_mean
+                                             + master.static_force / K_j) / v,
                                       dt=period / steps_per_period, seed=seed)
             stick_slip[i, j] = run.stick_slip
-            stuck[i, j], velocity[i, j] = run.stuck_fraction, run.velocity_spread
+            speed[i, j], stuck[i, j] = run.max_speed, run.stuck_fraction
+            velocity[i, j] = run.velocity_spread
             force[i, j] = run.force_spread
     return InstabilityMap(
         K=K_values, relative_spread=spreads, K_star=K_star, stick_slip=stick_slip,
-        stuck_fraction=stuck, velocity_spread=velocity, force_spread=force,
+        max_speed=speed, stuck_fraction=stuck, velocity_spread=velocity, force_spread=force,
         drive={"v": v, "mass": m, "damping_ratio": damping_ratio,
-               "t_end": drive_distance * x_s_mean / v, "steps_per_period": steps_per_period},
+               "drive_distance": drive_distance, "steps_per_period": steps_per_period},
         parameters={"N": n_contacts, "k": k, "x_s_mean": x_s_mean})
