@@ -8,7 +8,10 @@ import pytest
 
 MODULES = ["fenicsfriction.reduced.slider", "fenicsfriction.reduced.belt",
            "fenicsfriction.reduced.events", "fenicsfriction.statistics",
-           "fenicsfriction.reduced.rolling.fastsim", "fenicsfriction.reduced.rolling.hertz"]
+           "fenicsfriction.reduced.rolling.fastsim", "fenicsfriction.reduced.rolling.hertz",
+           "fenicsfriction.reduced.interface.eq_model",
+           "fenicsfriction.reduced.interface.master_equation",
+           "fenicsfriction.reduced.interface.instability"]
 
 
 @pytest.mark.parametrize("module", MODULES)

@@ -1,0 +1,34 @@
+"""Braun's nonhomogeneous frictional interface, reduced (no mesh): the earthquake-like model of
+many breaking contacts, its master equation and the elastic instability (Braun (slides),
+"Nonhomogeneous frictional interface")."""
+
+# ruff: noqa: F401  (lazy re-exports, as pyproject.toml ignores for the other packages)
+from __future__ import annotations
+
+import typing
+
+from fenicsfriction._lazy import attach
+
+__getattr__, __dir__, __all__ = attach(__name__, {
+    "EQModel": "eq_model", "QuasistaticResult": "eq_model",
+    "SpringDrivenResult": "eq_model", "describe_distribution": "eq_model",
+    "MasterEquation": "master_equation", "MasterEquationResult": "master_equation",
+    "InstabilityMap": "instability", "instability_map": "instability",
+    "critical_stiffness": "instability"})
+
+if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers
+    from fenicsfriction.reduced.interface.eq_model import (
+        EQModel,
+        QuasistaticResult,
+        SpringDrivenResult,
+        describe_distribution,
+    )
+    from fenicsfriction.reduced.interface.instability import (
+        InstabilityMap,
+        critical_stiffness,
+        instability_map,
+    )
+    from fenicsfriction.reduced.interface.master_equation import (
+        MasterEquation,
+        MasterEquationResult,
+    )

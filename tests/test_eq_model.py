@@ -1,0 +1,109 @@
+"""Braun's earthquake-like model: the quasistatic drive against closed forms of the renewal
+process, the spring-driven drive against an independent integrator and the elastic
+instability's criterion."""
+
+import numpy as np
+import pytest
+from scipy import integrate, stats
+
+from fenicsfriction.reduced.interface import EQModel, critical_stiffness
+
+# P_c broad enough that the contacts forget their common start within a few lives (a renewal
+# process's oscillation decays like exp(−2π² σ²/x_c²) per life), and supported on x > 0
+THRESHOLDS = {"uniform 0.5-1.5": stats.uniform(loc=0.5, scale=1.0),
+              "gamma shape 4": stats.gamma(a=4.0, scale=0.25)}
+
+
+@pytest.mark.parametrize("name", THRESHOLDS)
+def test_kinetic_force_is_N_k_mean_square_threshold_over_twice_the_mean(name):
+    P_c = THRESHOLDS[name]
+    model = EQModel(n_contacts=2000, k=2.0, thresholds=P_c)
+    result = model.quasistatic(X_max=12.0, realisations=10, kinetic_from=6.0)
+    closed_form = 2000 * 2.0 * P_c.moment(2) / (2 * P_c.mean())
+    # 20000 contacts, F per contact spread ~ 0.3 x_c: the window mean is a few 1e-3 off at worst
+    assert result.kinetic_force == pytest.approx(closed_form, rel=1e-2)
+    assert result.static_force > result.kinetic_force
+
+
+def test_stretching_histogram_is_the_steady_state_survival_over_the_mean_threshold():
+    P_c = THRESHOLDS["uniform 0.5-1.5"]
+    result = EQModel(n_contacts=20000, thresholds=P_c).quasistatic(X_max=12.0, bins=20)
+    # Q_s(x) = ∫_x^∞ P_c / ⟨x_s⟩ averaged over each bin; 20000 samples in 20 bins of width
+    # 0.075: ~1000 per bin where Q_s ~ 1, a relative noise of 3 % (one standard deviation)
+    cell = np.array([integrate.quad(P_c.sf, a, b)[0] / (b - a) / P_c.mean() for a, b in
+                     zip(result.histogram_edges[:-1], result.histogram_edges[1:],
+                                         strict=True)])
+    assert np.max(np.abs(result.histogram - cell)) < 0.15  # 5 standard deviations, Q_s <= 1
+
+
+def test_force_grows_as_N_k_X_until_the_first_contact_breaks():
+    model = EQModel(n_contacts=500, k=3.0, x_s_mean=1.0, x_s_std=0.05)
+    result = model.quasistatic(X_max=0.5, n_points=11)  # 10 σ below the mean: nothing breaks
+    assert result.breaks == 0
+    np.testing.assert_allclose(result.F, 500 * 3.0 * result.X, rtol=1e-12)
+
+
+def test_a_seed_reproduces_a_run_and_another_seed_does_not():
+    model = EQModel(n_contacts=200)
+    first, again, other = (model.quasistatic(X_max=3.0, seed=s) for s in (7, 7, 8))
+    np.testing.assert_array_equal(first.F, again.F)
+    assert not np.array_equal(first.F, other.F)
+
+
+def test_re_formed_contacts_are_born_below_their_new_thresholds():
+    model = EQModel(newborn=stats.norm(loc=0.5, scale=0.5))
+    rng = np.random.default_rng(1)
+    x0 = model.draw_newborn(rng, 10000)
+    assert np.all(model.draw_thresholds(rng, x0) > x0)
+
+
+def test_spring_driven_slider_follows_the_linear_oscillator_until_the_first_break():
+    N, k, K, v, m, eta = 100, 1.0, 50.0, 1.0, 1e-3, 0.2
+    model = EQModel(n_contacts=N, k=k, x_s_std=0.05)
+    t_end = 0.6  # X < 0.6 x_c = mean − 8 σ: no contact breaks
+    run = model.spring_driven(K=K, v=v, mass=m, damping=eta, t_end=t_end, dt=1e-4)
+    assert run.breaks.sum() == 0
+    # m Ẍ + η Ẋ + (N k + K) X = K v t, from rest, by SciPy's Runge-Kutta (independent)
+    exact = integrate.solve_ivp(lambda t, y: [y[1], (K * v * t - eta * y[1] - (N * k + K) * y[0])
+                                              / m], (0, t_end), [0.0, 0.0], t_eval=run.t,
+                                rtol=1e-10, atol=1e-12)
+    # implicit midpoint, ω dt = 0.039: phase error (ω dt)²/12 ≈ 1.3e-4 per radian of the
+    # oscillation, which is damped (ζ ≈ 0.26) within a few radians and is a small part of X
+    np.testing.assert_allclose(run.X, exact.y[0], atol=1e-5 * np.max(np.abs(exact.y[0])))
+    np.testing.assert_allclose(run.friction_force, N * k * run.X, rtol=1e-12)
+
+
+def test_stiff_drive_slides_smoothly_and_soft_drive_sticks_and_slips():
+    model = EQModel(n_contacts=300, x_s_std=0.3)
+    K_star = critical_stiffness(model)
+    mass = 3e-3  # the free period on the contacts, 0.02 x_c/v: short against the loading
+    runs = {}
+    for factor in (0.25, 4.0):
+        K = factor * K_star
+        period = 2 * np.pi * np.sqrt(mass / (300 + K))
+        # beyond the static peak (F_s ≈ 0.65 N k x_c): the drive's stretch F_s/K, then 2 x_c
+        runs[factor] = model.spring_driven(K=K, v=1.0, mass=mass,
+                                           damping=0.2 * np.sqrt(mass * (300 + K)),
+                                           t_end=0.65 * 300 / K + 2.0, dt=period / 20)
+    # following F(X) the slider moves at most v K/(K − K*) = 4v/3 at K = 4 K*, plus the start
+    # from rest (ζ = 0.1: up to ~1.7 v) and single breaks' micro-slips (~x_c ω/N ≈ 1.1 v);
+    # a jump moves a fraction of x_c at the oscillation's speed ω x_c ≈ 330 v
+    assert runs[4.0].max_speed < 6.0 and not runs[4.0].stick_slip
+    assert runs[0.25].max_speed > 30.0 and runs[0.25].stick_slip
+
+
+@pytest.mark.parametrize(("field", "value"), [("n_contacts", 0), ("k", -1.0), ("x_s_std", 0.0),
+                                              ("thresholds", "gauss")])
+def test_bad_model_parameters_are_named_in_the_error(field, value):
+    with pytest.raises(ValueError, match=field):
+        EQModel(**{field: value})
+
+
+def test_bad_drive_parameters_are_named_in_the_error():
+    model = EQModel(n_contacts=10)
+    with pytest.raises(ValueError, match="X_max"):
+        model.quasistatic(X_max=-1.0)
+    with pytest.raises(ValueError, match="realisations"):
+        model.quasistatic(X_max=1.0, realisations=0)
+    with pytest.raises(ValueError, match="damping"):
+        model.spring_driven(K=1.0, v=1.0, mass=1.0, damping=-1.0, t_end=1.0, dt=0.1)
