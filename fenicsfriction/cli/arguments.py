@@ -381,6 +381,40 @@ def add_interface_parsers(commands: typing.Any) -> None:
                     "re-form; each command writes interface.json, CSV tables and figures to "
                     "--out.")
     models = interface.add_subparsers(dest="model", required=True, parser_class=Parser)
+    contacts = Parser(add_help=False)
+    group = contacts.add_argument_group("the contacts (any consistent units)")
+    for name, kind, default, text in (
+            ("--N", int, 1000, "number of contacts"), ("--k", float, 1.0, "contact stiffness"),
+            ("--x-s-mean", float, 1.0, "mean threshold stretching x_c"),
+            ("--x-s-std", float, 0.1, "spread σ of the Gaussian thresholds"),
+            ("--seed", int, 0, "seed of the random numbers")):
+        group.add_argument(name, type=kind, default=default, help=f"{text} ({default})")
+    group.add_argument("--newborn", choices=["relaxed", "gaussian"], default="relaxed",
+                       help="stretching of re-formed contacts: δ(x), or Gaussian (relaxed)")
+    group.add_argument("--newborn-mean", type=float, default=0.0,
+                       help="mean of the Gaussian newborn stretching (0)")
+    group.add_argument("--newborn-std", type=float, default=0.1,
+                       help="spread of the Gaussian newborn stretching (0.1)")
+    contacts.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    for name, text in (("eq", "the EQ model moved quasistatically, beside its master equation"),
+                       ("master-equation", "the master equation of the stretching distribution")):
+        command = models.add_parser(name, parents=[contacts], help=text, description=text + ".")
+        command.add_argument("--X-max", type=float, default=5.0,
+                             help="the slider's last position (5)")
+        command.add_argument("--h", type=float, default=0.01,
+                             help="the master equation's step ΔX = Δx (0.01)")
+        if name == "eq":
+            command.add_argument("--realisations", type=int, default=1,
+                                 help="independent interfaces averaged (1)")
+    smap = models.add_parser(
+        "stability-map", parents=[contacts],
+        help="smooth sliding or stick-slip of the spring-driven EQ model over K and σ/x_c",
+        description="The spring-driven EQ model (PETSc TS) over drive stiffnesses and threshold "
+                    "spreads, each run classified, with the master equation's K* overlaid.")
+    smap.add_argument("--K", type=floats, required=True, metavar="K1,K2,...",
+                      help="drive stiffnesses")
+    smap.add_argument("--spreads", type=floats, default=[0.1, 0.3], metavar="S1,S2,...",
+                      help="relative threshold spreads σ/x_c (0.1,0.3)")
     fk = models.add_parser(
         "fk", help="Frenkel-Kontorova slip fronts (PETSc TS, breaks as events)",
         description="m ü + m η u̇ − g(u_{i+1} + u_{i−1} − 2u_i) + F_s(u_i) + K u_i = f: a front "

@@ -38,6 +38,132 @@ def _csv(path: pathlib.Path, rows: typing.Iterable[dict], comm: MPI.Comm) -> Non
             table.write(row)
 
 
+# --- the EQ model, its master equation, the elastic instability ---------------------------------
+
+def _eq_model(args: argparse.Namespace) -> typing.Any:
+    """The EQ model of the flags: Gaussian thresholds; newborn contacts relaxed or Gaussian."""
+    from scipy import stats
+
+    from fenicsfriction.laws import check_positive
+    from fenicsfriction.reduced.interface import EQModel
+
+    newborn = None
+    if args.newborn == "gaussian":
+        check_positive("--newborn-std", args.newborn_std)
+        newborn = stats.norm(args.newborn_mean, args.newborn_std)
+    return EQModel(n_contacts=args.N, k=args.k, x_s_mean=args.x_s_mean, x_s_std=args.x_s_std,
+                   newborn=newborn)
+
+
+def _interface_json(result: typing.Any) -> dict[str, typing.Any]:
+    """A result's record with the issue's names: parameters, the forces, K*, X and F."""
+    data = result.to_json()
+    return {**data, "X": list(map(float, result.X)), "F": list(map(float, result.F))}
+
+
+def _run_eq(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
+    from fenicsfriction.reduced.interface import MasterEquation
+
+    model = _eq_model(args)
+    out = output_folder(args.out, comm)
+    log.info(f"eq: {args.N} contacts, k = {args.k:g}, thresholds N({args.x_s_mean:g}, "
+             f"{args.x_s_std:g}), newborn {args.newborn}; X to {args.X_max:g}, "
+             f"{args.realisations} realisation(s), seed {args.seed}")
+    run = model.quasistatic(args.X_max, realisations=args.realisations, seed=args.seed)
+    me = MasterEquation(model, args.h).solve(args.X_max)
+    summary = {"command": "eq", **_interface_json(run), "K_star": me.K_star,
+               "master_equation": {"kinetic_force": me.kinetic_force,
+                                   "static_force": me.static_force, "h": me.h}}
+    results.write_summary(out / "interface.json", summary, comm)
+    _csv(out / "force.csv", ({"X": x, "F": f, "F_std": e}
+                             for x, f, e in zip(run.X, run.F, run.F_std, strict=True)), comm)
+    if comm.rank == 0:
+        plt = _pyplot()
+        fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4))
+        a1.plot(run.X, run.F, "-", lw=1, label=f"EQ model ({args.realisations} realisation(s))")
+        a1.plot(me.X, me.F, "k-", lw=1.2, label="master equation")
+        a1.set(xlabel="X", ylabel="F", title="friction force against the slider's position")
+        a1.legend(fontsize=8)
+        centres = 0.5 * (run.histogram_edges[1:] + run.histogram_edges[:-1])
+        a2.bar(centres, run.histogram, width=np.diff(run.histogram_edges), alpha=0.5,
+               label="EQ model")
+        a2.plot(me.x, me.Q / me.h, "k-", label="master equation")
+        a2.set(xlabel="stretching x", ylabel="density Q(x; X)",
+               title=f"stretchings at X = {args.X_max:g}")
+        a2.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(out / "eq.png", dpi=120)
+        plt.close(fig)
+    log.info(f"static force {run.static_force:.6g} (master equation {me.static_force:.6g}), "
+             f"kinetic {run.kinetic_force:.6g} ({me.kinetic_force:.6g}), K* = {me.K_star:.6g}; "
+             f"results in {out}/: interface.json, force.csv, eq.png")
+    return 0
+
+
+def _run_master_equation(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
+    from fenicsfriction.reduced.interface import MasterEquation
+
+    model = _eq_model(args)
+    out = output_folder(args.out, comm)
+    me = MasterEquation(model, args.h).solve(args.X_max)
+    results.write_summary(out / "interface.json",
+                          {"command": "master-equation", **_interface_json(me)}, comm)
+    _csv(out / "force.csv", ({"X": x, "F": f} for x, f in zip(me.X, me.F, strict=True)), comm)
+    if comm.rank == 0:
+        plt = _pyplot()
+        fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4))
+        a1.plot(me.X, me.F, "k-")
+        a1.axhline(me.kinetic_force, color="gray", ls=":", label="kinetic")
+        a1.set(xlabel="X", ylabel="F", title=f"F(X): static {me.static_force:.4g}, K* = "
+                                             f"{me.K_star:.4g}")
+        a1.legend(fontsize=8)
+        a2.plot(me.x, me.Q / me.h, "k-")
+        a2.set(xlabel="stretching x", ylabel="Q(x; X)", title=f"Q at X = {me.X[-1]:.4g}")
+        fig.tight_layout()
+        fig.savefig(out / "master_equation.png", dpi=120)
+        plt.close(fig)
+    log.info(f"static force {me.static_force:.6g}, kinetic {me.kinetic_force:.6g}, "
+             f"K* = {me.K_star:.6g}, mass error {me.mass_error:.1e}; results in {out}/: "
+             "interface.json, force.csv, master_equation.png")
+    return 0
+
+
+def _run_stability_map(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
+    from fenicsfriction.reduced.interface import instability_map
+
+    out = output_folder(args.out, comm)
+    log.info(f"stability-map: {len(args.K)} stiffnesses × {len(args.spreads)} spreads, "
+             f"{args.N} contacts")
+    smap = instability_map(args.K, args.spreads, n_contacts=args.N, k=args.k,
+                           x_s_mean=args.x_s_mean, seed=args.seed)
+    results.write_summary(out / "interface.json", {"command": "stability-map",
+                                                   **smap.to_json()}, comm)
+    _csv(out / "map.csv", ({"relative_spread": s, "K": K, "K_star": smap.K_star[i],
+                            "stick_slip": bool(smap.stick_slip[i, j]),
+                            "max_speed": smap.max_speed[i, j]}
+                           for i, s in enumerate(smap.relative_spread)
+                           for j, K in enumerate(smap.K)), comm)
+    if comm.rank == 0:
+        plt = _pyplot()
+        fig, ax = plt.subplots(figsize=(6.5, 4.5))
+        KK, SS = np.meshgrid(smap.K, smap.relative_spread)
+        stuck = smap.stick_slip.astype(bool)
+        ax.scatter(KK[stuck], SS[stuck], marker="x", color="tab:red", label="stick-slip")
+        ax.scatter(KK[~stuck], SS[~stuck], marker="o", facecolors="none",
+                   edgecolors="tab:blue", label="smooth sliding")
+        ax.plot(smap.K_star, smap.relative_spread, "k-", label="K* = −max F′(X)")
+        ax.set(xscale="log", xlabel="drive stiffness K", ylabel="threshold spread σ/x_c",
+               title="elastic instability of the EQ interface")
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(out / "stability_map.png", dpi=120)
+        plt.close(fig)
+    agree = np.mean(smap.stick_slip == (smap.K[None, :] < smap.K_star[:, None]))
+    log.info(f"{agree:.0%} of the runs on the side of K* the master equation predicts; "
+             f"results in {out}/: interface.json, map.csv, stability_map.png")
+    return 0
+
+
 # --- Frenkel-Kontorova slip fronts --------------------------------------------------------------
 
 def _run_fk(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
@@ -157,5 +283,6 @@ def _run_slider(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -
 
 def run_interface(args: argparse.Namespace, log: logging.Logger) -> int:
     """``interface COMMAND``: the model, its numbers and figures."""
-    run = {"fk": _run_fk, "slider": _run_slider}[args.model]
+    run = {"eq": _run_eq, "master-equation": _run_master_equation,
+           "stability-map": _run_stability_map, "fk": _run_fk, "slider": _run_slider}[args.model]
     return run(args, log, MPI.COMM_WORLD)

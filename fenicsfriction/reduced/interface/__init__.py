@@ -1,8 +1,7 @@
 """Braun's nonhomogeneous frictional interface, reduced (no mesh): the earthquake-like model of
-many breaking contacts, its master equation and the elastic instability (Braun (slides),
-"Nonhomogeneous frictional interface")."""
+many breaking contacts, its master equation, the elastic instability and Frenkel-Kontorova slip
+fronts (Braun (slides), "Nonhomogeneous frictional interface")."""
 
-# ruff: noqa: F401  (lazy re-exports, as pyproject.toml ignores for the other packages)
 from __future__ import annotations
 
 import typing
@@ -14,7 +13,9 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "SpringDrivenResult": "eq_model", "describe_distribution": "eq_model",
     "MasterEquation": "master_equation", "MasterEquationResult": "master_equation",
     "InstabilityMap": "instability", "instability_map": "instability",
-    "critical_stiffness": "instability"})
+    "critical_stiffness": "instability", "FKChain": "frenkel_kontorova",
+    "FKResult": "frenkel_kontorova", "FrontSpeeds": "frenkel_kontorova",
+    "TriangleRamp": "frenkel_kontorova", "front_speeds": "frenkel_kontorova"})
 
 if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers
     from fenicsfriction.reduced.interface.eq_model import (
@@ -22,6 +23,13 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers
         QuasistaticResult,
         SpringDrivenResult,
         describe_distribution,
+    )
+    from fenicsfriction.reduced.interface.frenkel_kontorova import (
+        FKChain,
+        FKResult,
+        FrontSpeeds,
+        TriangleRamp,
+        front_speeds,
     )
     from fenicsfriction.reduced.interface.instability import (
         InstabilityMap,
