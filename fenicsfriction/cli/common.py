@@ -14,12 +14,21 @@ import typing
 
 from mpi4py import MPI
 
-__all__ = ["flag", "output_folder", "scene_from_flags", "stop_line"]
+__all__ = ["flag", "named_by_flag", "output_folder", "scene_from_flags", "stop_line"]
 
 
 def flag(name: str) -> str:
     """The command-line flag of a field: ``slab_E`` -> ``--slab-E``."""
     return "--" + name.replace("_", "-")
+
+
+def named_by_flag(message: str, renamed: dict[str, str] | None = None) -> str:
+    """A model's ``name=value is invalid: ...`` with ``name`` replaced by its flag
+    (``renamed[name]`` when the flag is not ``--name``)."""
+    name = message.split("=", 1)[0]
+    if not name.isidentifier():
+        return message
+    return (renamed or {}).get(name, flag(name)) + message[len(name):]
 
 
 def scene_from_flags(cls: type, args: argparse.Namespace, **fixed: typing.Any) -> typing.Any:

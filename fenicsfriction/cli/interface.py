@@ -19,7 +19,7 @@ from mpi4py import MPI
 import numpy as np
 
 from fenicsfriction import results
-from fenicsfriction.cli.common import output_folder
+from fenicsfriction.cli.common import named_by_flag, output_folder
 from fenicsfriction.results import CsvRows
 
 __all__ = ["run_interface"]
@@ -281,8 +281,15 @@ def _run_slider(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -
     return 0
 
 
+#: the models' parameter names whose flag is not ``--name``
+_FLAGS = {"n_contacts": "--N", "relative_spread": "--spreads", "X_max": "--X-max"}
+
+
 def run_interface(args: argparse.Namespace, log: logging.Logger) -> int:
     """``interface COMMAND``: the model, its numbers and figures."""
     run = {"eq": _run_eq, "master-equation": _run_master_equation,
            "stability-map": _run_stability_map, "fk": _run_fk, "slider": _run_slider}[args.model]
-    return run(args, log, MPI.COMM_WORLD)
+    try:
+        return run(args, log, MPI.COMM_WORLD)
+    except ValueError as err:  # the models name their parameters: name the flags
+        raise ValueError(named_by_flag(str(err), _FLAGS)) from None

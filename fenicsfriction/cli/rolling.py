@@ -21,7 +21,7 @@ from mpi4py import MPI
 import numpy as np
 
 from fenicsfriction import plotting, results
-from fenicsfriction.cli.common import flag, output_folder, stop_line
+from fenicsfriction.cli.common import flag, named_by_flag, output_folder, stop_line
 from fenicsfriction.laws import check
 
 __all__ = ["run_rolling"]
@@ -199,20 +199,12 @@ _FLAGS = {"eps": "--eps-sequence", "pressure": "--normal", "xi": "--xi", "eta": 
           "phi": "--phi"}
 
 
-def _named_by_flag(message: str) -> str:
-    """A model's ``name=value is invalid: ...`` with ``name`` replaced by its flag."""
-    name = message.split("=", 1)[0]
-    if name.isidentifier():
-        return _FLAGS.get(name, flag(name)) + message[len(name):]
-    return message
-
-
 def run_rolling(args: argparse.Namespace, log: logging.Logger) -> int:
     """``rolling fastsim|fe|curve``: the creep forces, the traction, the outputs."""
     try:
         return _run(args, log)
     except ValueError as err:  # the models name their parameters: name the flags
-        raise ValueError(_named_by_flag(str(err))) from None
+        raise ValueError(named_by_flag(str(err), _FLAGS)) from None
 
 
 def _run(args: argparse.Namespace, log: logging.Logger) -> int:

@@ -1,0 +1,85 @@
+"""``fenicsfriction interface ...``: interface.json with the documented names, the numbers against
+the closed forms of the EQ model and the travelling front, the figures, and a bad value as one
+line and exit status 2. Serial and under ``mpirun -n 2``."""
+
+import json
+
+import numpy as np
+import pytest
+from cli_errors import assert_one_error_line
+
+from fenicsfriction.cli import main
+
+
+def _json(path):
+    return json.loads((path / "interface.json").read_text())
+
+
+def test_eq_against_its_master_equation_and_the_kinetic_closed_form(shared_tmp_path):
+    out = shared_tmp_path / "eq"
+    assert main(["interface", "eq", "--N", "4000", "--x-s-std", "0.1", "--X-max", "6",
+                 "--out", str(out)]) == 0
+    summary = _json(out)
+    assert {"parameters", "kinetic_force", "static_force", "K_star", "X", "F"} <= set(summary)
+    assert {"N", "k", "x_s_mean", "x_s_std", "newborn"} <= set(summary["parameters"])
+    # relaxed newborns: the kinetic force is N k <x_s²>/(2 <x_s>) = N k (x_c² + σ²)/(2 x_c);
+    # one realisation of 4000 contacts fluctuates by ~N^(-1/2) = 1.6 %
+    assert summary["kinetic_force"] == pytest.approx(4000 * (1 + 0.01) / 2, rel=0.03)
+    me = summary["master_equation"]
+    assert summary["static_force"] == pytest.approx(me["static_force"], rel=0.03)
+    assert summary["K_star"] > 0 and len(summary["X"]) == len(summary["F"])
+    assert (out / "eq.png").stat().st_size > 0
+
+
+def test_master_equation_conserves_the_contacts(shared_tmp_path):
+    out = shared_tmp_path / "me"
+    assert main(["interface", "master-equation", "--x-s-std", "0.3", "--out", str(out)]) == 0
+    summary = _json(out)
+    assert summary["mass_error"] < 1e-12
+    assert summary["kinetic_force"] == pytest.approx(1000 * (1 + 0.09) / 2, rel=1e-3)
+
+
+def test_stability_map_is_smooth_well_above_K_star_and_stick_slip_well_below(shared_tmp_path):
+    out = shared_tmp_path / "map"
+    assert main(["interface", "stability-map", "--N", "300", "--K", "25,1000", "--spreads",
+                 "0.3", "--out", str(out)]) == 0
+    summary = _json(out)
+    K_star = summary["K_star"][0]
+    assert 25 < K_star < 1000  # 0.44 N k for σ = 0.3 x_c
+    assert summary["stick_slip"] == [[True, False]]
+
+
+def test_fk_front_runs_near_the_continuum_travelling_wave(shared_tmp_path):
+    out = shared_tmp_path / "fk"
+    assert main(["interface", "fk", "--n", "120", "--g", "100", "--force", "1.0",
+                 "--t-end", "30", "--out", str(out)]) == 0
+    summary = _json(out)
+    # g = 100: the chain's front is within 1-2 % of the continuum's away from f_min, f_max
+    # (docs/interface-fk.md); 5 % here
+    assert summary["front_speed"] == pytest.approx(summary["continuum_front_speed"], rel=0.05)
+    assert summary["energy_residual"] < 1e-5 * 120
+    for name in ("fk.csv", "fk.png"):
+        assert (out / name).stat().st_size > 0
+
+
+@pytest.mark.parametrize(("argv", "name"), [
+    (["eq", "--N", "0"], "--N"),
+    (["master-equation", "--h", "-1"], "--h"),
+    (["eq", "--newborn", "gaussian", "--newborn-std", "0"], "--newborn-std"),
+    (["fk", "--g", "-1"], "--g")])
+def test_bad_value_is_one_line_naming_the_parameter_and_exit_2(shared_tmp_path, capsys, argv,
+                                                                name):
+    code = main(["interface", *argv, "--out", str(shared_tmp_path / "bad")])
+    assert code == 2
+    assert_one_error_line(capsys.readouterr().err, name)
+
+
+def test_slider_writes_its_fronts_and_fields(shared_tmp_path):
+    out = shared_tmp_path / "slider"
+    assert main(["interface", "slider", "--nx", "10", "--ny", "2", "--t-end", "1.6e-3",
+                 "--dt", "4e-6", "--spread", "0.05", "--push-speed", "1e-3",
+                 "--out", str(out)]) == 0
+    summary = _json(out)
+    assert summary["breaks"] >= 1 and np.isfinite(summary["peak_push_force"])
+    for name in ("slider.csv", "fronts.png", "slider.xdmf"):
+        assert (out / name).stat().st_size > 0
