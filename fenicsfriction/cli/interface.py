@@ -290,6 +290,8 @@ def run_interface(args: argparse.Namespace, log: logging.Logger) -> int:
     run = {"eq": _run_eq, "master-equation": _run_master_equation,
            "stability-map": _run_stability_map, "fk": _run_fk, "slider": _run_slider}[args.model]
     try:
-        return run(args, log, MPI.COMM_WORLD)
+        code = run(args, log, MPI.COMM_WORLD)
+        MPI.COMM_WORLD.Barrier()  # rank 0's figures are written before any rank returns
+        return code
     except ValueError as err:  # the models name their parameters: name the flags
         raise ValueError(named_by_flag(str(err), _FLAGS)) from None
