@@ -135,9 +135,11 @@ for i, s in enumerate(smap.relative_spread):
 # the master equation predicts.
 
 # %%
+stiffness = smap.K
 for i in range(len(smap.relative_spread)):
-    far = (smap.K < smap.K_star[i] / 3) | (smap.K > 3 * smap.K_star[i])
-    predicted = smap.K < smap.K_star[i]
+    critical = smap.K_star[i]
+    far = (stiffness < critical / 3) | (stiffness > 3 * critical)
+    predicted = stiffness < critical
     assert np.all(smap.stick_slip[i][far] == predicted[far]), (i, smap.stick_slip[i])
 
 # %% [markdown]
