@@ -13,23 +13,11 @@ from fenicsfriction.reduced.interface.interaction import (
     fit_power_laws,
     green_tensor,
     interaction_matrix,
+    radial_profile,
     self_compliance,
 )
 
 E, NU = 2.0, 0.3
-
-
-def _radial_profile(lattice: LatticeInteraction, response: np.ndarray, broken: int,
-                    r_max: float) -> tuple[np.ndarray, np.ndarray]:
-    """|δF| averaged (geometrically) in logarithmic bins of the distance from ``broken``."""
-    r = np.linalg.norm(lattice.positions - lattice.positions[broken], axis=1)
-    magnitude = np.linalg.norm(response, axis=1)
-    keep = (r > 0) & (r < r_max)
-    edges = np.geomspace(lattice.spacing, r_max, 20)
-    which = np.digitize(r[keep], edges)
-    bins = [which == b for b in np.unique(which)]
-    return (np.array([np.exp(np.log(r[keep][s]).mean()) for s in bins]),
-            np.array([np.exp(np.log(magnitude[keep][s]).mean()) for s in bins]))
 
 
 def test_self_term_is_the_mean_green_tensor_over_a_uniformly_loaded_disc():
@@ -97,7 +85,8 @@ def test_break_response_decays_as_inverse_distance_inside_the_correlation_length
     lattice = LatticeInteraction(n=64, spacing=1.0, E=E, nu=NU, stiffness=E / 512,
                                  contact_radius=0.5)
     broken = 32 * 64 + 32
-    r, f = _radial_profile(lattice, lattice.break_response([1.0, 0, 0], broken), broken, 8.0)
+    r, f = radial_profile(lattice.positions, lattice.break_response([1.0, 0, 0], broken), broken,
+                          edges=np.geomspace(1.0, 8.0, 20))
     fit = fit_power_laws(r, f, near_limit=8.0, far_limit=2.0)
     assert fit.near_exponent == pytest.approx(-1.0, abs=0.1)
 
@@ -110,7 +99,8 @@ def test_break_response_decays_as_inverse_cube_beyond_the_correlation_length():
     lattice = LatticeInteraction(n=n, spacing=1.0, E=E, nu=NU, stiffness=E / 4,
                                  contact_radius=0.5, rtol=1e-8)
     broken = (n // 2) * n + n // 2
-    r, f = _radial_profile(lattice, lattice.break_response([1.0, 0, 0], broken), broken, n / 4)
+    r, f = radial_profile(lattice.positions, lattice.break_response([1.0, 0, 0], broken), broken,
+                          edges=np.geomspace(1.0, n / 4, 20))
     fit = fit_power_laws(r, f, near_limit=2.0, far_limit=3 * lattice.correlation_length)
     assert fit.far_exponent == pytest.approx(-3.0, abs=0.35)
 

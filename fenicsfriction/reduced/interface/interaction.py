@@ -72,6 +72,7 @@ __all__ = [
     "fit_power_laws",
     "green_tensor",
     "interaction_matrix",
+    "radial_profile",
     "self_compliance",
 ]
 
@@ -303,6 +304,32 @@ def _cg_tolerance(rtol: float) -> dict[str, float]:
     import inspect
     name = "rtol" if "rtol" in inspect.signature(scipy.sparse.linalg.cg).parameters else "tol"
     return {name: rtol, "atol": 0.0}
+
+
+def radial_profile(positions: npt.ArrayLike, response: npt.ArrayLike, broken: int,
+                   edges: npt.ArrayLike) -> tuple[Array, Array]:
+    """|δF| against the distance from the broken contact, averaged in distance bins.
+
+    Geometric means (of r and of |δF|) per bin, the natural average for a power law; empty
+    bins are dropped.
+
+    Args:
+        positions: ``(N, 2)`` contact positions (m).
+        response: ``(N, 3)`` force changes (N).
+        broken: index of the broken contact (excluded).
+        edges: increasing bin edges (m); contacts outside ``[edges[0], edges[-1])`` are dropped.
+
+    Returns:
+        ``(r, |δF|)`` per non-empty bin.
+    """
+    p, edges = np.asarray(positions, dtype=float), np.asarray(edges, dtype=float)
+    r = np.linalg.norm(p - p[broken], axis=1)
+    magnitude = np.linalg.norm(np.asarray(response, dtype=float), axis=1)
+    keep = (r >= edges[0]) & (r < edges[-1]) & (magnitude > 0)
+    which = np.digitize(r[keep], edges)
+    bins = [which == b for b in np.unique(which)]
+    return (np.array([np.exp(np.log(r[keep][s]).mean()) for s in bins]),
+            np.array([np.exp(np.log(magnitude[keep][s]).mean()) for s in bins]))
 
 
 @dataclasses.dataclass(frozen=True)
