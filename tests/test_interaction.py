@@ -38,7 +38,7 @@ def test_self_term_is_the_mean_green_tensor_over_a_uniformly_loaded_disc():
 
 def test_green_tensor_is_reciprocal_and_matches_boussinesq_for_normal_load():
     """Betti's reciprocity G(r)ᵀ = G(-r), and the Boussinesq surface displacement under a
-    normal point force, u_z = (1 - σ²) P / (π E r) (Johnson 1985, eq. 3.21)."""
+    normal point force, u_z = (1 - σ²) P / (π E r) (Johnson 1985, *Contact mechanics*, §3.2)."""
     rng = np.random.default_rng(1)
     d = rng.normal(size=(20, 2))
     assert np.allclose(green_tensor(d, E, NU).transpose(0, 2, 1), green_tensor(-d, E, NU),
