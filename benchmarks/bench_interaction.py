@@ -133,13 +133,17 @@ def _plot(out: dict, path: object) -> None:
     import matplotlib.pyplot as plt
 
     fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.5))
-    for row in out["half_space"]:
-        lam = row["lambda_c"]
-        left.loglog(np.asarray(row["r"]) / lam, row["dF"], ".-", label=f"λ_c = {lam:g} a")
-    x = np.geomspace(0.02, 30, 10)
-    left.loglog(x, 2e-2 / x, "k--", lw=0.8, label="∝ r⁻¹")
-    left.loglog(x, 2e-3 / x**3, "k:", lw=0.8, label="∝ r⁻³")
-    left.set(xlabel="r / λ_c", ylabel="|δF| / |δF at the break|",
+    # near zone δF/δF* ≈ k G(r) ∝ a²/(λ_c r): λ_c² δF/δF* against r/λ_c is one curve
+    curves = [(np.asarray(row["r"]) / row["lambda_c"],
+               row["lambda_c"]**2 * np.asarray(row["dF"]), row["lambda_c"])
+              for row in out["half_space"]]
+    for x, y, lam in curves:
+        left.loglog(x, y, ".-", label=f"λ_c = {lam:g} a")
+    x_near, y_near, _ = curves[-1]
+    x_far, y_far, _ = curves[0]
+    left.loglog(x_near, y_near[0] * x_near[0] / x_near, "k--", lw=0.8, label="∝ r⁻¹")
+    left.loglog(x_far, y_far[-1] * (x_far[-1] / x_far) ** 3, "k:", lw=0.8, label="∝ r⁻³")
+    left.set(xlabel="r / λ_c", ylabel="(λ_c/a)² |δF| / |δF at the break|",
              title=f"half-space, {out['half_space'][0]['n']}² contacts")
     left.legend(fontsize=8)
     for row in out["block"]:
