@@ -85,9 +85,10 @@ class SubstrateBlock:
     @property
     def surface_nodes(self) -> npt.NDArray[np.float64]:
         """x (and y) coordinates of the top face's vertices (m): contacts sit on these."""
-        return self._graded(np.linspace(-1.0, 1.0, self.cells_per_side + 1)) * self.width / 2
+        return self.graded(np.linspace(-1.0, 1.0, self.cells_per_side + 1)) * self.width / 2
 
-    def _graded(self, xi: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    def graded(self, xi: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+        """The grading map ``sign(ξ) |ξ|^p`` of uniform box coordinates in [-1, 1]."""
         return np.sign(xi) * np.abs(xi) ** self.grading
 
 
@@ -119,8 +120,8 @@ class ElasticSubstrate:
             comm, [-1.0, -1.0, -1.0], [1.0, 1.0, 0.0],
             [block.cells_per_side, block.cells_per_side, block.cells_deep])
         x = self.mesh.geometry.x
-        x[:, :2] = block._graded(x[:, :2]) * block.width / 2
-        x[:, 2] = block._graded(x[:, 2]) * block.depth
+        x[:, :2] = block.graded(x[:, :2]) * block.width / 2
+        x[:, 2] = block.graded(x[:, 2]) * block.depth
         self.V = _compat.vector_function_space(self.mesh, block.degree)
         self.u = fem.Function(self.V)
         self._local, self._global = self._contact_dofs()
