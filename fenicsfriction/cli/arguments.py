@@ -415,6 +415,16 @@ def add_interface_parsers(commands: typing.Any) -> None:
                       help="drive stiffnesses")
     smap.add_argument("--spreads", type=floats, default=[0.1, 0.3], metavar="S1,S2,...",
                       help="relative threshold spreads σ/x_c (0.1,0.3)")
+    interaction = models.add_parser(
+        "interaction", help="the response of contacts to a break, through the half-space",
+        description="Contacts on an n x n lattice of an elastic half-space (Landau-Lifshitz's "
+                    "Green tensor): the force response δf(r) of the others when the centre one "
+                    "breaks, its r^-1 and r^-3 laws and their crossover against λ_c = a²E/k.")
+    interaction.add_argument("--n", type=int, default=256, help="lattice side (256)")
+    interaction.add_argument("--lambda-c", type=float, default=16.0,
+                             help="the elastic correlation length over the spacing (16)")
+    interaction.add_argument("--nu", type=float, default=0.3, help="Poisson's ratio (0.3)")
+    interaction.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
     fk = models.add_parser(
         "fk", help="Frenkel-Kontorova slip fronts (PETSc TS, breaks as events)",
         description="m ü + m η u̇ − g(u_{i+1} + u_{i−1} − 2u_i) + F_s(u_i) + K u_i = f: a front "

@@ -164,6 +164,59 @@ def _run_stability_map(args: argparse.Namespace, log: logging.Logger, comm: MPI.
     return 0
 
 
+# --- the elastic interaction of contacts --------------------------------------------------------
+
+def _run_interaction(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
+    from fenicsfriction.reduced.interface import (
+        LatticeInteraction,
+        fit_power_laws,
+        radial_profile,
+    )
+
+    out = output_folder(args.out, comm)
+    lam = args.lambda_c
+    lattice = LatticeInteraction(n=args.n, spacing=1.0, E=1.0, nu=args.nu, stiffness=1.0 / lam,
+                                 contact_radius=0.5)
+    log.info(f"interaction: {args.n} x {args.n} contacts (spacing a = 1, E = 1, ν = "
+             f"{args.nu:g}), k = 1/λ_c: λ_c = a²E/k = {lam:g} a; the centre contact breaks "
+             "under a uniform shear")
+    broken = (args.n // 2) * args.n + args.n // 2
+    response = lattice.break_response((1.0, 0.0, 0.0), broken)
+    r, f = radial_profile(lattice.positions, response, broken,
+                          edges=np.geomspace(1.0, args.n / 4, 40))
+    f = f / np.linalg.norm(response[broken])
+    near = max(lam / 4, 2.0)  # at least two distance bins for the near law
+    fit = fit_power_laws(r, f, near, 3 * lam)
+    summary = {"command": "interaction", "parameters": {"n": args.n, "nu": args.nu,
+                                                        "lambda_c": lam, "spacing": 1.0,
+                                                        "E": 1.0, "contact_radius": 0.5},
+               "near_exponent": fit.near_exponent, "far_exponent": fit.far_exponent,
+               "crossover": fit.crossover, "crossover_over_lambda_c": fit.crossover / lam,
+               "r": list(map(float, r)), "dF": list(map(float, f))}
+    results.write_summary(out / "interface.json", summary, comm)
+    _csv(out / "response.csv", ({"r": x, "dF": y} for x, y in zip(r, f, strict=True)), comm)
+    if comm.rank == 0:
+        plt = _pyplot()
+        fig, ax = plt.subplots(figsize=(6, 4.2))
+        ax.loglog(r, f, "o", ms=3, label="|δf(r)| / |δf(0)|")
+        for slope, pre, where, style in (
+                (fit.near_exponent, fit.near_prefactor, r < near, "k--"),
+                (fit.far_exponent, fit.far_prefactor, r > 3 * lam, "k:")):
+            if np.any(where):
+                ax.loglog(r[where], pre * r[where] ** slope, style, label=f"slope {slope:.2f}")
+        ax.axvline(lam, color="gray", lw=0.8, label="λ_c")
+        ax.set(xlabel="r / a", ylabel="response of the other contacts",
+               title="a contact breaks: the response against distance")
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(out / "interaction.png", dpi=120)
+        plt.close(fig)
+    log.info(f"near exponent {fit.near_exponent:.3f} (r < {near:g}), far {fit.far_exponent:.3f} "
+             f"(r > 3 λ_c), crossover at {fit.crossover / lam:.2f} λ_c; results in {out}/: "
+             "interface.json, response.csv, interaction.png")
+    return 0
+
+
 # --- Frenkel-Kontorova slip fronts --------------------------------------------------------------
 
 def _run_fk(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
@@ -288,7 +341,8 @@ _FLAGS = {"n_contacts": "--N", "relative_spread": "--spreads", "X_max": "--X-max
 def run_interface(args: argparse.Namespace, log: logging.Logger) -> int:
     """``interface COMMAND``: the model, its numbers and figures."""
     run = {"eq": _run_eq, "master-equation": _run_master_equation,
-           "stability-map": _run_stability_map, "fk": _run_fk, "slider": _run_slider}[args.model]
+           "stability-map": _run_stability_map, "interaction": _run_interaction,
+           "fk": _run_fk, "slider": _run_slider}[args.model]
     try:
         code = run(args, log, MPI.COMM_WORLD)
         MPI.COMM_WORLD.Barrier()  # rank 0's figures are written before any rank returns

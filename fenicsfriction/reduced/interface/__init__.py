@@ -1,6 +1,7 @@
 """Braun's nonhomogeneous frictional interface, reduced (no mesh): the earthquake-like model of
-many breaking contacts, its master equation, the elastic instability and Frenkel-Kontorova slip
-fronts (Braun (slides), "Nonhomogeneous frictional interface")."""
+many breaking contacts, its master equation, the elastic instability, the elastic interaction
+of contacts through the half-space and Frenkel-Kontorova slip fronts (Braun (slides),
+"Nonhomogeneous frictional interface")."""
 
 from __future__ import annotations
 
@@ -15,7 +16,10 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "InstabilityMap": "instability", "instability_map": "instability",
     "critical_stiffness": "instability", "FKChain": "frenkel_kontorova",
     "FKResult": "frenkel_kontorova", "FrontSpeeds": "frenkel_kontorova",
-    "TriangleRamp": "frenkel_kontorova", "front_speeds": "frenkel_kontorova"})
+    "TriangleRamp": "frenkel_kontorova", "front_speeds": "frenkel_kontorova",
+    "LatticeInteraction": "interaction", "interaction_matrix": "interaction",
+    "green_tensor": "interaction", "correlation_length": "interaction",
+    "fit_power_laws": "interaction", "radial_profile": "interaction"})
 
 if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers
     from fenicsfriction.reduced.interface.eq_model import (
@@ -35,6 +39,14 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers
         InstabilityMap,
         critical_stiffness,
         instability_map,
+    )
+    from fenicsfriction.reduced.interface.interaction import (
+        LatticeInteraction,
+        correlation_length,
+        fit_power_laws,
+        green_tensor,
+        interaction_matrix,
+        radial_profile,
     )
     from fenicsfriction.reduced.interface.master_equation import (
         MasterEquation,
