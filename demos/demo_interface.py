@@ -11,7 +11,7 @@
 # %% [markdown]
 # # A nonhomogeneous frictional interface: many contacts, their master equation, fronts
 #
-# This demo shows how friction emerges from many contacts that break and re-form, following
+# This demo shows how to compute friction from many contacts that break and re-form, following
 # Braun's lectures *Nonhomogeneous frictional interface* (Braun (slides); Braun & Röder 2002;
 # Braun & Peyrard 2008): the earthquake-like (EQ) model against its master equation, the
 # elastic instability that turns smooth sliding into stick-slip, the elastic interaction of
