@@ -78,6 +78,9 @@ benchmark: setup
 	$(PY) benchmarks/bench_rolling_fe.py --out $(OUT)/benchmarks
 	$(PY) benchmarks/bench_rolling_methods.py --out $(OUT)/benchmarks
 	$(PY) benchmarks/bench_panagiotopoulos.py --out $(OUT)/benchmarks
+	$(PY) benchmarks/bench_interface.py --out $(OUT)/benchmarks
+	$(PY) benchmarks/bench_interaction.py --out $(OUT)/benchmarks
+	$(PY) benchmarks/bench_slider.py --out $(OUT)/benchmarks
 
 clean:
 	rm -rf .venv .venv-debian13 results *.egg-info
