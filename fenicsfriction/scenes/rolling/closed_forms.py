@@ -1,7 +1,8 @@
 r"""Closed forms of the rolling and shift scenes (two identical elastic bodies).
 
 Notation: :math:`G, \nu` the bodies' shear modulus and Poisson ratio, :math:`E^*` the contact
-modulus of the pair, :math:`1/E^* = 2(1-\nu^2)/E`, i.e. :math:`E^* = G/(1-\nu)`; R the relative
+modulus of the pair, :math:`1/E^* = 2(1-\nu^2)/E`, i.e. :math:`E^* = G/(1-\nu)`
+(:func:`fenicsfriction.reduced.rolling.hertz.quasi_identical_modulus`); R the relative
 radius of curvature :math:`1/R = 1/R_1 + 1/R_2` (two cylinders of radius :math:`R_1`:
 :math:`R = R_1/2`); a (b) the contact's semi-axis along (across) the rolling direction x.
 
@@ -36,17 +37,10 @@ import math
 import numpy as np
 
 from fenicsfriction.laws import check, check_positive
+from fenicsfriction.scenes.contact.closed_forms import hertz_pressure
 
-__all__ = ["carter_force", "carter_stick_half_width", "carter_traction", "contact_modulus",
-           "ellipse_load", "ellipse_pressure", "hertz_line_radius", "mindlin_stick_radius",
-           "mindlin_traction"]
-
-def contact_modulus(G: float, nu: float) -> float:
-    """:math:`E^* = G/(1-\\nu)` of two identical bodies (:math:`1/E^* = 2(1-\\nu^2)/E`)."""
-    check_positive("G", G)
-    check("nu", nu, -1 < nu < 0.5, "Poisson's ratio must be in (-1, 0.5)")
-    return G / (1 - nu)
-
+__all__ = ["carter_force", "carter_stick_half_width", "carter_traction", "ellipse_load",
+           "hertz_line_radius", "mindlin_stick_radius", "mindlin_traction"]
 
 def hertz_line_radius(a: float, p0: float, E_star: float) -> float:
     """The relative radius R of the cylinders whose Hertz contact has half-width a and peak
@@ -54,13 +48,6 @@ def hertz_line_radius(a: float, p0: float, E_star: float) -> float:
     for name, value in (("a", a), ("p0", p0), ("E_star", E_star)):
         check_positive(name, value)
     return a * E_star / (2 * p0)
-
-
-def ellipse_pressure(x: np.ndarray, y: np.ndarray | float, a: float, b: float,
-                     p0: float) -> np.ndarray:
-    """Hertz's :math:`p_0\\sqrt{1 - x^2/a^2 - y^2/b^2}`, 0 outside (2D: y = 0, any b)."""
-    r2 = (np.asarray(x) / a) ** 2 + (np.asarray(y) / b) ** 2
-    return p0 * np.sqrt(np.clip(1 - r2, 0.0, None))
 
 
 def ellipse_load(a: float, b: float | None, p0: float) -> float:
@@ -87,9 +74,9 @@ def carter_traction(x: np.ndarray, creepage: float, mu: float, a: float, p0: flo
                     R: float) -> np.ndarray:
     """Carter's traction on body 1 at x (0 outside the contact)."""
     c = carter_stick_half_width(creepage, mu, a, R)
-    q = ellipse_pressure(x, 0.0, a, 1.0, p0)
+    q = hertz_pressure(x, a, p0)
     if c > 0:
-        q = q - (c / a) * ellipse_pressure(np.asarray(x) - (a - c), 0.0, c, 1.0, p0)
+        q = q - (c / a) * hertz_pressure(np.asarray(x) - (a - c), c, p0)
     return -float(np.sign(creepage)) * mu * q
 
 
@@ -103,8 +90,8 @@ def mindlin_traction(r: np.ndarray, a: float, p0: float, mu: float,
                      q_ratio: float) -> np.ndarray:
     """Cattaneo-Mindlin's traction along Q at the distance r from the centre."""
     c = mindlin_stick_radius(a, q_ratio)
-    q = mu * ellipse_pressure(r, 0.0, a, 1.0, p0)
+    q = mu * hertz_pressure(r, a, p0)
     if c > 0:
-        q = q - mu * (c / a) * ellipse_pressure(r, 0.0, c, 1.0, p0)
+        q = q - mu * (c / a) * hertz_pressure(r, c, p0)
     return q
 

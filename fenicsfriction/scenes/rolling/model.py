@@ -50,6 +50,7 @@ from dolfinx import fem
 from fenicsfriction import _compat, forms, laws
 from fenicsfriction.io import FieldWriter
 from fenicsfriction.laws import check, check_positive
+from fenicsfriction.reduced.rolling.hertz import quasi_identical_modulus
 from fenicsfriction.scenes.rolling import closed_forms
 from fenicsfriction.scenes.rolling.geometry import CLAMPED, CONTACT, half_space
 from fenicsfriction.steady import SteadySolver, epsilon_sequence
@@ -135,7 +136,8 @@ class RollingContact:
             check_positive(name, getattr(self, name))
         if self.dim == 3 and self.b is not None:
             check_positive("b", self.b)
-        closed_forms.contact_modulus(self.G, self.nu)  # validates nu
+        # ν = 1/2 is refused: the displacement formulation locks for incompressible bodies
+        check("nu", self.nu, -1 < self.nu < 0.5, "Poisson's ratio must be in (-1, 0.5)")
         check("p0", self.p0, self.p0 is None or self.Fn is None, "give p0 or Fn, not both")
         if self.Fn is not None:
             check_positive("Fn", self.Fn)
@@ -170,7 +172,7 @@ class RollingContact:
     @property
     def E_star(self) -> float:
         """The pair's contact modulus :math:`E^* = G/(1-\\nu)`."""
-        return closed_forms.contact_modulus(self.G, self.nu)
+        return quasi_identical_modulus(self.G, self.nu)
 
     @property
     def peak_pressure(self) -> float:
