@@ -40,14 +40,13 @@ import time
 import typing
 
 from mpi4py import MPI
-from petsc4py import PETSc
 
-import dolfinx.fem.petsc
 import numpy as np
 import ufl
 from dolfinx import fem
 
 from fenicsfriction import _compat, forms, laws
+from fenicsfriction.assembly import assemble_owned
 from fenicsfriction.io import FieldWriter
 from fenicsfriction.laws import check, check_positive
 from fenicsfriction.reduced.rolling.hertz import quasi_identical_modulus
@@ -445,14 +444,7 @@ class RollingModel:
         ``slip`` (integral against the node's hat function over the hat's integral), gathered
         on every rank and sorted by x, then y."""
         Q, form = self._nodal
-        b = dolfinx.fem.petsc.create_vector(form)
-        with b.localForm() as local:
-            local.set(0.0)
-        dolfinx.fem.petsc.assemble_vector(b, form)
-        b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        k = Q.dofmap.index_map_bs
-        values = b.getArray().reshape(-1, k).copy()
-        b.destroy()
+        values = assemble_owned(form).reshape(-1, Q.dofmap.index_map_bs)
         owned = np.flatnonzero(values[:, 0] > 0)
         x = Q.tabulate_dof_coordinates()[owned, :self.dim]
         local = np.column_stack([x, values[owned, 1:] / values[owned, :1]])
