@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 import typing
 
@@ -18,7 +19,7 @@ __all__ = ["body_cells", "cell_outlines", "plot_contact_deformed", "plot_contact
            "plot_contact_traction", "plot_creep_curves", "plot_deformed", "plot_growth",
            "plot_loci", "plot_oscillator", "plot_rolling_traction_line",
            "plot_rolling_traction_map", "plot_stability_map", "plot_steady_forces",
-           "plot_stick_slip", "plot_stroboscopic_growth"]
+           "plot_stick_slip", "plot_stroboscopic_growth", "saved_figure"]
 
 
 def _pyplot() -> typing.Any:
@@ -26,6 +27,21 @@ def _pyplot() -> typing.Any:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     return plt
+
+
+@contextlib.contextmanager
+def saved_figure(path: PathLike, ncols: int = 1, figsize: tuple[float, float] = (6.5, 4.5),
+                 dpi: int = 120) -> typing.Iterator[typing.Any]:
+    """``ncols`` axes side by side (a NumPy array of them); on leaving the block the figure is
+    laid out, written to ``path`` and closed. Call on rank 0."""
+    plt = _pyplot()
+    fig, axes = plt.subplots(1, ncols, figsize=figsize, squeeze=False)
+    try:
+        yield axes[0]
+    finally:
+        fig.tight_layout()
+        fig.savefig(path, dpi=dpi)
+        plt.close(fig)
 
 
 def cell_outlines(u: fem.Function) -> tuple[np.ndarray, np.ndarray] | None:
@@ -423,19 +439,15 @@ def plot_creep_curves(curves: typing.Sequence[tuple[np.ndarray, np.ndarray, str,
     """Creep-force curves side by side: (creepage, force, label, matplotlib style) each, e.g.
     FASTSIM, the finite element complete theory, Kalker's linear theory and the saturation
     ±μ Fn. Call on rank 0."""
-    plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(7.5, 4.8))
-    for x, f, label, style in curves:
-        ax.plot(x, f, style, ms=4, mfc="none", label=label)
-    ax.axhline(0.0, color="k", lw=0.5)
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel(ylabel)
-    ax.set_title(title, fontsize=10)
-    ax.legend(fontsize=8)
-    ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    with saved_figure(path, figsize=(7.5, 4.8), dpi=130) as (ax,):
+        for x, f, label, style in curves:
+            ax.plot(x, f, style, ms=4, mfc="none", label=label)
+        ax.axhline(0.0, color="k", lw=0.5)
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(ylabel)
+        ax.set_title(title, fontsize=10)
+        ax.legend(fontsize=8)
+        ax.grid(alpha=0.3)
 
 
 def plot_rolling_traction_line(x: np.ndarray, traction: np.ndarray, bound: np.ndarray,
@@ -444,24 +456,20 @@ def plot_rolling_traction_line(x: np.ndarray, traction: np.ndarray, bound: np.nd
     """A line contact in steady rolling (2D): the tangential traction and the traction bound
     μ p_n at the surface points ``x``, the adhesion points marked, a closed form ``exact``
     (abscissae, traction, label) as a line. Call on rank 0."""
-    plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(9, 4.5))
-    order = np.argsort(x)
-    ax.plot(x[order], bound[order], "k--", lw=1.0, label="bound μ p_n")
-    ax.plot(x[order], -bound[order], "k--", lw=1.0)
-    if exact is not None:
-        ax.plot(exact[0], exact[1], "k-", lw=1.2, label=exact[2])
-    ax.plot(x[order], traction[order], "o", ms=3, mfc="none", color="tab:blue",
-            label="traction (slip)")
-    stuck = adhesion.astype(bool)
-    ax.plot(x[stuck], traction[stuck], "o", ms=3.5, color="tab:green", label="adhesion")
-    ax.set_xlabel("x (rolling direction →, leading edge on the right)")
-    ax.set_ylabel("tangential traction on body 1")
-    ax.set_title(title, fontsize=10)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    with saved_figure(path, figsize=(9, 4.5), dpi=130) as (ax,):
+        order = np.argsort(x)
+        ax.plot(x[order], bound[order], "k--", lw=1.0, label="bound μ p_n")
+        ax.plot(x[order], -bound[order], "k--", lw=1.0)
+        if exact is not None:
+            ax.plot(exact[0], exact[1], "k-", lw=1.2, label=exact[2])
+        ax.plot(x[order], traction[order], "o", ms=3, mfc="none", color="tab:blue",
+                label="traction (slip)")
+        stuck = adhesion.astype(bool)
+        ax.plot(x[stuck], traction[stuck], "o", ms=3.5, color="tab:green", label="adhesion")
+        ax.set_xlabel("x (rolling direction →, leading edge on the right)")
+        ax.set_ylabel("tangential traction on body 1")
+        ax.set_title(title, fontsize=10)
+        ax.legend(fontsize=8)
 
 
 def plot_rolling_traction_map(x: np.ndarray, y: np.ndarray, px: np.ndarray, py: np.ndarray,
@@ -471,28 +479,25 @@ def plot_rolling_traction_map(x: np.ndarray, y: np.ndarray, px: np.ndarray, py: 
     |p_τ|/(μ p_n) in colour at the points (x, y), the traction as arrows, the adhesion
     points ringed and the contact ellipse (a along x, b along y) drawn; points where the bound
     is zero (outside the contact) are left out. Call on rank 0."""
-    plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(7.0, float(np.clip(5.0 * b / a, 3.5, 7.5))))
-    inside = bound > 0  # the contact area: where the pressure is positive
-    x, y, px, py, bound, adhesion = (v[inside] for v in (x, y, px, py, bound, adhesion))
-    share = np.divide(np.hypot(px, py), bound, out=np.zeros_like(bound), where=bound > 0)
-    dots = ax.scatter(x, y, c=share, s=12, cmap="viridis", vmin=0.0, vmax=1.0)
-    stuck = adhesion.astype(bool)
-    ax.scatter(x[stuck], y[stuck], s=30, facecolors="none", edgecolors="tab:red", lw=0.6,
-               label="adhesion")
-    scale = np.abs(np.hypot(px, py)).max()
-    if scale > 0:
-        step = max(1, len(x) // 400)
-        ax.quiver(x[::step], y[::step], px[::step], py[::step], color="w", alpha=0.8,
-                  scale=scale * 25, width=0.003)
-    t = np.linspace(0.0, 2 * np.pi, 200)
-    ax.plot(a * np.cos(t), b * np.sin(t), "k-", lw=0.8)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x (rolling direction →)")
-    ax.set_ylabel("y")
-    ax.set_title(title, fontsize=9)
-    ax.legend(fontsize=8, loc="upper left")
-    fig.colorbar(dots, ax=ax, label="|p_τ| / (μ p_n)", shrink=0.8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    height = float(np.clip(5.0 * b / a, 3.5, 7.5))
+    with saved_figure(path, figsize=(7.0, height), dpi=130) as (ax,):
+        inside = bound > 0  # the contact area: where the pressure is positive
+        x, y, px, py, bound, adhesion = (v[inside] for v in (x, y, px, py, bound, adhesion))
+        share = np.divide(np.hypot(px, py), bound, out=np.zeros_like(bound), where=bound > 0)
+        dots = ax.scatter(x, y, c=share, s=12, cmap="viridis", vmin=0.0, vmax=1.0)
+        stuck = adhesion.astype(bool)
+        ax.scatter(x[stuck], y[stuck], s=30, facecolors="none", edgecolors="tab:red", lw=0.6,
+                   label="adhesion")
+        scale = np.abs(np.hypot(px, py)).max()
+        if scale > 0:
+            step = max(1, len(x) // 400)
+            ax.quiver(x[::step], y[::step], px[::step], py[::step], color="w", alpha=0.8,
+                      scale=scale * 25, width=0.003)
+        t = np.linspace(0.0, 2 * np.pi, 200)
+        ax.plot(a * np.cos(t), b * np.sin(t), "k-", lw=0.8)
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (rolling direction →)")
+        ax.set_ylabel("y")
+        ax.set_title(title, fontsize=9)
+        ax.legend(fontsize=8, loc="upper left")
+        ax.figure.colorbar(dots, ax=ax, label="|p_τ| / (μ p_n)", shrink=0.8)

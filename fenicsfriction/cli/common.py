@@ -14,7 +14,8 @@ import typing
 
 from mpi4py import MPI
 
-__all__ = ["flag", "named_by_flag", "output_folder", "scene_from_flags", "stop_line"]
+__all__ = ["flag", "named_by_flag", "output_folder", "scene_from_flags", "stop_line",
+           "write_rows"]
 
 
 def flag(name: str) -> str:
@@ -71,3 +72,15 @@ def stop_line(message: str, comm: MPI.Comm = MPI.COMM_WORLD) -> None:
     """
     if comm.rank == 0:
         print(f"fenicsfriction: {message}", file=sys.stderr, flush=True)
+
+
+def write_rows(path: pathlib.Path, rows: typing.Iterable[dict],
+               comm: MPI.Comm = MPI.COMM_WORLD) -> None:
+    """A CSV table of ``rows`` (dicts with the same keys), written on rank 0; collective, every
+    rank returns once it is written."""
+    from fenicsfriction.results import CsvRows
+
+    with CsvRows(path, comm) as table:
+        for row in rows:
+            table.write(row)
+    comm.Barrier()

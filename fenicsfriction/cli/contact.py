@@ -23,9 +23,14 @@ from mpi4py import MPI
 import numpy as np
 
 from fenicsfriction import _compat, plotting, results
-from fenicsfriction.cli.common import flag, output_folder, scene_from_flags, stop_line
+from fenicsfriction.cli.common import (
+    flag,
+    output_folder,
+    scene_from_flags,
+    stop_line,
+    write_rows,
+)
 from fenicsfriction.laws import check
-from fenicsfriction.results import CsvRows
 
 if typing.TYPE_CHECKING:
     from fenicsfriction.scenes.contact.model import TwoBodyModel
@@ -123,13 +128,6 @@ def _surface_rows(values: typing.Any, columns: dict[str, np.ndarray], dim: int,
     return rows
 
 
-def _write_csv(path: pathlib.Path, rows: list[dict], comm: MPI.Comm) -> None:
-    with CsvRows(path, comm) as table:
-        for row in rows:
-            table.write(row)
-    comm.Barrier()
-
-
 def _hertz_outputs(scene: typing.Any, summary: dict, model: TwoBodyModel, out: pathlib.Path,
                    comm: MPI.Comm, log: logging.Logger,
                    tractions: typing.Sequence[tuple[np.ndarray, str]] = ()) -> None:
@@ -152,7 +150,7 @@ def _hertz_outputs(scene: typing.Any, summary: dict, model: TwoBodyModel, out: p
     if cattaneo:
         columns["cattaneo_traction"] = closed_forms.cattaneo_traction(r, a, p0, scene.mu,
                                                                       scene.q_ratio)
-    _write_csv(out / "surface.csv", _surface_rows(values, columns, dim), comm)
+    write_rows(out / "surface.csv", _surface_rows(values, columns, dim), comm)
     width = "half_width" if dim == 2 else "contact_radius"
     if comm.rank == 0:
         grid = np.linspace(-1.5 * a, 1.5 * a, 601) if dim == 2 else np.linspace(0, 1.5 * a, 301)
@@ -296,7 +294,7 @@ def _run_patch(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) ->
                                        "applied": np.full(len(transmitted), scene.pressure),
                                        "gap": values.gap}, model.dim, {"passes": scene.passes})
         curves.append((values.x[:, 0], transmitted, f"transmitted, {name.replace('_', ' ')}"))
-    _write_csv(out / "surface.csv", rows, comm)
+    write_rows(out / "surface.csv", rows, comm)
     # the two-pass solution (the one that passes the test) when both were run
     name, model = list(models.items())[-1]
     if comm.rank == 0:

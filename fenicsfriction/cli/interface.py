@@ -11,31 +11,16 @@ from __future__ import annotations
 
 import argparse
 import logging
-import pathlib
 import typing
 
 from mpi4py import MPI
 
 import numpy as np
 
-from fenicsfriction import results
-from fenicsfriction.cli.common import named_by_flag, output_folder
-from fenicsfriction.results import CsvRows
+from fenicsfriction import plotting, results
+from fenicsfriction.cli.common import named_by_flag, output_folder, write_rows
 
 __all__ = ["run_interface"]
-
-
-def _pyplot() -> typing.Any:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    return plt
-
-
-def _csv(path: pathlib.Path, rows: typing.Iterable[dict], comm: MPI.Comm) -> None:
-    with CsvRows(path, comm) as table:
-        for row in rows:
-            table.write(row)
 
 
 # --- the EQ model, its master equation, the elastic instability ---------------------------------
@@ -75,25 +60,21 @@ def _run_eq(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> in
                "master_equation": {"kinetic_force": me.kinetic_force,
                                    "static_force": me.static_force, "h": me.h}}
     results.write_summary(out / "interface.json", summary, comm)
-    _csv(out / "force.csv", ({"X": x, "F": f, "F_std": e}
+    write_rows(out / "force.csv", ({"X": x, "F": f, "F_std": e}
                              for x, f, e in zip(run.X, run.F, run.F_std, strict=True)), comm)
     if comm.rank == 0:
-        plt = _pyplot()
-        fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4))
-        a1.plot(run.X, run.F, "-", lw=1, label=f"EQ model ({args.realisations} realisation(s))")
-        a1.plot(me.X, me.F, "k-", lw=1.2, label="master equation")
-        a1.set(xlabel="X", ylabel="F", title="friction force against the slider's position")
-        a1.legend(fontsize=8)
-        centres = 0.5 * (run.histogram_edges[1:] + run.histogram_edges[:-1])
-        a2.bar(centres, run.histogram, width=np.diff(run.histogram_edges), alpha=0.5,
-               label="EQ model")
-        a2.plot(me.x, me.Q / me.h, "k-", label="master equation")
-        a2.set(xlabel="stretching x", ylabel="density Q(x; X)",
-               title=f"stretchings at X = {args.X_max:g}")
-        a2.legend(fontsize=8)
-        fig.tight_layout()
-        fig.savefig(out / "eq.png", dpi=120)
-        plt.close(fig)
+        with plotting.saved_figure(out / "eq.png", ncols=2, figsize=(11, 4)) as (a1, a2):
+            a1.plot(run.X, run.F, "-", lw=1, label=f"EQ model ({args.realisations} realisation(s))")
+            a1.plot(me.X, me.F, "k-", lw=1.2, label="master equation")
+            a1.set(xlabel="X", ylabel="F", title="friction force against the slider's position")
+            a1.legend(fontsize=8)
+            centres = 0.5 * (run.histogram_edges[1:] + run.histogram_edges[:-1])
+            a2.bar(centres, run.histogram, width=np.diff(run.histogram_edges), alpha=0.5,
+                   label="EQ model")
+            a2.plot(me.x, me.Q / me.h, "k-", label="master equation")
+            a2.set(xlabel="stretching x", ylabel="density Q(x; X)",
+                   title=f"stretchings at X = {args.X_max:g}")
+            a2.legend(fontsize=8)
     log.info(f"static force {run.static_force:.6g} (master equation {me.static_force:.6g}), "
              f"kinetic {run.kinetic_force:.6g} ({me.kinetic_force:.6g}), K* = {me.K_star:.6g}; "
              f"results in {out}/: interface.json, force.csv, eq.png")
@@ -108,20 +89,17 @@ def _run_master_equation(args: argparse.Namespace, log: logging.Logger, comm: MP
     me = MasterEquation(model, args.h).solve(args.X_max)
     results.write_summary(out / "interface.json",
                           {"command": "master-equation", **_interface_json(me)}, comm)
-    _csv(out / "force.csv", ({"X": x, "F": f} for x, f in zip(me.X, me.F, strict=True)), comm)
+    write_rows(out / "force.csv", ({"X": x, "F": f} for x, f in zip(me.X, me.F, strict=True)), comm)
     if comm.rank == 0:
-        plt = _pyplot()
-        fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4))
-        a1.plot(me.X, me.F, "k-")
-        a1.axhline(me.kinetic_force, color="gray", ls=":", label="kinetic")
-        a1.set(xlabel="X", ylabel="F", title=f"F(X): static {me.static_force:.4g}, K* = "
-                                             f"{me.K_star:.4g}")
-        a1.legend(fontsize=8)
-        a2.plot(me.x, me.Q / me.h, "k-")
-        a2.set(xlabel="stretching x", ylabel="Q(x; X)", title=f"Q at X = {me.X[-1]:.4g}")
-        fig.tight_layout()
-        fig.savefig(out / "master_equation.png", dpi=120)
-        plt.close(fig)
+        with plotting.saved_figure(out / "master_equation.png", ncols=2,
+                                   figsize=(11, 4)) as (a1, a2):
+            a1.plot(me.X, me.F, "k-")
+            a1.axhline(me.kinetic_force, color="gray", ls=":", label="kinetic")
+            a1.set(xlabel="X", ylabel="F", title=f"F(X): static {me.static_force:.4g}, K* = "
+                                                 f"{me.K_star:.4g}")
+            a1.legend(fontsize=8)
+            a2.plot(me.x, me.Q / me.h, "k-")
+            a2.set(xlabel="stretching x", ylabel="Q(x; X)", title=f"Q at X = {me.X[-1]:.4g}")
     log.info(f"static force {me.static_force:.6g}, kinetic {me.kinetic_force:.6g}, "
              f"K* = {me.K_star:.6g}, mass error {me.mass_error:.1e}; results in {out}/: "
              "interface.json, force.csv, master_equation.png")
@@ -138,26 +116,22 @@ def _run_stability_map(args: argparse.Namespace, log: logging.Logger, comm: MPI.
                            x_s_mean=args.x_s_mean, seed=args.seed)
     results.write_summary(out / "interface.json", {"command": "stability-map",
                                                    **smap.to_json()}, comm)
-    _csv(out / "map.csv", ({"relative_spread": s, "K": K, "K_star": smap.K_star[i],
+    write_rows(out / "map.csv", ({"relative_spread": s, "K": K, "K_star": smap.K_star[i],
                             "stick_slip": bool(smap.stick_slip[i, j]),
                             "max_speed": smap.max_speed[i, j]}
                            for i, s in enumerate(smap.relative_spread)
                            for j, K in enumerate(smap.K)), comm)
     if comm.rank == 0:
-        plt = _pyplot()
-        fig, ax = plt.subplots(figsize=(6.5, 4.5))
-        KK, SS = np.meshgrid(smap.K, smap.relative_spread)
-        stuck = smap.stick_slip.astype(bool)
-        ax.scatter(KK[stuck], SS[stuck], marker="x", color="tab:red", label="stick-slip")
-        ax.scatter(KK[~stuck], SS[~stuck], marker="o", facecolors="none",
-                   edgecolors="tab:blue", label="smooth sliding")
-        ax.plot(smap.K_star, smap.relative_spread, "k-", label="K* = −max F′(X)")
-        ax.set(xscale="log", xlabel="drive stiffness K", ylabel="threshold spread σ/x_c",
-               title="elastic instability of the EQ interface")
-        ax.legend(fontsize=8)
-        fig.tight_layout()
-        fig.savefig(out / "stability_map.png", dpi=120)
-        plt.close(fig)
+        with plotting.saved_figure(out / "stability_map.png", figsize=(6.5, 4.5)) as (ax,):
+            KK, SS = np.meshgrid(smap.K, smap.relative_spread)
+            stuck = smap.stick_slip.astype(bool)
+            ax.scatter(KK[stuck], SS[stuck], marker="x", color="tab:red", label="stick-slip")
+            ax.scatter(KK[~stuck], SS[~stuck], marker="o", facecolors="none",
+                       edgecolors="tab:blue", label="smooth sliding")
+            ax.plot(smap.K_star, smap.relative_spread, "k-", label="K* = −max F′(X)")
+            ax.set(xscale="log", xlabel="drive stiffness K", ylabel="threshold spread σ/x_c",
+                   title="elastic instability of the EQ interface")
+            ax.legend(fontsize=8)
     agree = np.mean(smap.stick_slip == (smap.K[None, :] < smap.K_star[:, None]))
     log.info(f"{agree:.0%} of the runs on the side of K* the master equation predicts; "
              f"results in {out}/: interface.json, map.csv, stability_map.png")
@@ -194,23 +168,19 @@ def _run_interaction(args: argparse.Namespace, log: logging.Logger, comm: MPI.Co
                "crossover": fit.crossover, "crossover_over_lambda_c": fit.crossover / lam,
                "r": list(map(float, r)), "dF": list(map(float, f))}
     results.write_summary(out / "interface.json", summary, comm)
-    _csv(out / "response.csv", ({"r": x, "dF": y} for x, y in zip(r, f, strict=True)), comm)
+    write_rows(out / "response.csv", ({"r": x, "dF": y} for x, y in zip(r, f, strict=True)), comm)
     if comm.rank == 0:
-        plt = _pyplot()
-        fig, ax = plt.subplots(figsize=(6, 4.2))
-        ax.loglog(r, f, "o", ms=3, label="|δf(r)| / |δf(0)|")
-        for slope, pre, where, style in (
-                (fit.near_exponent, fit.near_prefactor, r < near, "k--"),
-                (fit.far_exponent, fit.far_prefactor, r > 3 * lam, "k:")):
-            if np.any(where):
-                ax.loglog(r[where], pre * r[where] ** slope, style, label=f"slope {slope:.2f}")
-        ax.axvline(lam, color="gray", lw=0.8, label="λ_c")
-        ax.set(xlabel="r / a", ylabel="response of the other contacts",
-               title="a contact breaks: the response against distance")
-        ax.legend(fontsize=8)
-        fig.tight_layout()
-        fig.savefig(out / "interaction.png", dpi=120)
-        plt.close(fig)
+        with plotting.saved_figure(out / "interaction.png", figsize=(6, 4.2)) as (ax,):
+            ax.loglog(r, f, "o", ms=3, label="|δf(r)| / |δf(0)|")
+            for slope, pre, where, style in (
+                    (fit.near_exponent, fit.near_prefactor, r < near, "k--"),
+                    (fit.far_exponent, fit.far_prefactor, r > 3 * lam, "k:")):
+                if np.any(where):
+                    ax.loglog(r[where], pre * r[where] ** slope, style, label=f"slope {slope:.2f}")
+            ax.axvline(lam, color="gray", lw=0.8, label="λ_c")
+            ax.set(xlabel="r / a", ylabel="response of the other contacts",
+                   title="a contact breaks: the response against distance")
+            ax.legend(fontsize=8)
     log.info(f"near exponent {fit.near_exponent:.3f} (r < {near:g}), far {fit.far_exponent:.3f} "
              f"(r > 3 λ_c), crossover at {fit.crossover / lam:.2f} λ_c; results in {out}/: "
              "interface.json, response.csv, interaction.png")
@@ -248,36 +218,33 @@ def _run_fk(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> in
         sweep = front_speeds(chain, args.forces, relaxed=relaxed, first=first,
                              last=min(last, args.n - 1))
         summary["front_speeds"] = sweep.to_json()
-        _csv(out / "front_speeds.csv", sweep.rows(), comm)
-    _csv(out / "fk.csv", run.rows(), comm)
+        write_rows(out / "front_speeds.csv", sweep.rows(), comm)
+    write_rows(out / "fk.csv", run.rows(), comm)
     results.write_summary(out / "interface.json", summary, comm)
     if comm.rank == 0:
-        plt = _pyplot()
         panels = 2 if args.forces else 1
-        fig, axes = plt.subplots(1, panels, figsize=(5.5 * panels, 4), squeeze=False)
-        ax = axes[0, 0]
-        sites = np.flatnonzero(broken)
-        ax.plot(run.break_time[sites], sites * chain.a, ".", ms=3)
-        ax.set(xlabel="t", ylabel="x of the contact (first break)",
-               title=f"front in the x–t plane, f = {args.force:g}")
-        if args.forces:
-            ax = axes[0, 1]
-            s = summary["front_speeds"]
-            fine = np.linspace(chain.f_min, chain.f_max, 201)[1:-1]
-            ax.plot(s["force"], s["measured"], "o", label="chain")
-            ax.plot(fine, chain.continuum_front_speed(fine), "k-",
-                    label="continuum travelling wave")
-            ax.plot(fine, chain.low_velocity_speed(fine), "k--", lw=0.8,
-                    label="low-velocity limit")
-            ax.plot(fine, chain.high_velocity_speed(fine), "k:", lw=0.8,
-                    label="high-velocity limit")
-            ax.set_ylim(0, 1.2 * chain.sound_speed)
-            ax.axhline(chain.sound_speed, color="gray", ls=":", label="sound speed")
-            ax.set(xlabel="f", ylabel="front speed", title="front speed against the force")
-            ax.legend(fontsize=8)
-        fig.tight_layout()
-        fig.savefig(out / "fk.png", dpi=120)
-        plt.close(fig)
+        with plotting.saved_figure(out / "fk.png", ncols=panels,
+                                   figsize=(5.5 * panels, 4)) as axes:
+            ax = axes[0]
+            sites = np.flatnonzero(broken)
+            ax.plot(run.break_time[sites], sites * chain.a, ".", ms=3)
+            ax.set(xlabel="t", ylabel="x of the contact (first break)",
+                   title=f"front in the x–t plane, f = {args.force:g}")
+            if args.forces:
+                ax = axes[1]
+                s = summary["front_speeds"]
+                fine = np.linspace(chain.f_min, chain.f_max, 201)[1:-1]
+                ax.plot(s["force"], s["measured"], "o", label="chain")
+                ax.plot(fine, chain.continuum_front_speed(fine), "k-",
+                        label="continuum travelling wave")
+                ax.plot(fine, chain.low_velocity_speed(fine), "k--", lw=0.8,
+                        label="low-velocity limit")
+                ax.plot(fine, chain.high_velocity_speed(fine), "k:", lw=0.8,
+                        label="high-velocity limit")
+                ax.set_ylim(0, 1.2 * chain.sound_speed)
+                ax.axhline(chain.sound_speed, color="gray", ls=":", label="sound speed")
+                ax.set(xlabel="f", ylabel="front speed", title="front speed against the force")
+                ax.legend(fontsize=8)
     log.info(f"{summary['contacts_broken']} contacts broken; front speed "
              f"{summary.get('front_speed', float('nan')):.6g} (continuum "
              f"{summary['continuum_front_speed'] or float('nan'):.6g}); results in {out}/: "
@@ -317,17 +284,14 @@ def _run_slider(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -
     with FieldWriter(out / "slider.xdmf", model) as writer:
         writer.write(float(model.time.value))
     if comm.rank == 0:
-        plt = _pyplot()
-        fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4))
-        a1.plot(np.array(history.time) * 1e3, np.array(history.front_position) / scene.L, "-")
-        for b in history.breaks:
-            a1.plot(b.time * 1e3, b.x / scene.L, ".", color="tab:red", ms=2)
-        a1.set(xlabel="t [ms]", ylabel="x / L", title="detachment fronts (breaks in red)")
-        a2.plot(np.array(history.time) * 1e3, history.push_force, "-")
-        a2.set(xlabel="t [ms]", ylabel="push force [N/m]", title="the force on the trailing edge")
-        fig.tight_layout()
-        fig.savefig(out / "fronts.png", dpi=120)
-        plt.close(fig)
+        with plotting.saved_figure(out / "fronts.png", ncols=2, figsize=(11, 4)) as (a1, a2):
+            a1.plot(np.array(history.time) * 1e3, np.array(history.front_position) / scene.L, "-")
+            for b in history.breaks:
+                a1.plot(b.time * 1e3, b.x / scene.L, ".", color="tab:red", ms=2)
+            a1.set(xlabel="t [ms]", ylabel="x / L", title="detachment fronts (breaks in red)")
+            a2.plot(np.array(history.time) * 1e3, history.push_force, "-")
+            a2.set(xlabel="t [ms]", ylabel="push force [N/m]",
+                   title="the force on the trailing edge")
     log.info(f"{len(history.breaks)} breaks, {len(history.fronts)} fronts, slip force "
              f"{history.slip_force}; results in {out}/: interface.json, slider.csv, fronts.png, "
              "slider.xdmf")
