@@ -23,11 +23,10 @@ from __future__ import annotations
 
 import math
 import sys
-import time
 
 import numpy as np
+from _common import best_time, save
 from _common import parser as benchmark_parser
-from _common import save
 
 from fenicsfriction.reduced.rolling.fastsim import creep_curve, fastsim, linear_theory
 from fenicsfriction.results import write_summary
@@ -35,16 +34,6 @@ from fenicsfriction.results import write_summary
 CASE = {"a": 6.304e-3, "b": 12.61e-3, "G": 82e9, "nu": 0.28, "mu": 0.3, "Fn": 106.7e3}
 CREEPAGES = (1e-4, 1e-3, 3e-3)
 BASELINE_GRID = 40
-
-
-def best_time(call, repeats: int) -> tuple[float, object]:
-    """The shortest of ``repeats`` wall times of ``call()`` (noise only ever adds time)."""
-    times, value = [], None
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        value = call()
-        times.append(time.perf_counter() - t0)
-    return min(times), value
 
 
 def grid_study(grids: list[int], repeats: int) -> list[dict]:

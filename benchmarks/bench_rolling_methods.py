@@ -34,8 +34,8 @@ import time
 
 from mpi4py import MPI
 
+from _common import best_time, save
 from _common import parser as benchmark_parser
-from _common import save
 
 from fenicsfriction.reduced.rolling.fastsim import fastsim, linear_theory
 from fenicsfriction.results import write_summary
@@ -55,12 +55,8 @@ def fastsim_rows(grids: list[int], repeats: int) -> list[dict]:
     for n in grids:
         curve, raw, seconds = [], [], 0.0
         for xi in CREEPAGES:
-            times = []
-            for _ in range(repeats):
-                t0 = time.perf_counter()
-                result = fastsim(**CASE, xi=xi, nx=n, ny=n)
-                times.append(time.perf_counter() - t0)
-            seconds += min(times)
+            best, result = best_time(lambda xi=xi, n=n: fastsim(**CASE, xi=xi, nx=n, ny=n), repeats)
+            seconds += best
             curve.append(_normalised(result.Fx, result.Fn))
             raw.append(result.Fx)
         rows.append({"method": "fastsim", "n": n, "force": curve, "Fx": raw, "time_s": seconds})
