@@ -32,9 +32,9 @@ _METHOD_FLAGS = {"fastsim": ("nx", "ny", "pressure"),
                  "fe": ("dim", "cells_per_a", "block_size", "normal", "eps_sequence")}
 
 
-def _parameters(args: argparse.Namespace) -> dict[str, typing.Any]:
-    """The contact's data and the method's discretisation, as given (b: a when not given)."""
-    names = ("a", "b", "G", "nu", "mu", "Fn") + _METHOD_FLAGS[args.method]
+def _parameters(args: argparse.Namespace, method: str) -> dict[str, typing.Any]:
+    """The contact's data and ``method``'s discretisation, as given (b: a when not given)."""
+    names = ("a", "b", "G", "nu", "mu", "Fn") + _METHOD_FLAGS[method]
     values = {k: getattr(args, k, None) for k in names}
     if values["b"] is None:
         values["b"] = values["a"]
@@ -55,18 +55,15 @@ def _record(method: str, parameters: dict, Fx: float, Fy: float, Mz: float | Non
 
 # --- FASTSIM ------------------------------------------------------------------------------------
 
-def _fastsim_options(args: argparse.Namespace) -> dict[str, typing.Any]:
-    return {k: getattr(args, k) for k in ("nx", "ny", "pressure") if getattr(args, k) is not None}
-
-
-def _fastsim_records(args: argparse.Namespace, xi: typing.Sequence[float]) -> tuple[list, list]:
-    """(records, FASTSIM results) at the creepages ``xi`` (with the flags' η and φ)."""
+def _fastsim_records(p: dict, args: argparse.Namespace,
+                     xi: typing.Sequence[float]) -> tuple[list, list]:
+    """(records, FASTSIM results) of the parameters ``p`` at the creepages ``xi`` (with the
+    flags' η and φ)."""
     from fenicsfriction.reduced.rolling.fastsim import creep_curve
 
-    p = _parameters(args)
+    grid = {k: p[k] for k in _METHOD_FLAGS["fastsim"] if k in p}
     points = creep_curve(p["a"], p["b"], p["G"], p["nu"], p["mu"], p["Fn"], xi=np.asarray(xi),
-                         eta=np.full(len(xi), args.eta), phi=np.full(len(xi), args.phi),
-                         **_fastsim_options(args))
+                         eta=np.full(len(xi), args.eta), phi=np.full(len(xi), args.phi), **grid)
     records = [_record("fastsim", p, r.Fx, r.Fy, r.Mz, r.Fn, (r.xi, r.eta, r.phi),
                        r.adhesion_fraction, r.wall_time_s) for r in points]
     return records, points
@@ -91,11 +88,10 @@ def _cylinders(p: dict) -> tuple[float, float]:
     return scene.peak_pressure, scene.radius
 
 
-def _fe_model(args: argparse.Namespace, comm: MPI.Comm) -> typing.Any:
-    """The finite element model of the flags' contact (built once, re-solved per creepage)."""
+def _fe_model(p: dict, comm: MPI.Comm) -> typing.Any:
+    """The finite element model of the parameters ``p`` (built once, re-solved per creepage)."""
     from fenicsfriction.scenes.rolling import RollingContact
 
-    p = _parameters(args)
     renamed = {"normal": "pressure", "eps_sequence": "eps"}
     fields: dict[str, typing.Any] = {renamed.get(k, k): (tuple(v) if k == "eps_sequence" else v)
                                      for k, v in p.items()}
@@ -103,10 +99,9 @@ def _fe_model(args: argparse.Namespace, comm: MPI.Comm) -> typing.Any:
     return scene.build(comm)
 
 
-def _fe_records(model: typing.Any, args: argparse.Namespace, xi: typing.Sequence[float],
-                log: logging.Logger) -> tuple[list, list]:
+def _fe_records(model: typing.Any, p: dict, args: argparse.Namespace,
+                xi: typing.Sequence[float], log: logging.Logger) -> tuple[list, list]:
     """(records, results) of the creepages ``xi`` in turn, each from the last."""
-    p = _parameters(args)
     records, solutions = [], []
     for k, value in enumerate(xi):
         solution = model.solve((value, args.eta, args.phi))
@@ -145,10 +140,10 @@ def _fe_traction(result: typing.Any, p: dict, dim: int, path: pathlib.Path) -> N
 
 # --- outputs ------------------------------------------------------------------------------------
 
-def _creep_curve_png(records: list[dict], args: argparse.Namespace, path: pathlib.Path) -> None:
+def _creep_curve_png(records: list[dict], p: dict, args: argparse.Namespace,
+                     path: pathlib.Path) -> None:
     """Fx/(μFn) against ξ: the records' method, FASTSIM beside it (cheap), Kalker's linear
     theory (3D) or Carter's closed form (2D)."""
-    p = _parameters(args)
     xi = np.array([r["creepage"]["xi"] for r in records])
     scale = p["mu"] * p["Fn"]
     fine = np.linspace(min(xi.min(), 0.0), xi.max(), 200)
@@ -212,37 +207,37 @@ def _run(args: argparse.Namespace, log: logging.Logger) -> int:
     _validate(args)
     curve = args.method == "curve"
     method = args.curve_method if curve else args.method
-    args.method = method
+    p = _parameters(args, method)
     xi = args.xi_range if curve else [args.xi]
     out = output_folder(args.out)
     if method == "fastsim":
-        records, points = _fastsim_records(args, xi)
+        records, points = _fastsim_records(p, args, xi)
         if comm.rank == 0:
-            _fastsim_traction(points[-1], _parameters(args), out / "traction.png")
+            _fastsim_traction(points[-1], p, out / "traction.png")
         for r in records:
             log.info(f"ξ = {r['creepage']['xi']:.4g}  Fx = {r['Fx']:.6g}  Fy = {r['Fy']:.6g}  "
                      f"Fx/(μFn) = {r['Fx'] / (r['mu'] * r['Fn']):+.5f}  adhesion "
                      f"{r['adhesion_fraction']:.3f}")
         written = ["rolling.json", "traction.png"]
     else:
-        model = _fe_model(args, comm)
+        model = _fe_model(p, comm)
         log.info(f"rolling fe {model.dim}D: {model.dofs} dofs on {comm.size} rank(s)")
         try:
-            records, solutions = _fe_records(model, args, xi, log)
+            records, solutions = _fe_records(model, p, args, xi, log)
         except RuntimeError as err:
             results.write_summary(out / "rolling.json", {
-                "method": "fe", "parameters": _parameters(args), "failure": str(err)}, comm)
+                "method": "fe", "parameters": p, "failure": str(err)}, comm)
             stop_line(f"rolling fe: {err}", comm)
             return 1
         from fenicsfriction.scenes.rolling import write_xdmf
         write_xdmf(out / "rolling.xdmf", model)
         if comm.rank == 0:
-            _fe_traction(solutions[-1], _parameters(args), model.dim, out / "traction.png")
+            _fe_traction(solutions[-1], p, model.dim, out / "traction.png")
         written = ["rolling.json", "traction.png", "rolling.xdmf"]
     _write(out, records, curve, comm)
     if curve:
         if comm.rank == 0:
-            _creep_curve_png(records, args, out / "creep_curve.png")
+            _creep_curve_png(records, p, args, out / "creep_curve.png")
         written.append("creep_curve.png")
     comm.Barrier()
     log.info(f"results in {out}/: {', '.join(written)}")
