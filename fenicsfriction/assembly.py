@@ -17,14 +17,24 @@ from dolfinx import fem
 
 from fenicsfriction import _compat
 
-__all__ = ["CoupledMatrix", "assemble_jacobian", "assemble_owned", "assemble_residual"]
+__all__ = ["CoupledMatrix", "assemble_into", "assemble_jacobian", "assemble_owned",
+           "assemble_residual"]
+
+
+def assemble_into(vector: PETSc.Vec, form: typing.Any) -> PETSc.Vec:
+    """``vector`` = the linear form assembled anew (zeroed first), the ghosts' contributions
+    added to their owners; returned for chaining."""
+    with vector.localForm() as local:
+        local.set(0.0)
+    dolfinx.fem.petsc.assemble_vector(vector, form)
+    vector.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    return vector
 
 
 def assemble_owned(form: typing.Any) -> np.ndarray:
     """A linear form's assembled vector: its owned entries, the ghosts' contributions added
     (a copy; e.g. nodal forces or the tributary areas of the nodes)."""
-    vector = dolfinx.fem.petsc.assemble_vector(form)
-    vector.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    vector = assemble_into(dolfinx.fem.petsc.create_vector(form), form)
     values = vector.array_r.copy()
     vector.destroy()
     return values

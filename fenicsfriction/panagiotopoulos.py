@@ -53,7 +53,7 @@ from ufl.corealg.multifunction import MultiFunction
 from ufl.corealg.traversal import unique_pre_traversal
 
 from fenicsfriction import _compat
-from fenicsfriction.assembly import assemble_owned
+from fenicsfriction.assembly import assemble_into, assemble_owned
 from fenicsfriction.forms import Residual
 from fenicsfriction.laws import FRICTION_BOUND, check, check_positive
 from fenicsfriction.mollification import SurfaceMollifier
@@ -283,11 +283,7 @@ class PanagiotopoulosSolver:
         self.mollified_bound.x.scatter_forward()
 
     def _traction(self, vector: PETSc.Vec) -> PETSc.Vec:
-        with vector.localForm() as local:
-            local.set(0.0)
-        dolfinx.fem.petsc.assemble_vector(vector, self._friction)
-        vector.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        return vector
+        return assemble_into(vector, self._friction)
 
     # --- the solve ----------------------------------------------------------------------------
     def _report(self, converged: bool, outer: int, newton: int, t0: float, changes: list,

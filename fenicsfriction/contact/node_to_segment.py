@@ -45,7 +45,7 @@ import ufl
 from dolfinx import fem, mesh
 
 from fenicsfriction import _compat, laws
-from fenicsfriction.assembly import assemble_owned
+from fenicsfriction.assembly import assemble_into, assemble_owned
 from fenicsfriction.contact.kinematics import Projection, project
 from fenicsfriction.contact.pairing import Pairing, facet_nodes
 
@@ -368,10 +368,7 @@ class ContactOperator:
                        or not contact.searched)
         t0 = time.perf_counter()
         for vector, form in ((self.b_F, self.F), (self.b_G, self.G)):
-            with vector.localForm() as local:
-                local.set(0.0)
-            dolfinx.fem.petsc.assemble_vector(vector, form)
-            vector.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+            assemble_into(vector, form)
         b.axpy(1.0, self.b_F)
         Q = self.contact.pairing.Q
         assert Q is not None

@@ -18,7 +18,6 @@ import dataclasses
 import typing
 
 from mpi4py import MPI
-from petsc4py import PETSc
 
 import dolfinx.fem.petsc
 import numpy as np
@@ -26,6 +25,7 @@ import ufl
 from dolfinx import fem
 
 from fenicsfriction import _compat, laws
+from fenicsfriction.assembly import assemble_into
 from fenicsfriction.results import Record
 from fenicsfriction.scenes.block.data import TOP
 
@@ -152,11 +152,8 @@ class Functionals:
 
     def local(self) -> np.ndarray:
         """This rank's share of each integral, in the order of ``names`` (no communication)."""
-        with self.vector.localForm() as b:
-            b.set(0.0)
-        dolfinx.fem.petsc.assemble_vector(self.vector, self.form)
-        self.vector.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        return self.vector.array_r.reshape(-1, len(self.names)).sum(axis=0)
+        owned = assemble_into(self.vector, self.form).array_r
+        return owned.reshape(-1, len(self.names)).sum(axis=0)
 
     def values(self) -> dict[str, float]:
         """The integrals by name (same on every rank)."""
