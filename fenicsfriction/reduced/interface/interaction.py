@@ -175,7 +175,8 @@ def contact_forces(G: Array, stiffness: float | npt.ArrayLike, U0: npt.ArrayLike
     n = G.shape[0] // 3
     k = _stiffness_vector(stiffness, n)
     A = np.eye(3 * n) + k[:, None] * G
-    return np.linalg.solve(A, k * _displacements(U0, n)).reshape(n, 3)
+    forces = np.linalg.solve(A, k * _displacements(U0, n))
+    return np.asarray(forces, dtype=np.float64).reshape(n, 3)
 
 
 def break_response(G: Array, stiffness: float | npt.ArrayLike, U0: npt.ArrayLike,

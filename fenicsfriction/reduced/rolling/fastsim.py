@@ -231,8 +231,8 @@ def creep_curve(a: float, b: float, G: float, nu: float, mu: float, Fn: float,
     px = np.zeros((len(xis), ny, nx))
     py = np.zeros_like(px)
     slip = np.zeros(px.shape, dtype=bool)
-    tx = np.zeros((len(xis), ny))
-    ty = np.zeros_like(tx)
+    tx: npt.NDArray[np.float64] = np.zeros((len(xis), ny))
+    ty: npt.NDArray[np.float64] = np.zeros_like(tx)
     for i in range(nx):
         step = 0.5 * dx if i == 0 else dx                  # from the edge, then centre to centre
         mid = x[:, i] + 0.5 * step                         # w_y is linear: its midpoint is exact

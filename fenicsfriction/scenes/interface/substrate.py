@@ -85,7 +85,8 @@ class SubstrateBlock:
     @property
     def surface_nodes(self) -> npt.NDArray[np.float64]:
         """x (and y) coordinates of the top face's vertices (m): contacts sit on these."""
-        return self.graded(np.linspace(-1.0, 1.0, self.cells_per_side + 1)) * self.width / 2
+        uniform = np.linspace(-1.0, 1.0, self.cells_per_side + 1, dtype=np.float64)
+        return self.graded(uniform) * self.width / 2
 
     def graded(self, xi: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
         """The grading map ``sign(ξ) |ξ|^p`` of uniform box coordinates in [-1, 1]."""

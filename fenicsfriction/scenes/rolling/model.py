@@ -42,6 +42,7 @@ import typing
 from mpi4py import MPI
 
 import numpy as np
+import numpy.typing as npt
 import ufl
 from dolfinx import fem
 
@@ -332,7 +333,7 @@ class RollingModel:
         zero = fem.Function(V)
         self.residual = forms.Residual(form, self.u, zero, zero, v, bcs=[self._clamp()])
         self.solver = SteadySolver(self.residual, prefix="rolling_", options=SOLVER_OPTIONS)
-        self.shift_total = np.zeros(dim - 1)
+        self.shift_total: npt.NDArray[np.float64] = np.zeros(dim - 1)
 
     # --- the pieces of the residual ----------------------------------------------------------
 
