@@ -14,7 +14,10 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "SpringDrivenResult": "eq_model", "describe_distribution": "eq_model",
     "MasterEquation": "master_equation", "MasterEquationResult": "master_equation",
     "InstabilityMap": "instability", "instability_map": "instability",
-    "critical_stiffness": "instability", "FKChain": "frenkel_kontorova",
+    "critical_stiffness": "instability", "CouplingMap": "instability",
+    "coupling_map": "instability", "InteractingEQModel": "interacting",
+    "InteractingQuasistaticResult": "interacting", "lattice_compliance": "interacting",
+    "FKChain": "frenkel_kontorova",
     "FKResult": "frenkel_kontorova", "FrontSpeeds": "frenkel_kontorova",
     "TriangleRamp": "frenkel_kontorova", "front_speeds": "frenkel_kontorova",
     "LatticeInteraction": "interaction", "interaction_matrix": "interaction",
@@ -36,9 +39,16 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers
         front_speeds,
     )
     from fenicsfriction.reduced.interface.instability import (
+        CouplingMap,
         InstabilityMap,
+        coupling_map,
         critical_stiffness,
         instability_map,
+    )
+    from fenicsfriction.reduced.interface.interacting import (
+        InteractingEQModel,
+        InteractingQuasistaticResult,
+        lattice_compliance,
     )
     from fenicsfriction.reduced.interface.interaction import (
         LatticeInteraction,

@@ -40,8 +40,8 @@ from scipy import stats
 from fenicsfriction.laws import check, check_positive
 from fenicsfriction.results import Record
 
-__all__ = ["Distribution", "EQModel", "QuasistaticResult", "SpringDrivenResult",
-           "describe_distribution"]
+__all__ = ["Contacts", "Distribution", "EQModel", "IndependentContacts", "QuasistaticResult",
+           "SpringDrivenResult", "describe_distribution", "drive"]
 
 
 class Distribution(typing.Protocol):
@@ -166,6 +166,8 @@ class EQModel:
     x_s_std: float = 0.1
     thresholds: Distribution | None = None
     newborn: Distribution | None = None
+    _gaussian: tuple[tuple[float, float], Distribution] | None = dataclasses.field(
+        default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         check("n_contacts", self.n_contacts,
@@ -183,9 +185,14 @@ class EQModel:
 
     @property
     def P_c(self) -> Distribution:
-        """The threshold distribution P_c."""
-        return self.thresholds if self.thresholds is not None else \
-            stats.norm(loc=self.x_s_mean, scale=self.x_s_std)
+        """The threshold distribution P_c (the Gaussian is kept while its parameters stay: a
+        SciPy frozen distribution costs ~0.3 ms to make, more than a step's draws)."""
+        if self.thresholds is not None:
+            return self.thresholds
+        key = (self.x_s_mean, self.x_s_std)
+        if self._gaussian is None or self._gaussian[0] != key:
+            self._gaussian = (key, stats.norm(loc=self.x_s_mean, scale=self.x_s_std))
+        return self._gaussian[1]
 
     def parameters(self) -> dict[str, typing.Any]:
         """N, k, the threshold distribution's mean and spread and the newborn distribution."""
@@ -296,67 +303,105 @@ class EQModel:
             prefix, options: the TS's options prefix and defaults
                 (see :class:`~fenicsfriction.reduced.dynamics.ReducedDynamics`).
         """
-        from fenicsfriction.reduced.dynamics import ReducedDynamics
-
-        for name, value in (("K", K), ("v", v), ("mass", mass), ("t_end", t_end), ("dt", dt),
-                            ("slip_speed", slip_speed)):
-            check_positive(name, value)
-        check_positive("damping", damping, strict=False)
-        late_from = 0.5 * t_end if late_from is None else late_from
-        check("late_from", late_from, 0 <= late_from < t_end, f"must lie in [0, {t_end})")
-        slider = _SpringDrivenSlider(self, K, mass, damping, np.random.default_rng(seed))
-        integrator = ReducedDynamics(slider, [0.0, 0.0], [0.0, v], prefix=prefix,
-                                     options=options, atol=1e-12 * self.n_contacts * self.k
-                                     * self.x_s_mean)
-        records = integrator.run(
-            t_end, dt, observe=lambda t: slider.observe(integrator.q, integrator.q_dot))
-        t, X, X_dot, D, friction, broken = (np.array([r[key] for r in records]) for key in
-                                            ("time", "X", "X_dot", "D", "friction", "breaks"))
-        spring = K * (D - X)
-        late = t >= late_from
-        max_speed = float(np.max(X_dot) / v)
-        return SpringDrivenResult(
-            t=t, X=X, X_dot=X_dot, spring_force=spring, friction_force=friction,
-            breaks=broken.astype(int), K=float(K), v=float(v), mass=float(mass),
-            damping=float(damping), late_from=float(late_from),
-            force_spread=float(np.std(spring[late]) / abs(np.mean(spring[late]))),
-            velocity_spread=float(np.std(X_dot[late]) / v),
-            stuck_fraction=float(np.mean(X_dot[late] < 0.1 * v)), max_speed=max_speed,
-            stick_slip=max_speed > slip_speed, parameters=self.parameters())
+        contacts = IndependentContacts(self, np.random.default_rng(seed))
+        return drive(contacts, self.parameters(), K=K, v=v, mass=mass, damping=damping,
+                     t_end=t_end, dt=dt, late_from=late_from, slip_speed=slip_speed,
+                     prefix=prefix, options=options)
 
 
-class _SpringDrivenSlider:
-    """The slider and the drive q = (X, D) for :class:`ReducedDynamics`; the contacts' anchors
-    a (x_i = X − a_i) and thresholds change after each accepted step (:meth:`observe`)."""
+class Contacts(typing.Protocol):
+    """The contacts as the spring-driven slider sees them (:func:`drive`): a friction force
+    linear in the slider's position X between breaks, and the breaks."""
 
-    def __init__(self, model: EQModel, K: float, mass: float, damping: float,
-                 rng: np.random.Generator) -> None:
-        self.model, self.K, self.mass, self.damping, self.rng = model, K, mass, damping, rng
+    #: dF/dX between breaks (force / length).
+    stiffness: float
+    #: a force scale of the interface, for the tolerance of the time integration.
+    weight: float
+
+    def friction(self, X: float) -> float:
+        """The contacts' force on the slider at X, before the breaks at X."""
+
+    def relax(self, X: float) -> int:
+        """Break every contact over its threshold at X and re-form it (and any it overloads);
+        return the number of breaks."""
+
+
+class IndependentContacts:
+    """The EQ model's contacts without interaction: x_i = X − a_i, F = k (N X − Σ a_i)."""
+
+    def __init__(self, model: EQModel, rng: np.random.Generator) -> None:
+        self.model, self.rng = model, rng
         self.anchors = np.zeros(model.n_contacts)
         self.thresholds = model.draw_thresholds(rng, self.anchors)
         self.sum_anchors = 0.0
+        self.stiffness = model.n_contacts * model.k
         self.weight = model.n_contacts * model.k * model.x_s_mean
 
+    def friction(self, X: float) -> float:
+        return self.model.k * (self.model.n_contacts * X - self.sum_anchors)
+
+    def relax(self, X: float) -> int:
+        broken = np.flatnonzero(X - self.anchors > self.thresholds)
+        if broken.size:
+            x0 = self.model.draw_newborn(self.rng, broken.size)
+            self.anchors[broken] = X - x0
+            self.thresholds[broken] = self.model.draw_thresholds(self.rng, x0)
+            self.sum_anchors = float(np.sum(self.anchors))
+        return int(broken.size)
+
+
+def drive(contacts: Contacts, parameters: dict, K: float, v: float, mass: float,
+          damping: float, t_end: float, dt: float, late_from: float | None = None,
+          slip_speed: float = 10.0, prefix: str = "eq_",
+          options: dict | None = None) -> SpringDrivenResult:
+    """Pull a slider held by ``contacts`` through a spring K (see :meth:`EQModel.spring_driven`,
+    whose arguments these are; ``parameters`` go into the result)."""
+    from fenicsfriction.reduced.dynamics import ReducedDynamics
+
+    for name, value in (("K", K), ("v", v), ("mass", mass), ("t_end", t_end), ("dt", dt),
+                        ("slip_speed", slip_speed)):
+        check_positive(name, value)
+    check_positive("damping", damping, strict=False)
+    late_from = 0.5 * t_end if late_from is None else late_from
+    check("late_from", late_from, 0 <= late_from < t_end, f"must lie in [0, {t_end})")
+    slider = _SpringDrivenSlider(contacts, K, mass, damping)
+    integrator = ReducedDynamics(slider, [0.0, 0.0], [0.0, v], prefix=prefix, options=options,
+                                 atol=1e-12 * contacts.weight)
+    records = integrator.run(
+        t_end, dt, observe=lambda t: slider.observe(integrator.q, integrator.q_dot))
+    t, X, X_dot, D, friction, broken = (np.array([r[key] for r in records]) for key in
+                                        ("time", "X", "X_dot", "D", "friction", "breaks"))
+    spring = K * (D - X)
+    late = t >= late_from
+    max_speed = float(np.max(X_dot) / v)
+    return SpringDrivenResult(
+        t=t, X=X, X_dot=X_dot, spring_force=spring, friction_force=friction,
+        breaks=broken.astype(int), K=float(K), v=float(v), mass=float(mass),
+        damping=float(damping), late_from=float(late_from),
+        force_spread=float(np.std(spring[late]) / abs(np.mean(spring[late]))),
+        velocity_spread=float(np.std(X_dot[late]) / v),
+        stuck_fraction=float(np.mean(X_dot[late] < 0.1 * v)), max_speed=max_speed,
+        stick_slip=max_speed > slip_speed, parameters=parameters)
+
+
+class _SpringDrivenSlider:
+    """The slider and the drive q = (X, D) for :class:`ReducedDynamics`; the contacts break
+    after each accepted step (:meth:`observe`)."""
+
+    def __init__(self, contacts: Contacts, K: float, mass: float, damping: float) -> None:
+        self.contacts, self.K, self.mass, self.damping = contacts, K, mass, damping
+
     def residual(self, q: np.ndarray, q_dot: np.ndarray, q_ddot: np.ndarray) -> np.ndarray:
-        model = self.model
-        friction = model.k * (model.n_contacts * q[0] - self.sum_anchors)
-        return np.array([self.mass * q_ddot[0] + self.damping * q_dot[0] + friction
-                         - self.K * (q[1] - q[0]), self.mass * q_ddot[1]])
+        return np.array([self.mass * q_ddot[0] + self.damping * q_dot[0]
+                         + self.contacts.friction(q[0]) - self.K * (q[1] - q[0]),
+                         self.mass * q_ddot[1]])
 
     def linearisation(self, q: np.ndarray, q_dot: np.ndarray
                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        stiffness = self.model.n_contacts * self.model.k
         return (self.mass * np.eye(2), np.diag([self.damping, 0.0]),
-                np.array([[stiffness + self.K, -self.K], [0.0, 0.0]]))
+                np.array([[self.contacts.stiffness + self.K, -self.K], [0.0, 0.0]]))
 
     def observe(self, q: np.ndarray, q_dot: np.ndarray) -> dict[str, float]:
-        stretch = q[0] - self.anchors
-        broken = np.flatnonzero(stretch > self.thresholds)
-        if broken.size:
-            x0 = self.model.draw_newborn(self.rng, broken.size)
-            self.anchors[broken] = q[0] - x0
-            self.thresholds[broken] = self.model.draw_thresholds(self.rng, x0)
-            self.sum_anchors = float(np.sum(self.anchors))
+        broken = self.contacts.relax(float(q[0]))
         return {"X": float(q[0]), "X_dot": float(q_dot[0]), "D": float(q[1]),
-                "friction": self.model.k * (self.model.n_contacts * q[0] - self.sum_anchors),
-                "breaks": float(broken.size)}
+                "friction": self.contacts.friction(float(q[0])), "breaks": float(broken)}

@@ -29,7 +29,7 @@ from fenicsfriction.reduced.interface.master_equation import (
 )
 from fenicsfriction.results import Record
 
-__all__ = ["InstabilityMap", "critical_stiffness", "instability_map"]
+__all__ = ["CouplingMap", "InstabilityMap", "coupling_map", "critical_stiffness", "instability_map"]
 
 
 def critical_stiffness(model: EQModel, h: float | None = None) -> float:
@@ -136,3 +136,102 @@ def instability_map(K: typing.Sequence[float], relative_spread: typing.Sequence[
         drive={"v": v, "mass": m, "damping_ratio": damping_ratio,
                "drive_distance": drive_distance, "steps_per_period": steps_per_period},
         parameters={"N": n_contacts, "k": k, "x_s_mean": x_s_mean})
+
+
+@dataclasses.dataclass
+class CouplingMap(Record):
+    """Interacting EQ interfaces over the coupling k/(E a) (columns) and the relative threshold
+    spread σ/x_c (rows), moved quasistatically (:func:`coupling_map`).
+
+    Attributes:
+        coupling: k/(E a) of each column.
+        relative_spread: σ/x_c of each row.
+        stick_slip: ``largest_drop > drop_threshold``.
+        largest_drop: the largest fall of the friction force in one avalanche, late window,
+            over the kinetic force.
+        largest_avalanche: the most breaks in one avalanche, late window, over N.
+        mean_avalanche: the mean breaks per avalanche, late window.
+        interface_stiffness: S/(N k) of each column (the bodies' compliance in series).
+        kinetic_force: the kinetic force over N k x_c.
+        drop_threshold, lives: the classification's threshold and the distance moved, in
+            contact lives x_c N k/S (the late window is its second half).
+        parameters: N, k, x_s_mean, ν, the lattice, the realisations.
+    """
+
+    coupling: np.ndarray
+    relative_spread: np.ndarray
+    stick_slip: np.ndarray
+    largest_drop: np.ndarray
+    largest_avalanche: np.ndarray
+    mean_avalanche: np.ndarray
+    interface_stiffness: np.ndarray
+    kinetic_force: np.ndarray
+    drop_threshold: float
+    lives: float
+    parameters: dict
+
+
+def coupling_map(couplings: typing.Sequence[float], relative_spread: typing.Sequence[float],
+                 n_side: int = 16, k: float = 1.0, x_s_mean: float = 1.0, nu: float = 0.3,
+                 lives: float = 8.0, realisations: int = 1, drop_threshold: float = 0.05,
+                 seed: int = 0) -> CouplingMap:
+    """Stick-slip of interacting contacts (Braun (slides), "Interaction between contacts: EQ
+    simulation") over the coupling and the threshold spread.
+
+    Each interface (:class:`~fenicsfriction.reduced.interface.interacting.InteractingEQModel`
+    on an ``n_side × n_side`` lattice between two identical bodies) is moved quasistatically
+    over ``lives`` contact lives; in the second half a run is classified stick-slip when one
+    avalanche drops the friction force by more than ``drop_threshold`` of the kinetic force.
+    That is what a rigid drive sees: without interaction every break is single and drops F by
+    k x_s, 2 x_s/(N x_c) of the kinetic force ~N k x_c/2, so the threshold must stand above
+    the largest single break (checked: > 6/N, a threshold of 3 x_c). The spring-driven runs
+    (:meth:`InteractingEQModel.spring_driven`) are the dynamic counterpart; their late-time
+    measures do not separate the regimes on such small lattices (see
+    :class:`~fenicsfriction.reduced.interface.eq_model.SpringDrivenResult`).
+
+    Args:
+        couplings: k/(E a) values, >= 0 (0: no interaction).
+        relative_spread: σ/x_c values of the Gaussian thresholds, > 0.
+        n_side: the lattice's side (N = n_side² contacts).
+        k, x_s_mean: the contacts' stiffness and mean threshold.
+        nu: Poisson's ratio of the bodies.
+        lives: the distance moved, in contact lives x_c N k/S.
+        realisations: independent interfaces per cell (their largest drop counts).
+        drop_threshold: the force drop, over the kinetic force, that makes a run stick-slip.
+        seed: seeds every cell (the same thresholds for every coupling of a row).
+    """
+    from fenicsfriction.reduced.interface.interacting import InteractingEQModel
+
+    values, spreads = np.asarray(couplings, dtype=float), np.asarray(relative_spread, dtype=float)
+    check("couplings", couplings, values.size > 0 and bool(np.all(values >= 0)),
+          "must be numbers >= 0")
+    check("relative_spread", relative_spread,
+          spreads.size > 0 and bool(np.all(spreads > 0)), "must be numbers > 0")
+    check("n_side", n_side, isinstance(n_side, int) and n_side >= 2, "must be an integer >= 2")
+    check_positive("lives", lives)
+    n = n_side**2
+    check("drop_threshold", drop_threshold,
+          isinstance(drop_threshold, (int, float)) and 6.0 / n < drop_threshold < 1.0,
+          f"must lie in (6/N, 1) = ({6.0 / n:.3g}, 1): one break drops F by 2 x_s/(N x_c)")
+    shape = (spreads.size, values.size)
+    drop, largest, mean, kinetic = (np.zeros(shape) for _ in range(4))
+    stiffness = np.zeros(values.size)
+    for i, spread in enumerate(spreads):
+        model = EQModel(n_contacts=n, k=k, x_s_mean=x_s_mean, x_s_std=float(spread * x_s_mean))
+        for j, coupling in enumerate(values):
+            interface = InteractingEQModel.lattice(model, float(coupling), nu=nu)
+            stiffness[j] = interface.interface_stiffness / (n * k)
+            X_max = lives * x_s_mean / stiffness[j]
+            run = interface.quasistatic(X_max, realisations=realisations, seed=seed)
+            late = run.avalanche_X >= run.kinetic_from
+            drop[i, j] = np.max(run.force_drop[late], initial=0.0) / run.kinetic_force
+            largest[i, j] = np.max(run.avalanche_size[late], initial=0) / n
+            mean[i, j] = np.mean(run.avalanche_size[late]) if np.any(late) else 0.0
+            kinetic[i, j] = run.kinetic_force / (n * k * x_s_mean)
+    return CouplingMap(
+        coupling=values, relative_spread=spreads, stick_slip=drop > drop_threshold,
+        largest_drop=drop, largest_avalanche=largest, mean_avalanche=mean,
+        interface_stiffness=stiffness, kinetic_force=kinetic,
+        drop_threshold=float(drop_threshold), lives=float(lives),
+        parameters={"N": n, "k": k, "x_s_mean": x_s_mean, "nu": nu, "n_side": n_side,
+                    "realisations": realisations, "seed": seed})
