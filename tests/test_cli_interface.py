@@ -31,6 +31,28 @@ def test_eq_against_its_master_equation_and_the_kinetic_closed_form(shared_tmp_p
     assert (out / "eq.png").stat().st_size > 0
 
 
+def test_eq_with_interacting_contacts_writes_its_avalanches(shared_tmp_path):
+    out = shared_tmp_path / "eq-coupled"
+    assert main(["interface", "eq", "--N", "144", "--coupling", "0.1", "--out", str(out)]) == 0
+    summary = _json(out)
+    assert summary["parameters"]["coupling"] == 0.1
+    # the bodies in series soften the interface: S < N k (0.29 N k on this lattice)
+    assert 0.1 * 144 < summary["interface_stiffness"] < 144
+    # five contact lives: X_max = 5 x_c N k/S
+    assert summary["X"][-1] == pytest.approx(5 * 144 / summary["interface_stiffness"])
+    rows = (out / "avalanches.csv").read_text().splitlines()
+    assert len(rows) > 144 and summary["largest_avalanche"] > 0.1  # avalanches, not single
+
+
+def test_coupling_map_has_no_stick_slip_without_interaction_and_some_with(shared_tmp_path):
+    out = shared_tmp_path / "coupling-map"
+    assert main(["interface", "stability-map", "--N", "144", "--couplings", "0,0.1",
+                 "--spreads", "0.3", "--lives", "6", "--out", str(out)]) == 0
+    summary = _json(out)
+    assert summary["stick_slip"] == [[False, True]]
+    assert (out / "coupling_map.png").stat().st_size > 0
+
+
 def test_master_equation_conserves_the_contacts(shared_tmp_path):
     out = shared_tmp_path / "me"
     assert main(["interface", "master-equation", "--x-s-std", "0.3", "--out", str(out)]) == 0
@@ -78,7 +100,11 @@ def test_interaction_response_falls_like_r_minus_3_beyond_the_correlation_length
     (["eq", "--N", "0"], "--N"),
     (["master-equation", "--h", "-1"], "--h"),
     (["eq", "--newborn", "gaussian", "--newborn-std", "0"], "--newborn-std"),
-    (["fk", "--g", "-1"], "--g")])
+    (["fk", "--g", "-1"], "--g"),
+    (["eq", "--coupling", "0.1"], "--N"),
+    (["stability-map", "--N", "100", "--couplings", "0.1", "--K", "3"], "--K"),
+    (["stability-map"], "--K"),
+    (["stability-map", "--N", "144", "--couplings", "-0.1"], "--couplings")])
 def test_bad_value_is_one_line_naming_the_parameter_and_exit_2(shared_tmp_path, capsys, argv,
                                                                 name):
     code = main(["interface", *argv, "--out", str(shared_tmp_path / "bad")])

@@ -399,20 +399,37 @@ def add_interface_parsers(commands: typing.Any) -> None:
     for name, text in (("eq", "the EQ model moved quasistatically, beside its master equation"),
                        ("master-equation", "the master equation of the stretching distribution")):
         command = models.add_parser(name, parents=[contacts], help=text, description=text + ".")
-        command.add_argument("--X-max", type=float, default=5.0,
-                             help="the slider's last position (5)")
+        command.add_argument("--X-max", type=float,
+                             help="the slider's last position (5 contact lives: 5 x_c N k/S, "
+                                  "5 x_c without interaction)")
         command.add_argument("--h", type=float, default=0.01,
                              help="the master equation's step ΔX = Δx (0.01)")
         if name == "eq":
             command.add_argument("--realisations", type=int, default=1,
                                  help="independent interfaces averaged (1)")
+            command.add_argument("--coupling", type=float,
+                                 help="interacting contacts: k/(E a) of a √N × √N lattice "
+                                      "between two identical bodies (N a square, e.g. --N 256); "
+                                      "none by default")
+            command.add_argument("--nu", type=float, default=0.3,
+                                 help="Poisson's ratio of the bodies, with --coupling (0.3)")
     smap = models.add_parser(
         "stability-map", parents=[contacts],
-        help="smooth sliding or stick-slip of the spring-driven EQ model over K and σ/x_c",
-        description="The spring-driven EQ model (PETSc TS) over drive stiffnesses and threshold "
-                    "spreads, each run classified, with the master equation's K* overlaid.")
-    smap.add_argument("--K", type=floats, required=True, metavar="K1,K2,...",
-                      help="drive stiffnesses")
+        help="smooth sliding or stick-slip of the EQ model over K (or the coupling) and σ/x_c",
+        description="With --K: the spring-driven EQ model (PETSc TS) over drive stiffnesses and "
+                    "threshold spreads, each run classified, with the master equation's K* "
+                    "overlaid. With --couplings: interacting contacts on a √N × √N lattice "
+                    "moved quasistatically over couplings k/(E a) and spreads, stick-slip where "
+                    "one avalanche drops the force by more than --drop-threshold.")
+    smap.add_argument("--K", type=floats, metavar="K1,K2,...", help="drive stiffnesses")
+    smap.add_argument("--couplings", type=floats, metavar="C1,C2,...",
+                      help="couplings k/(E a) of interacting contacts (instead of --K; "
+                           "N a square, e.g. --N 256)")
+    smap.add_argument("--drop-threshold", type=float, default=0.05,
+                      help="with --couplings: the force drop in one avalanche, over the "
+                           "kinetic force, that is stick-slip (0.05)")
+    smap.add_argument("--lives", type=float, default=8.0,
+                      help="with --couplings: the distance moved, in contact lives (8)")
     smap.add_argument("--spreads", type=floats, default=[0.1, 0.3], metavar="S1,S2,...",
                       help="relative threshold spreads σ/x_c (0.1,0.3)")
     interaction = models.add_parser(

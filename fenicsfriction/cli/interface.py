@@ -40,6 +40,15 @@ def _eq_model(args: argparse.Namespace) -> typing.Any:
                    newborn=newborn)
 
 
+def _interacting(args: argparse.Namespace, model: typing.Any) -> typing.Any:
+    """The model's contacts on a lattice, coupled by ``--coupling``; None without it."""
+    if args.coupling is None:
+        return None
+    from fenicsfriction.reduced.interface import InteractingEQModel
+
+    return InteractingEQModel.lattice(model, args.coupling, nu=args.nu)
+
+
 def _interface_json(result: typing.Any) -> dict[str, typing.Any]:
     """A result's record with the issue's names: parameters, the forces, K*, X and F."""
     data = result.to_json()
@@ -50,22 +59,35 @@ def _run_eq(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> in
     from fenicsfriction.reduced.interface import MasterEquation
 
     model = _eq_model(args)
+    interacting = _interacting(args, model)
+    moved = model if interacting is None else interacting
+    lives = 1.0 if interacting is None else args.N * args.k / interacting.interface_stiffness
+    X_max = 5.0 * args.x_s_mean * lives if args.X_max is None else args.X_max
     out = output_folder(args.out, comm)
     log.info(f"eq: {args.N} contacts, k = {args.k:g}, thresholds N({args.x_s_mean:g}, "
-             f"{args.x_s_std:g}), newborn {args.newborn}; X to {args.X_max:g}, "
-             f"{args.realisations} realisation(s), seed {args.seed}")
-    run = model.quasistatic(args.X_max, realisations=args.realisations, seed=args.seed)
-    me = MasterEquation(model, args.h).solve(args.X_max)
+             f"{args.x_s_std:g}), newborn {args.newborn}"
+             + ("" if interacting is None else f", coupling k/(E a) = {args.coupling:g} "
+                f"(S = {interacting.interface_stiffness / (args.N * args.k):.3g} N k)")
+             + f"; X to {X_max:g}, {args.realisations} realisation(s), seed {args.seed}")
+    run = moved.quasistatic(X_max, realisations=args.realisations, seed=args.seed)
+    me = MasterEquation(model, args.h).solve(X_max)
     summary = {"command": "eq", **_interface_json(run), "K_star": me.K_star,
                "master_equation": {"kinetic_force": me.kinetic_force,
                                    "static_force": me.static_force, "h": me.h}}
     results.write_summary(out / "interface.json", summary, comm)
     write_rows(out / "force.csv", ({"X": x, "F": f, "F_std": e}
                              for x, f, e in zip(run.X, run.F, run.F_std, strict=True)), comm)
+    files = "interface.json, force.csv, eq.png"
+    if interacting is not None:
+        write_rows(out / "avalanches.csv", ({"X": x, "breaks": b, "force_drop": d} for x, b, d
+                                            in zip(run.avalanche_X, run.avalanche_size,
+                                                   run.force_drop, strict=True)), comm)
+        files += ", avalanches.csv"
     if comm.rank == 0:
         with plotting.saved_figure(out / "eq.png", ncols=2, figsize=(11, 4)) as (a1, a2):
             a1.plot(run.X, run.F, "-", lw=1, label=f"EQ model ({args.realisations} realisation(s))")
-            a1.plot(me.X, me.F, "k-", lw=1.2, label="master equation")
+            a1.plot(me.X, me.F, "k-", lw=1.2, label="master equation"
+                    + ("" if interacting is None else " (no interaction)"))
             a1.set(xlabel="X", ylabel="F", title="friction force against the slider's position")
             a1.legend(fontsize=8)
             centres = 0.5 * (run.histogram_edges[1:] + run.histogram_edges[:-1])
@@ -73,11 +95,13 @@ def _run_eq(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> in
                    label="EQ model")
             a2.plot(me.x, me.Q / me.h, "k-", label="master equation")
             a2.set(xlabel="stretching x", ylabel="density Q(x; X)",
-                   title=f"stretchings at X = {args.X_max:g}")
+                   title=f"stretchings at X = {X_max:g}")
             a2.legend(fontsize=8)
     log.info(f"static force {run.static_force:.6g} (master equation {me.static_force:.6g}), "
-             f"kinetic {run.kinetic_force:.6g} ({me.kinetic_force:.6g}), K* = {me.K_star:.6g}; "
-             f"results in {out}/: interface.json, force.csv, eq.png")
+             f"kinetic {run.kinetic_force:.6g} ({me.kinetic_force:.6g}), K* = {me.K_star:.6g}"
+             + ("" if interacting is None else
+                f", largest avalanche {run.largest_avalanche:.1%} of the contacts")
+             + f"; results in {out}/: {files}")
     return 0
 
 
@@ -86,7 +110,8 @@ def _run_master_equation(args: argparse.Namespace, log: logging.Logger, comm: MP
 
     model = _eq_model(args)
     out = output_folder(args.out, comm)
-    me = MasterEquation(model, args.h).solve(args.X_max)
+    X_max = 5.0 * args.x_s_mean if args.X_max is None else args.X_max
+    me = MasterEquation(model, args.h).solve(X_max)
     results.write_summary(out / "interface.json",
                           {"command": "master-equation", **_interface_json(me)}, comm)
     write_rows(out / "force.csv", ({"X": x, "F": f} for x, f in zip(me.X, me.F, strict=True)), comm)
@@ -107,8 +132,13 @@ def _run_master_equation(args: argparse.Namespace, log: logging.Logger, comm: MP
 
 
 def _run_stability_map(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
+    from fenicsfriction.laws import check
     from fenicsfriction.reduced.interface import instability_map
 
+    check("--K", args.K, (args.K is None) != (args.couplings is None),
+          "give --K (drive stiffnesses) or --couplings (interacting contacts), one of the two")
+    if args.couplings is not None:
+        return _run_coupling_map(args, log, comm)
     out = output_folder(args.out, comm)
     log.info(f"stability-map: {len(args.K)} stiffnesses × {len(args.spreads)} spreads, "
              f"{args.N} contacts")
@@ -123,11 +153,7 @@ def _run_stability_map(args: argparse.Namespace, log: logging.Logger, comm: MPI.
                            for j, K in enumerate(smap.K)), comm)
     if comm.rank == 0:
         with plotting.saved_figure(out / "stability_map.png", figsize=(6.5, 4.5)) as (ax,):
-            KK, SS = np.meshgrid(smap.K, smap.relative_spread)
-            stuck = smap.stick_slip.astype(bool)
-            ax.scatter(KK[stuck], SS[stuck], marker="x", color="tab:red", label="stick-slip")
-            ax.scatter(KK[~stuck], SS[~stuck], marker="o", facecolors="none",
-                       edgecolors="tab:blue", label="smooth sliding")
+            _classified(ax, smap.K, smap.relative_spread, smap.stick_slip)
             ax.plot(smap.K_star, smap.relative_spread, "k-", label="K* = −max F′(X)")
             ax.set(xscale="log", xlabel="drive stiffness K", ylabel="threshold spread σ/x_c",
                    title="elastic instability of the EQ interface")
@@ -135,6 +161,62 @@ def _run_stability_map(args: argparse.Namespace, log: logging.Logger, comm: MPI.
     agree = np.mean(smap.stick_slip == (smap.K[None, :] < smap.K_star[:, None]))
     log.info(f"{agree:.0%} of the runs on the side of K* the master equation predicts; "
              f"results in {out}/: interface.json, map.csv, stability_map.png")
+    return 0
+
+
+def _classified(ax: typing.Any, x: np.ndarray, spreads: np.ndarray,
+                stick_slip: np.ndarray) -> None:
+    """The runs of a map as crosses (stick-slip) and circles (smooth sliding)."""
+    xx, ss = np.meshgrid(x, spreads)
+    stuck = stick_slip.astype(bool)
+    ax.scatter(xx[stuck], ss[stuck], marker="x", color="tab:red", label="stick-slip")
+    ax.scatter(xx[~stuck], ss[~stuck], marker="o", facecolors="none", edgecolors="tab:blue",
+               label="smooth sliding")
+
+
+def _run_coupling_map(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
+    import math
+
+    from fenicsfriction.laws import check
+    from fenicsfriction.reduced.interface import coupling_map
+
+    n_side = math.isqrt(args.N)
+    check("--N", args.N, n_side**2 == args.N, "must be a square n² with --couplings (e.g. 256)")
+    out = output_folder(args.out, comm)
+    log.info(f"stability-map: {len(args.couplings)} couplings × {len(args.spreads)} spreads, "
+             f"{n_side} × {n_side} interacting contacts, {args.lives:g} lives each")
+    cmap = coupling_map(args.couplings, args.spreads, n_side=n_side, k=args.k,
+                        x_s_mean=args.x_s_mean, lives=args.lives,
+                        drop_threshold=args.drop_threshold, seed=args.seed)
+    results.write_summary(out / "interface.json", {"command": "stability-map",
+                                                   **cmap.to_json()}, comm)
+    write_rows(out / "map.csv", ({"relative_spread": s, "coupling": c,
+                                  "stick_slip": bool(cmap.stick_slip[i, j]),
+                                  "largest_drop": cmap.largest_drop[i, j],
+                                  "largest_avalanche": cmap.largest_avalanche[i, j]}
+                                 for i, s in enumerate(cmap.relative_spread)
+                                 for j, c in enumerate(cmap.coupling)), comm)
+    if comm.rank == 0:
+        with plotting.saved_figure(out / "coupling_map.png", ncols=2,
+                                   figsize=(11, 4.5)) as (a1, a2):
+            shown = np.where(cmap.coupling > 0, cmap.coupling,
+                             np.min(cmap.coupling[cmap.coupling > 0], initial=1.0) / 3)
+            _classified(a1, shown, cmap.relative_spread, cmap.stick_slip)
+            a1.set(xscale="log", xlabel="coupling k/(E a) (no interaction at the left edge)",
+                   ylabel="threshold spread σ/x_c", title="stick-slip of interacting contacts")
+            a1.legend(fontsize=8)
+            for i, s in enumerate(cmap.relative_spread):
+                a2.plot(shown, cmap.largest_drop[i], "o-", label=f"σ/x_c = {s:g}")
+            a2.axhline(cmap.drop_threshold, color="gray", ls=":", label="threshold")
+            a2.set(xscale="log", yscale="log", xlabel="coupling k/(E a)",
+                   ylabel="largest drop of F in one avalanche / F_k",
+                   title="avalanches grow with the interaction")
+            a2.legend(fontsize=8)
+    log.info(f"stick-slip in {int(np.sum(cmap.stick_slip))} of {cmap.stick_slip.size} runs; "
+             "per coupling: " + ", ".join(f"{c:g}: {int(n)}" for c, n in
+                                           zip(cmap.coupling, cmap.stick_slip.sum(axis=0),
+                                               strict=True))
+             + f"; results in {out}/: interface.json, map.csv, coupling_map.png")
     return 0
 
 
