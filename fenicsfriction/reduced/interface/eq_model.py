@@ -41,7 +41,7 @@ from fenicsfriction.laws import check, check_positive
 from fenicsfriction.results import Record
 
 __all__ = ["Contacts", "Distribution", "EQModel", "IndependentContacts", "QuasistaticResult",
-           "SpringDrivenResult", "describe_distribution", "drive"]
+           "SpringDrivenResult", "check_quasistatic", "describe_distribution", "drive"]
 
 
 class Distribution(typing.Protocol):
@@ -68,6 +68,20 @@ def describe_distribution(dist: Distribution | None) -> dict[str, typing.Any]:
         return {"name": scipy_dist.name, "args": list(getattr(dist, "args", ())),
                 "kwds": dict(getattr(dist, "kwds", {}))}
     return {"name": repr(dist)}
+
+
+def check_quasistatic(X_max: float, n_points: int, realisations: int,
+                      kinetic_from: float | None) -> float:
+    """Check a quasistatic drive's arguments (:meth:`EQModel.quasistatic`); return the start
+    of its kinetic window (None: X_max/2)."""
+    check_positive("X_max", X_max)
+    check("n_points", n_points, isinstance(n_points, int) and n_points >= 2,
+          "must be an integer >= 2")
+    check("realisations", realisations, isinstance(realisations, int) and realisations >= 1,
+          "must be an integer >= 1")
+    kinetic_from = 0.5 * X_max if kinetic_from is None else kinetic_from
+    check("kinetic_from", kinetic_from, 0 <= kinetic_from < X_max, f"must lie in [0, {X_max})")
+    return kinetic_from
 
 
 @dataclasses.dataclass
@@ -236,13 +250,7 @@ class EQModel:
             kinetic_from: start of the window averaged into the kinetic force; None: X_max/2.
             bins: bins of the stretching histogram.
         """
-        check_positive("X_max", X_max)
-        check("n_points", n_points, isinstance(n_points, int) and n_points >= 2,
-              "must be an integer >= 2")
-        check("realisations", realisations, isinstance(realisations, int) and realisations >= 1,
-              "must be an integer >= 1")
-        kinetic_from = 0.5 * X_max if kinetic_from is None else kinetic_from
-        check("kinetic_from", kinetic_from, 0 <= kinetic_from < X_max, f"must lie in [0, {X_max})")
+        kinetic_from = check_quasistatic(X_max, n_points, realisations, kinetic_from)
         rng = np.random.default_rng(seed)
         n = self.n_contacts * realisations
         # lives[:, l]: the newborn stretching x_0 and the slip to the break of each life

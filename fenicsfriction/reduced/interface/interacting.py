@@ -58,6 +58,7 @@ from fenicsfriction.reduced.interface.eq_model import (
     EQModel,
     QuasistaticResult,
     SpringDrivenResult,
+    check_quasistatic,
     drive,
 )
 from fenicsfriction.reduced.interface.interaction import interaction_matrix
@@ -269,13 +270,7 @@ class InteractingEQModel:
         closed form, and each avalanche is resolved at its X (arguments as
         :meth:`EQModel.quasistatic`).
         """
-        check_positive("X_max", X_max)
-        check("n_points", n_points, isinstance(n_points, int) and n_points >= 2,
-              "must be an integer >= 2")
-        check("realisations", realisations, isinstance(realisations, int) and realisations >= 1,
-              "must be an integer >= 1")
-        kinetic_from = 0.5 * X_max if kinetic_from is None else kinetic_from
-        check("kinetic_from", kinetic_from, 0 <= kinetic_from < X_max, f"must lie in [0, {X_max})")
+        kinetic_from = check_quasistatic(X_max, n_points, realisations, kinetic_from)
         rng = np.random.default_rng(seed)
         X = np.linspace(0.0, X_max, n_points)
         F = np.empty((realisations, n_points))
