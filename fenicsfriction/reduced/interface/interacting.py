@@ -28,8 +28,9 @@ the set :math:`S` of contacts breaking together this is one small solve,
 :math:`M_{\cdot S}\,\delta U_{0,S}`: exactly the response to the break
 (:func:`~fenicsfriction.reduced.interface.interaction.break_response`, which removes the
 contact: a relaxed contact carries no force, so the others see the same field). The response
-loads the neighbours (:math:`M_{ij} < 0` for :math:`G_{ij} > 0`), which may break in turn, at
-the same X: an avalanche, resolved in rounds until no contact is over its threshold.
+loads the neighbours (to first order :math:`M \approx k - k^2 G`, :math:`M_{ij} < 0`), which
+may break in turn, at the same X: an avalanche, resolved in rounds until no contact is over its
+threshold.
 With :math:`G = 0` (no interaction) :math:`M = k` and nothing cascades: the model is
 :class:`EQModel` exactly, random draws included.
 
