@@ -116,7 +116,9 @@ class CoupledContacts:
                  max_rounds: int) -> None:
         self.model, self.M, self.rng, self.max_rounds = model, stiffness_matrix, rng, max_rounds
         n = model.n_contacts
-        self.forces, self.X_ref, self.offsets = np.zeros(n), 0.0, np.zeros(n)
+        self.forces: Array = np.zeros(n)
+        self.offsets: Array = np.zeros(n)
+        self.X_ref = 0.0
         self.thresholds = model.draw_thresholds(rng, np.zeros(n))
         self.rate = stiffness_matrix.sum(axis=1)
         self.stiffness = float(self.rate.sum())
