@@ -121,6 +121,7 @@ class CoupledContacts:
         self.X_ref = 0.0
         self.thresholds = model.draw_thresholds(rng, np.zeros(n))
         self.rate = stiffness_matrix.sum(axis=1)
+        self._loaded = np.flatnonzero(self.rate > 0)  # the contacts X loads (rate is fixed)
         self.stiffness = float(self.rate.sum())
         self.weight = n * model.k * model.x_s_mean
         self.avalanches: list[tuple[float, int, float]] = []
@@ -135,13 +136,12 @@ class CoupledContacts:
     def next_break(self) -> tuple[float, int]:
         """The slider position of the next break under further loading, and the contact that
         breaks there (``(inf, -1)`` if none is loaded)."""
-        loading = np.flatnonzero(self.rate > 0)
-        if loading.size == 0:
+        loaded = self._loaded
+        if loaded.size == 0:
             return math.inf, -1
-        room = (self.model.k * self.thresholds[loading] - self.forces[loading]) \
-            / self.rate[loading]
+        room = (self.model.k * self.thresholds[loaded] - self.forces[loaded]) / self.rate[loaded]
         first = int(np.argmin(room))
-        return self.X_ref + max(0.0, float(room[first])), int(loading[first])
+        return self.X_ref + max(0.0, float(room[first])), int(loaded[first])
 
     def relax(self, X: float, trigger: int | None = None) -> int:
         """Break and re-form, in rounds, every contact over its threshold at X (and
@@ -149,11 +149,13 @@ class CoupledContacts:
         return the number of breaks (a contact may break more than once in an avalanche)."""
         f = self.forces_at(X)
         k, before, broken, rounds = self.model.k, float(np.sum(f)), 0, 0
-        kept = self.thresholds.copy(), self.offsets.copy()  # the state before, if it runs away
+        kept = None  # the state before the avalanche, copied at its first round
         while (over := np.flatnonzero(f > k * self.thresholds)).size or trigger is not None:
             if trigger is not None:
                 over = over if trigger in over else np.union1d(over, [trigger])
                 trigger = None
+            if kept is None:
+                kept = self.thresholds.copy(), self.offsets.copy()
             if rounds == self.max_rounds:
                 self.thresholds, self.offsets = kept
                 raise RuntimeError(f"the avalanche at X = {X:.6g} was still going after "
@@ -184,7 +186,8 @@ class InteractingQuasistaticResult(QuasistaticResult):
         force_drop: the fall of the friction force in each avalanche.
         largest_avalanche: the largest avalanche's breaks over N.
         interface_stiffness: S = 1ᵀ M 1, dF/dX between breaks.
-        coupling: the model's ``coupling`` (None when G was given directly).
+
+    The coupling k/(E a) is in ``parameters``.
     """
 
     avalanche_X: np.ndarray
@@ -192,7 +195,6 @@ class InteractingQuasistaticResult(QuasistaticResult):
     force_drop: np.ndarray
     largest_avalanche: float
     interface_stiffness: float
-    coupling: float | None
 
 
 @dataclasses.dataclass
@@ -300,7 +302,7 @@ class InteractingEQModel:
             realisations=realisations, breaks=int(np.sum(size)), parameters=self.parameters(),
             avalanche_X=where, avalanche_size=size.astype(int), force_drop=drop,
             largest_avalanche=float(np.max(size, initial=0) / self.model.n_contacts),
-            interface_stiffness=self.interface_stiffness, coupling=self.coupling)
+            interface_stiffness=self.interface_stiffness)
 
     def spring_driven(self, K: float, v: float, mass: float, damping: float, t_end: float,
                       dt: float, seed: int | None = 0, late_from: float | None = None,
