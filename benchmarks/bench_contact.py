@@ -48,10 +48,10 @@ from _common import parser as benchmark_parser
 from _common import save
 
 import fenicsfriction as ff
-from fenicsfriction.contact import Pairing, facet_nodes, geometry
-from fenicsfriction.scenes.contact import closed_forms
-from fenicsfriction.scenes.contact.model import TwoBodyModel
-from fenicsfriction.scenes.contact.validation import Hertz
+from fenicsfriction.contact import Pairing, facet_nodes
+from fenicsfriction.studies.contact import closed_forms, geometry
+from fenicsfriction.studies.contact.model import TwoBodyModel
+from fenicsfriction.studies.contact.validation import Hertz
 
 EVENTS = ("SNESFunctionEval", "SNESJacobianEval", "MatLUFactorSym", "MatLUFactorNum",
           "MatSolve", "SNESSolve")

@@ -47,7 +47,7 @@ def getfem_worker(refine: int, repeats: int) -> dict:
     """The continuation in GetFEM (run in its own process)."""
     import getfem as gf
 
-    from fenicsfriction.scenes.block import BlockOnBelt
+    from fenicsfriction.studies.block import BlockOnBelt
 
     gf.util_trace_level(0)
     gf.util_warning_level(0)

@@ -4,13 +4,13 @@ r"""Response of an interface of elastically interacting contacts to the break of
 ``n × n`` square lattice of spacing a = 1 on an elastic half-space (E = 1, σ = 0.3, contact
 radius a/2 for the self term), uniform shear U₀ = (1, 0, 0); the centre contact breaks
 (δK = -k) and δF = B δK (1 - GBK) U₀ is solved matrix-free
-(:class:`~fenicsfriction.reduced.interface.interaction.LatticeInteraction`). For each
+(:class:`~fenicsfriction.studies.multicontact.interaction.LatticeInteraction`). For each
 elastic correlation length λ_c = a²E/k: |δF|(r) (normalised by the broken contact's own δF),
 the exponents fitted on r < λ_c/4 (near zone, when it holds ≥ 2 bins) and on
 3λ_c < r < n/4 (far zone, away from the lattice's edge), and where the two fitted laws cross,
 against λ_c.
 
-**Finite block** (:class:`~fenicsfriction.scenes.interface.ElasticSubstrate`): the same on a
+**Finite block** (:class:`~fenicsfriction.studies.multicontact.ElasticSubstrate`): the same on a
 lattice of contacts of spacing a = 2h covering the top face of a block of width W and depth
 W/2 (uniform P1 hexahedra of side h = 1/8, clamped bottom), λ_c = a; the Green-tensor model of
 the same contacts takes the contact radius for which its self term equals the FE node's
@@ -35,15 +35,15 @@ import numpy as np
 from _common import parser as benchmark_parser
 from _common import save
 
-from fenicsfriction.reduced.interface.interaction import (
+from fenicsfriction.results import get_logger, write_summary
+from fenicsfriction.studies.multicontact import ElasticSubstrate, SubstrateBlock
+from fenicsfriction.studies.multicontact.interaction import (
     LatticeInteraction,
     break_response,
     fit_power_laws,
     interaction_matrix,
     radial_profile,
 )
-from fenicsfriction.results import get_logger, write_summary
-from fenicsfriction.scenes.interface import ElasticSubstrate, SubstrateBlock
 
 E, NU = 1.0, 0.3
 SHEAR = [1.0, 0.0, 0.0]

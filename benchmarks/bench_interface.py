@@ -31,14 +31,14 @@ import numpy as np
 from _common import parser as benchmark_parser
 from _common import save
 
-from fenicsfriction.reduced.interface import (
+from fenicsfriction.results import write_summary
+from fenicsfriction.studies.multicontact import (
     EQModel,
     InstabilityMap,
     InteractingEQModel,
     MasterEquation,
     instability_map,
 )
-from fenicsfriction.results import write_summary
 
 STEPS = [0.04, 0.02, 0.01, 0.005, 0.0025]
 SIZES = [100, 400, 1600, 6400, 25600]

@@ -29,10 +29,10 @@ from _common import parser as benchmark_parser
 from _common import save
 
 from fenicsfriction import laws
-from fenicsfriction.reduced import BeltOscillator
-from fenicsfriction.reduced.slider import stability_map, table2_slider
 from fenicsfriction.results import write_summary
 from fenicsfriction.statistics import limit_cycle
+from fenicsfriction.studies.oscillators import BeltOscillator
+from fenicsfriction.studies.oscillators.slider import stability_map, table2_slider
 
 BANDS = [(29.0, 34.0), (60.0, 67.0)]
 SAMPLES = 41

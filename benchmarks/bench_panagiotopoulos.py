@@ -38,9 +38,9 @@ from _common import save
 
 import fenicsfriction as ff
 from fenicsfriction.panagiotopoulos import PanagiotopoulosSolver, ProcessError
-from fenicsfriction.scenes.block import LayeredBlockOnBelt
-from fenicsfriction.scenes.contact import closed_forms
-from fenicsfriction.scenes.contact.validation import Cattaneo
+from fenicsfriction.studies.block import LayeredBlockOnBelt
+from fenicsfriction.studies.contact import closed_forms
+from fenicsfriction.studies.contact.validation import Cattaneo
 
 METHODS = ("newton", "panagiotopoulos", "johnson")
 log = logging.getLogger("bench_panagiotopoulos")

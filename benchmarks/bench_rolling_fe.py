@@ -23,9 +23,9 @@ import numpy as np
 from _common import parser as benchmark_parser
 from _common import save
 
-from fenicsfriction.reduced.rolling.kalker import creep_coefficients
-from fenicsfriction.scenes.rolling import closed_forms
-from fenicsfriction.scenes.rolling.model import RollingContact
+from fenicsfriction.studies.rolling import closed_forms
+from fenicsfriction.studies.rolling.kalker import creep_coefficients
+from fenicsfriction.studies.rolling.model import RollingContact
 
 CARTER = {"dim": 2, "nu": 0.0, "mu": 0.3, "p0": 0.01}
 SMALL = 1e-6  # creepage of the linear theory (far below μ p0/G = 3e-3)

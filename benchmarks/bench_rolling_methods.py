@@ -7,7 +7,7 @@ adhesion 80 % to 20 % of the area).
 
 * **FASTSIM** (Kalker's simplified theory) on n × n grids (``--grids``): wall time of one call
   (best of ``--repeats``).
-* **Finite elements** (Kalker's complete theory, :class:`fenicsfriction.scenes.rolling.
+* **Finite elements** (Kalker's complete theory, :class:`fenicsfriction.studies.rolling.
   RollingContact`: block of 10 a, cells growing by 1.5) at ``--cells`` cells per a, each with
   the ε sequence (10, 1, 0.1, 0.01) × the creepage: wall time of the whole sequence at each
   creepage (the mesh and the forms built once per mesh are counted apart, ``setup_s``).
@@ -37,9 +37,9 @@ from mpi4py import MPI
 from _common import best_time, save
 from _common import parser as benchmark_parser
 
-from fenicsfriction.reduced.rolling.fastsim import fastsim, linear_theory
 from fenicsfriction.results import write_summary
-from fenicsfriction.scenes.rolling import RollingContact
+from fenicsfriction.studies.rolling import RollingContact
+from fenicsfriction.studies.rolling.fastsim import fastsim, linear_theory
 
 CASE = {"a": 6.304e-3, "b": 12.61e-3, "G": 82e9, "nu": 0.28, "mu": 0.3, "Fn": 106.7e3}
 CREEPAGES = (1e-6, 5e-4, 1e-3, 2e-3)

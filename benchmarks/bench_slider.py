@@ -1,6 +1,6 @@
 """The elastic slider on EQ contacts: its cost per simulated front, against mesh and time step.
 
-The scene of :mod:`fenicsfriction.scenes.interface_slider` (a 10 cm × 1 cm slider, E = 1 GPa,
+The scene of :mod:`fenicsfriction.studies.multicontact` (a 10 cm × 1 cm slider, E = 1 GPa,
 plane strain; EQ contacts of threshold 1 μm ± 5 %, re-forming relaxed after 0.1 ms; pushed at
 1 mm/s at its trailing edge) run to 4 ms, through the precursors to the front that spans the base,
 on the meshes ``--meshes`` (nx × ny) and steps ``--steps``. For each run: the wall time, the time
@@ -26,7 +26,7 @@ from _common import parser as benchmark_parser
 from _common import save
 
 from fenicsfriction.results import write_summary
-from fenicsfriction.scenes.interface_slider import InterfaceSlider, InterfaceSliderModel
+from fenicsfriction.studies.multicontact import InterfaceSlider, InterfaceSliderModel
 
 T_END = 4e-3
 

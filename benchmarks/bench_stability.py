@@ -23,7 +23,7 @@ range of refinement factors r. For every mesh it records:
   K̄, C, M, where n is small enough for that (``--dense-max-dofs``; its wall time is recorded
   too); (b) the growing eigenvalue of the flutter pair and the spring mode against the finest
   mesh of the same dimension (discretisation convergence), and the flutter pair against the
-  rigid 3-dof block (:class:`~fenicsfriction.reduced.RigidBlock`) for reference.
+  rigid 3-dof block (:class:`~fenicsfriction.studies.block.RigidBlock`) for reference.
 
 Timings are the best of up to 3 calls (noise only adds time); a call that takes long is timed
 fewer times (the calls stop once ``TIME_BUDGET`` seconds are spent).
@@ -57,9 +57,9 @@ from _common import save
 
 import fenicsfriction as ff
 from fenicsfriction.numerics import dense_eigenvalues
-from fenicsfriction.reduced import RigidBlock
 from fenicsfriction.results import to_plain
 from fenicsfriction.stability import StabilitySolver
+from fenicsfriction.studies.block import RigidBlock
 
 MU = 0.5
 MAX_MODULUS = 8000.0  # [rad/s]: the spring mode, the flutter pair; the next mode is at 1.8e4

@@ -60,7 +60,7 @@ BARE_REPEATS = 5
 class BaseProbe:
     """u_y at fixed points of the base y = 0, gathered on rank 0 (``None`` elsewhere)."""
 
-    def __init__(self, model: ff.scenes.block.BlockModel, num_points: int):
+    def __init__(self, model: ff.studies.block.BlockModel, num_points: int):
         msh = model.msh
         self.comm = msh.comm
         self.num_points = num_points

@@ -1,7 +1,7 @@
 r"""Flutter onset of the block on an elastic belt against the belt's stiffness and thickness.
 
 The block of Martins & Oden (1986) (Q1, 4r × 3r cells, nodal contact rule) slides on an
-elastic slab (``fenicsfriction.scenes.block_on_slab``, two-body node-to-segment contact after
+elastic slab (``fenicsfriction.studies.block``, two-body node-to-segment contact after
 Pop) whose Young's modulus is E_slab = ratio × E (E the block's, 1.4e6) and whose
 thickness is t, clamped on a rigid carrier at the belt speed. For each (ratio, t) it finds the
 friction coefficient μ_crit at which steady sliding loses stability (a pair of eigenvalues of

@@ -12,7 +12,7 @@ This script reads the time series of the finite element run (the CLI's ``timeser
     fenicsfriction dynamics block --mu 0.6 --belt-speed 0.08 --b-n 0.381e10 --eps 1e-3 \
         --t-end 20 --dt 1e-5 --stride 20000 --out DIR
 
-integrates the rigid block (:class:`~fenicsfriction.reduced.RigidBlock`, same data, same ε,
+integrates the rigid block (:class:`~fenicsfriction.studies.block.RigidBlock`, same data, same ε,
 same integrator and step; 32 min for 20 s on 2 shared cores) unless ``--rigid-csv`` gives
 its time series from an earlier run, and prints, for both, per window of ``--window``
 seconds: the apparent coefficient F̄/N̄, the range of N, the spring elongation, the share of
@@ -42,8 +42,9 @@ from _common import parser as benchmark_parser
 from scipy.integrate import trapezoid
 
 import fenicsfriction as ff
-from fenicsfriction.reduced import ReducedDynamics, RigidBlock, rigid_block_observables
 from fenicsfriction.results import CsvRows
+from fenicsfriction.studies.block import RigidBlock, rigid_block_observables
+from fenicsfriction.timestepping import ReducedDynamics
 
 MU, BELT_SPEED, B_N = 0.6, 0.08, 0.381e10
 PERTURBATION = -0.01  # [cm/s]

@@ -43,8 +43,8 @@ from mpi4py import MPI
 import numpy as np
 
 import fenicsfriction as ff
-from fenicsfriction.reduced import RigidBlock
 from fenicsfriction.stability import Loci, StabilitySolver, unstable_intervals
+from fenicsfriction.studies.block import RigidBlock
 
 logging.getLogger("ffcx").setLevel(logging.WARNING)
 comm = MPI.COMM_WORLD

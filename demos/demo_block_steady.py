@@ -48,7 +48,7 @@ import ufl
 from dolfinx import fem
 
 import fenicsfriction as ff
-from fenicsfriction.scenes.block.data import TOP
+from fenicsfriction.studies.block.data import TOP
 
 logging.getLogger("ffcx").setLevel(logging.WARNING)
 comm = MPI.COMM_WORLD

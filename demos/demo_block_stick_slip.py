@@ -38,7 +38,7 @@
 # data of their Figs. 13-15 ($\mu = 0.6$, $K_x = 11.1\cdot 10^3$ kg/s², $B_0 = 30.5$ cm,
 # $b_n = 0.381\cdot 10^{10}$, $l_n = 2.5$) at the paper's two belt speeds, 0.08 and 0.287 cm/s.
 #
-# The rigid 3-d.o.f. block of the stability analysis (`fenicsfriction.reduced.RigidBlock`,
+# The rigid 3-d.o.f. block of the stability analysis (`fenicsfriction.studies.block.RigidBlock`,
 # the same interface law integrated over its base, same data) is driven by the same time
 # integrator (TSALPHA2 through `ReducedDynamics`) next to each finite element run: its
 # flutter onset is later ($\mu \approx 0.40$) and its growth rate smaller, but the sequence is
@@ -67,11 +67,12 @@ from scipy.integrate import trapezoid
 import fenicsfriction as ff
 from fenicsfriction.dynamics import DynamicsSolver
 from fenicsfriction.plotting import plot_stick_slip
-from fenicsfriction.reduced import ReducedDynamics, RigidBlock, rigid_block_observables
 from fenicsfriction.results import CsvRows
 from fenicsfriction.signals import Interrupted, StopSignals
 from fenicsfriction.stability import StabilitySolver
 from fenicsfriction.statistics import stick_slip_statistics
+from fenicsfriction.studies.block import RigidBlock, rigid_block_observables
+from fenicsfriction.timestepping import ReducedDynamics
 
 logging.getLogger("ffcx").setLevel(logging.WARNING)
 world = MPI.COMM_WORLD

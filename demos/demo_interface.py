@@ -43,10 +43,12 @@ from mpi4py import MPI
 import numpy as np
 
 import fenicsfriction as ff
-from fenicsfriction.reduced.interface import (
+from fenicsfriction.studies.multicontact import (
     EQModel,
     FKChain,
     InteractingEQModel,
+    InterfaceSlider,
+    InterfaceSliderModel,
     LatticeInteraction,
     MasterEquation,
     coupling_map,
@@ -54,7 +56,6 @@ from fenicsfriction.reduced.interface import (
     instability_map,
     radial_profile,
 )
-from fenicsfriction.scenes.interface_slider import InterfaceSlider, InterfaceSliderModel
 
 logging.getLogger("ffcx").setLevel(logging.WARNING)
 comm = MPI.COMM_WORLD

@@ -54,8 +54,13 @@ import numpy as np
 
 import fenicsfriction as ff
 from fenicsfriction.panagiotopoulos import PanagiotopoulosSolver
-from fenicsfriction.reduced.rolling import creep_coefficients, creep_curve, linear_theory
-from fenicsfriction.scenes.rolling import RollingContact, closed_forms
+from fenicsfriction.studies.rolling import (
+    RollingContact,
+    closed_forms,
+    creep_coefficients,
+    creep_curve,
+    linear_theory,
+)
 
 logging.getLogger("ffcx").setLevel(logging.WARNING)
 comm = MPI.COMM_WORLD

@@ -69,9 +69,12 @@ from mpi4py import MPI
 import numpy as np
 
 import fenicsfriction as ff
+from fenicsfriction.events import integrate_hybrid
 from fenicsfriction.plotting import plot_oscillator, plot_stability_map, plot_stroboscopic_growth
-from fenicsfriction.reduced import integrate_hybrid
-from fenicsfriction.reduced.slider import (
+from fenicsfriction.results import CsvRows
+from fenicsfriction.signals import Interrupted, StopSignals
+from fenicsfriction.statistics import mode_intervals
+from fenicsfriction.studies.oscillators.slider import (
     TABLE2_PAPER_BANDS,
     TABLE2_READINGS,
     SliderMotion,
@@ -79,9 +82,6 @@ from fenicsfriction.reduced.slider import (
     stroboscopic_growth,
     table2_slider,
 )
-from fenicsfriction.results import CsvRows
-from fenicsfriction.signals import Interrupted, StopSignals
-from fenicsfriction.statistics import mode_intervals
 
 world = MPI.COMM_WORLD
 say = ff.results.get_logger(comm=world).info

@@ -48,11 +48,10 @@ from mpi4py import MPI
 import numpy as np
 
 import fenicsfriction as ff
-from fenicsfriction.contact import geometry
-from fenicsfriction.scenes.contact import closed_forms
-from fenicsfriction.scenes.contact.model import TwoBodyModel
-from fenicsfriction.scenes.contact.validation import Cattaneo, Hertz, Patch
 from fenicsfriction.stability import Loci, StabilitySolver
+from fenicsfriction.studies.contact import closed_forms, geometry
+from fenicsfriction.studies.contact.model import TwoBodyModel
+from fenicsfriction.studies.contact.validation import Cattaneo, Hertz, Patch
 
 logging.getLogger("ffcx").setLevel(logging.WARNING)
 comm = MPI.COMM_WORLD

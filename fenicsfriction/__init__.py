@@ -1,12 +1,15 @@
 """fenicsfriction: dynamic friction with normal compliance in FEniCSx.
 
 Interface laws with normal compliance and regularised Coulomb-type friction (Martins & Oden
-1987), steady sliding on a moving foundation, its stability as a quadratic eigenproblem, and
-the dynamics that follow, on one UFL residual; reduced (mesh-free) models beside the finite
-element ones.
+1986), steady sliding on a moving foundation, its stability as a quadratic eigenproblem, and
+the dynamics that follow, on one UFL residual (:mod:`~fenicsfriction.laws` →
+:mod:`~fenicsfriction.forms` → :mod:`~fenicsfriction.steady`, :mod:`~fenicsfriction.stability`,
+:mod:`~fenicsfriction.dynamics`); the studies, grouped by physics family with their mesh-free
+models beside the finite element ones, in :mod:`fenicsfriction.studies`.
 
 Every name in ``__all__`` is importable from the package itself. The names are loaded on first
-use, so ``import fenicsfriction.reduced`` (the models without a mesh) does not import dolfinx.
+use, so importing a mesh-free model (``fenicsfriction.studies.rolling.fastsim``, say) does not
+import dolfinx.
 """
 
 from __future__ import annotations
@@ -23,7 +26,7 @@ except _metadata.PackageNotFoundError:  # running from a source tree
 
 #: public name -> the module that defines it
 _EXPORTS: dict[str, str] = {
-    # pointwise laws (NumPy and UFL)
+    # the interface law (NumPy and UFL)
     "InterfaceLaw": "laws", "ConstantFriction": "laws", "PiecewiseLinearFriction": "laws",
     "StribeckFriction": "laws", "CoulombSlipRule": "laws", "EllipticSlipRule": "laws",
     # the one residual
@@ -34,9 +37,12 @@ _EXPORTS: dict[str, str] = {
     "StabilitySolver": "stability", "Loci": "stability", "Mode": "stability",
     "EigenSolveError": "stability", "unstable_intervals": "stability", "Onset": "stability",
     "DynamicsSolver": "dynamics", "CentralDifference": "dynamics",
-    "DynamicsError": "timestepping",
+    "DynamicsError": "timestepping", "ReducedDynamics": "timestepping",
     "PanagiotopoulosSolver": "panagiotopoulos", "ProcessError": "panagiotopoulos",
     "ProcessReport": "panagiotopoulos", "SurfaceMollifier": "mollification",
+    "integrate_hybrid": "events", "HybridError": "events", "HybridResult": "events",
+    # two-body contact elements
+    "NodeToSegment": "contact", "solve_with_search": "contact",
     # post-processing and output
     "stick_slip_statistics": "statistics", "StickSlipStatistics": "statistics",
     "mode_intervals": "statistics", "limit_cycle": "statistics", "LimitCycle": "statistics",
@@ -44,33 +50,36 @@ _EXPORTS: dict[str, str] = {
     "dense_eigenvalues": "numerics", "bisect": "numerics",
     "Record": "results", "write_json": "results", "get_logger": "results", "CsvRows": "results",
     "StopSignals": "signals", "Interrupted": "signals",
-    # scenes
-    "BlockData": "scenes", "BlockOnBelt": "scenes", "BlockModel": "scenes",
-    "BlockOnSlab": "scenes", "SlabModel": "scenes", "LayeredBlockOnBelt": "scenes.block",
-    "Hertz": "scenes.contact.validation", "Patch": "scenes.contact.validation",
-    "Cattaneo": "scenes.contact.validation", "TwoBodyModel": "scenes.contact.model",
-    "PressAndDrag": "scenes.contact.impact",
-    # two-body contact
-    "NodeToSegment": "contact", "solve_with_search": "contact",
-    "BlockQuantities": "scenes.block", "Energies": "scenes.block", "Powers": "scenes.block",
-    "ContactStates": "scenes.block", "CentreOfMass": "scenes.block",
-    "ProbeValues": "scenes.block",
-    # reduced models (no mesh)
-    "RigidBlock": "reduced", "RigidLoci": "reduced.rigid_block", "rigid_loci":
-    "reduced.rigid_block", "ReducedDynamics": "reduced", "BouncingMass": "reduced",
-    "BeltOscillator": "reduced", "Slider": "reduced", "SliderMotion": "reduced",
-    "Contact": "reduced", "table2_slider": "reduced", "stability_map": "reduced",
-    "integrate_hybrid": "reduced", "HybridError": "reduced", "HybridResult": "reduced",
-    "BeltResult": "reduced", "AveragedStability": "reduced.slider",
-    "FloquetStability": "reduced.slider", "StabilityMap": "reduced.slider",
-    "fastsim": "reduced.rolling.fastsim", "creep_curve": "reduced.rolling",
-    "linear_theory": "reduced.rolling", "creep_coefficients": "reduced.rolling",
-    "HertzEllipse": "reduced.rolling", "FastsimResult": "reduced.rolling",
+    # studies: the block on a belt
+    "BlockData": "studies.block", "BlockOnBelt": "studies.block", "BlockModel": "studies.block",
+    "BlockOnSlab": "studies.block", "SlabModel": "studies.block",
+    "LayeredBlockOnBelt": "studies.block", "BlockQuantities": "studies.block",
+    "Energies": "studies.block", "Powers": "studies.block", "ContactStates": "studies.block",
+    "CentreOfMass": "studies.block", "ProbeValues": "studies.block",
+    "RigidBlock": "studies.block", "RigidLoci": "studies.block", "rigid_loci": "studies.block",
+    # studies: two-body contact
+    "Hertz": "studies.contact", "Patch": "studies.contact", "Cattaneo": "studies.contact",
+    "TwoBodyModel": "studies.contact", "PressAndDrag": "studies.contact",
+    # studies: rolling contact
+    "fastsim": "studies.rolling.fastsim", "creep_curve": "studies.rolling",
+    "linear_theory": "studies.rolling", "creep_coefficients": "studies.rolling",
+    "HertzEllipse": "studies.rolling", "FastsimResult": "studies.rolling",
+    "RollingContact": "studies.rolling",
+    # studies: oscillators
+    "BouncingMass": "studies.oscillators", "BeltOscillator": "studies.oscillators",
+    "BeltResult": "studies.oscillators", "Slider": "studies.oscillators",
+    "SliderMotion": "studies.oscillators", "Contact": "studies.oscillators",
+    "table2_slider": "studies.oscillators", "stability_map": "studies.oscillators",
+    "AveragedStability": "studies.oscillators", "FloquetStability": "studies.oscillators",
+    "StabilityMap": "studies.oscillators",
+    # studies: the multi-contact interface
+    "EQModel": "studies.multicontact", "MasterEquation": "studies.multicontact",
+    "InteractingEQModel": "studies.multicontact", "FKChain": "studies.multicontact",
 }
 
-_SUBMODULES = ("contact", "dynamics", "forms", "io", "laws", "mollification", "numerics",
-               "panagiotopoulos", "plotting", "reduced", "results", "scenes", "signals",
-               "stability", "statistics", "steady", "timestepping")
+_SUBMODULES = ("contact", "dynamics", "events", "forms", "io", "laws", "meshing", "mollification",
+               "numerics", "panagiotopoulos", "plotting", "results", "signals", "stability",
+               "statistics", "steady", "studies", "timestepping")
 
 __getattr__, __dir__, __all__ = attach(__name__, _EXPORTS, _SUBMODULES)
 __all__.append("__version__")  # the same list __dir__ returns
@@ -78,25 +87,28 @@ __all__.append("__version__")  # the same list __dir__ returns
 
 if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers and IDEs
     from fenicsfriction import (
+        contact,
         dynamics,
+        events,
         forms,
         io,
         laws,
+        meshing,
         mollification,
         numerics,
         panagiotopoulos,
         plotting,
-        reduced,
         results,
-        scenes,
         signals,
         stability,
         statistics,
         steady,
+        studies,
         timestepping,
     )
     from fenicsfriction.contact import NodeToSegment, solve_with_search
     from fenicsfriction.dynamics import CentralDifference, DynamicsSolver
+    from fenicsfriction.events import HybridError, HybridResult, integrate_hybrid
     from fenicsfriction.forms import NodalSpring, Residual
     from fenicsfriction.laws import (
         ConstantFriction,
@@ -109,45 +121,7 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers and IDEs
     from fenicsfriction.mollification import SurfaceMollifier
     from fenicsfriction.numerics import bisect, dense_eigenvalues
     from fenicsfriction.panagiotopoulos import PanagiotopoulosSolver, ProcessError, ProcessReport
-    from fenicsfriction.reduced import (
-        BeltOscillator,
-        BeltResult,
-        BouncingMass,
-        Contact,
-        HybridError,
-        HybridResult,
-        ReducedDynamics,
-        RigidBlock,
-        Slider,
-        SliderMotion,
-        integrate_hybrid,
-        stability_map,
-        table2_slider,
-    )
-    from fenicsfriction.reduced.rigid_block import RigidLoci, rigid_loci
-    from fenicsfriction.reduced.rolling import (
-        FastsimResult,
-        HertzEllipse,
-        creep_coefficients,
-        creep_curve,
-        linear_theory,
-    )
-    from fenicsfriction.reduced.rolling.fastsim import fastsim
-    from fenicsfriction.reduced.slider import AveragedStability, FloquetStability, StabilityMap
     from fenicsfriction.results import CsvRows, Record, get_logger, write_json
-    from fenicsfriction.scenes import BlockData, BlockModel, BlockOnBelt, BlockOnSlab, SlabModel
-    from fenicsfriction.scenes.block import (
-        BlockQuantities,
-        CentreOfMass,
-        ContactStates,
-        Energies,
-        LayeredBlockOnBelt,
-        Powers,
-        ProbeValues,
-    )
-    from fenicsfriction.scenes.contact.impact import PressAndDrag
-    from fenicsfriction.scenes.contact.model import TwoBodyModel
-    from fenicsfriction.scenes.contact.validation import Cattaneo, Hertz, Patch
     from fenicsfriction.signals import Interrupted, StopSignals
     from fenicsfriction.stability import (
         EigenSolveError,
@@ -174,4 +148,50 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers and IDEs
         continuation,
         epsilon_sequence,
     )
-    from fenicsfriction.timestepping import DynamicsError
+    from fenicsfriction.studies.block import (
+        BlockData,
+        BlockModel,
+        BlockOnBelt,
+        BlockOnSlab,
+        BlockQuantities,
+        CentreOfMass,
+        ContactStates,
+        Energies,
+        LayeredBlockOnBelt,
+        Powers,
+        ProbeValues,
+        RigidBlock,
+        RigidLoci,
+        SlabModel,
+        rigid_loci,
+    )
+    from fenicsfriction.studies.contact import Cattaneo, Hertz, Patch, PressAndDrag, TwoBodyModel
+    from fenicsfriction.studies.multicontact import (
+        EQModel,
+        FKChain,
+        InteractingEQModel,
+        MasterEquation,
+    )
+    from fenicsfriction.studies.oscillators import (
+        AveragedStability,
+        BeltOscillator,
+        BeltResult,
+        BouncingMass,
+        Contact,
+        FloquetStability,
+        Slider,
+        SliderMotion,
+        StabilityMap,
+        stability_map,
+        table2_slider,
+    )
+    from fenicsfriction.studies.rolling import (
+        FastsimResult,
+        HertzEllipse,
+        RollingContact,
+        creep_coefficients,
+        creep_curve,
+        linear_theory,
+    )
+    from fenicsfriction.studies.rolling.fastsim import fastsim
+    from fenicsfriction.timestepping import DynamicsError, ReducedDynamics

@@ -1,6 +1,6 @@
 """Names of a package loaded on first use (PEP 562), so that importing a package costs only
-what is used: ``import fenicsfriction.reduced`` does not import SciPy's integrators or MPI
-until a model needs them, and the command line's ``--help`` imports no solver at all.
+what is used: ``import fenicsfriction.studies.oscillators`` does not import SciPy's integrators
+or MPI until a model needs them, and the command line's ``--help`` imports no solver at all.
 """
 
 from __future__ import annotations

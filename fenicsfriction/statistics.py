@@ -8,8 +8,8 @@ Two families, both read from what an integrator recorded and neither part of one
   (``rigid_block_observables``);
 * :func:`mode_intervals`, :func:`displacement_extrema`, :func:`limit_cycle` and
   :func:`belt_summary` — the phases, extremes and limit cycle of an event-located run
-  (:class:`~fenicsfriction.reduced.events.HybridResult`,
-  :class:`~fenicsfriction.reduced.belt.BeltResult`).
+  (:class:`~fenicsfriction.events.HybridResult`,
+  :class:`~fenicsfriction.studies.oscillators.belt.BeltResult`).
 
 Imports NumPy and SciPy only (no dolfinx, no PETSc).
 """
@@ -27,11 +27,27 @@ from fenicsfriction.laws import check
 from fenicsfriction.results import Record
 
 if typing.TYPE_CHECKING:
-    from fenicsfriction.reduced.belt import BeltResult
-    from fenicsfriction.reduced.events import HybridResult
+    from fenicsfriction.events import HybridEvent, HybridResult
 
-__all__ = ["BeltSummary", "LimitCycle", "StickSlipStatistics", "belt_summary",
+__all__ = ["BeltRun", "BeltSummary", "LimitCycle", "StickSlipStatistics", "belt_summary",
            "displacement_extrema", "limit_cycle", "mode_intervals", "stick_slip_statistics"]
+
+
+class BeltRun(typing.Protocol):
+    """What the measures of an event-located run read: the protocol of
+    :class:`~fenicsfriction.studies.oscillators.belt.BeltResult` (a family's type, which these
+    generic measures do not import)."""
+
+    t: np.ndarray  #: recorded times
+    x: np.ndarray  #: displacements
+    v: np.ndarray  #: velocities
+    events: list[HybridEvent]  #: the located events
+    stick_intervals: list[tuple[float, float]]  #: (start, end) of each stick phase
+    hybrid: HybridResult  #: the integration's result (TS counters)
+    method: str  #: ``"events"`` or ``"regularised"``
+
+    def stick_onsets(self) -> np.ndarray:
+        """Times of the located events that enter stick."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -216,7 +232,7 @@ def mode_intervals(result: HybridResult, holds: typing.Callable[[typing.Any], bo
     phases).
 
     Args:
-        result: the run (:class:`~fenicsfriction.reduced.events.HybridResult`).
+        result: the run (:class:`~fenicsfriction.events.HybridResult`).
         holds: mode -> whether the phase of interest holds in it.
 
     Returns:
@@ -235,14 +251,14 @@ def mode_intervals(result: HybridResult, holds: typing.Callable[[typing.Any], bo
     return intervals
 
 
-def displacement_extrema(result: BeltResult) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def displacement_extrema(result: BeltRun) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Times, values and kinds (+1 maximum, -1 minimum) of the extremes of x.
 
     Where ẋ changes sign between two records, the cubic Hermite interpolant of (x, ẋ) is
     extremal (error O(h⁴) in the value).
 
     Args:
-        result: the run (:class:`~fenicsfriction.reduced.belt.BeltResult`: ``t``, ``x``,
+        result: the run (:class:`~fenicsfriction.studies.oscillators.belt.BeltResult`: ``t``, ``x``,
             ``v``).
 
     Returns:
@@ -264,7 +280,7 @@ def displacement_extrema(result: BeltResult) -> tuple[np.ndarray, np.ndarray, np
     return np.array(times), np.array(values), np.array(kinds)
 
 
-def limit_cycle(result: BeltResult) -> LimitCycle:
+def limit_cycle(result: BeltRun) -> LimitCycle:
     """Measure the last full cycle of a run (make the run long enough for transients to die).
 
     The cycle is delimited by the last two stick onsets (located events) if the run has them,
@@ -272,7 +288,7 @@ def limit_cycle(result: BeltResult) -> LimitCycle:
     amplitude is max - min of x over it, the extremes interpolated alike.
 
     Args:
-        result: the run (:class:`~fenicsfriction.reduced.belt.BeltResult`).
+        result: the run (:class:`~fenicsfriction.studies.oscillators.belt.BeltResult`).
 
     Returns:
         The :class:`LimitCycle`; ``period_change`` is NaN without a third cycle marker.
@@ -298,11 +314,11 @@ def limit_cycle(result: BeltResult) -> LimitCycle:
                       period_change=float(change))
 
 
-def belt_summary(result: BeltResult) -> BeltSummary:
+def belt_summary(result: BeltRun) -> BeltSummary:
     """The JSON-able numbers of a belt oscillator run.
 
     Args:
-        result: the run (:class:`~fenicsfriction.reduced.belt.BeltResult`).
+        result: the run (:class:`~fenicsfriction.studies.oscillators.belt.BeltResult`).
 
     Returns:
         The :class:`BeltSummary`: the last cycle's :class:`LimitCycle` (None where it cannot

@@ -1,6 +1,6 @@
 r"""Second-order time stepping by PETSc TS without a mesh: the driver shared by the finite
 element dynamics (:class:`fenicsfriction.dynamics.DynamicsSolver`) and the few-d.o.f. models
-(:class:`fenicsfriction.reduced.ReducedDynamics`).
+(:class:`ReducedDynamics`, dense and sequential).
 
 The default scheme is PETSc's generalized-α method for second-order systems (``TSALPHA2``),
 Newton (SNES) at each step from a constant-velocity predictor, with the step cut back to a
@@ -13,6 +13,7 @@ from __future__ import annotations
 import time
 import typing
 
+from mpi4py import MPI
 from petsc4py import PETSc
 
 import numpy as np
@@ -24,7 +25,9 @@ from fenicsfriction.petsc_options import (
     options_with_defaults,
 )
 
-__all__ = ["DEFAULT_OPTIONS", "Alpha2Integrator", "DynamicsError"]
+__all__ = ["DEFAULT_OPTIONS", "Alpha2Integrator", "DynamicsError", "ReducedDynamics"]
+
+ArrayLike: typing.TypeAlias = typing.Any  # an array of floats, or a float for one d.o.f.
 
 
 DEFAULT_OPTIONS = {
@@ -68,7 +71,8 @@ class DynamicsError(RuntimeError):
 class Alpha2Integrator:
     """PETSc TS (TSALPHA2 by default) on a second-order system R(t, x, ẋ, ẍ) = 0: the set-up,
     the Newton stopping test, the cut-back and regrowth of the step, and the run loop with its
-    records, shared by the FE solver and the few-d.o.f. models of :mod:`fenicsfriction.reduced`.
+    records, shared by the FE solver and the few-d.o.f. models of the studies
+    (:class:`ReducedDynamics`).
 
     A subclass provides the residual ``_F(ts, t, x, xdot, xddot, F)``, the Jacobian
     ``_J(ts, t, x, xdot, xddot, shift_v, shift_a, J, P)`` (which must call
@@ -213,3 +217,69 @@ class Alpha2Integrator:
             raise DynamicsError(f"TS stopped at t = {self.ts.getTime():.6g} with reason "
                                 f"{reason} after {self.ts.getStepNumber()} steps", records)
         return records
+
+
+class ReducedDynamics(Alpha2Integrator):
+    """Generalized-α (TSALPHA2) integration of a few-d.o.f. model, dense and sequential.
+
+    Args:
+        model: offers ``residual(q, q_dot, q_ddot)`` and ``linearisation(q, q_dot)``.
+        q0, q_dot0: initial displacement and velocity (n values each).
+        prefix: PETSc options prefix of the TS (and its SNES/KSP/PC).
+        options: defaults over :data:`~fenicsfriction.timestepping.DEFAULT_OPTIONS` (LU by PETSc's
+            own dense factorisation instead of MUMPS); options in the database win.
+        atol: absolute Newton tolerance on the residual (force units); None: 1e-10 times the
+            model's ``weight`` if it has a positive one, else 1e-10.
+
+    Attributes:
+        q, q_dot: the current state (NumPy arrays): the initial one, the accepted step while
+            ``observe`` runs, the final one after :meth:`run`. Assigning to them before a run
+            sets its initial state; a second run continues from the final state (the time
+            restarts at 0).
+
+    With the default ρ∞ = 1 the scheme advances (q, q̇) by the implicit midpoint rule, and the
+    starting acceleration does not enter. With ρ∞ < 1 it does, and PETSc 3.18's start
+    (``TSAlpha_Restart``) estimates it twice too large: a free fall at ρ∞ = 0.5 keeps a
+    velocity error g h/6 after the first step.
+    """
+
+    def __init__(self, model: typing.Any, q0: ArrayLike, q_dot0: ArrayLike,
+                 prefix: str = "reduced_", options: dict | None = None,
+                 atol: float | None = None):
+        q0, q_dot0 = (np.array(x, dtype=float).ravel() for x in (q0, q_dot0))
+        check("q0", q0, q0.size > 0 and bool(np.all(np.isfinite(q0))), "must be finite numbers")
+        check("q_dot0", q_dot0, q_dot0.shape == q0.shape and bool(np.all(np.isfinite(q_dot0))),
+              f"must be {q0.size} finite numbers, like q0")
+        self.model = model
+        self.q, self.q_dot = q0, q_dot0
+        if atol is None:
+            weight = float(getattr(model, "weight", 0.0) or 0.0)
+            atol = 1e-10 * (weight if weight > 0 else 1.0)
+        n = q0.size
+        comm = MPI.COMM_SELF
+        self._u, self._v, F = (PETSc.Vec().createSeq(n, comm=comm) for _ in range(3))
+        J = PETSc.Mat().createDense((n, n), comm=comm)
+        J.setUp()
+        self._rows = np.arange(n, dtype=PETSc.IntType)
+        super().__init__(comm, prefix, F, J,
+                         {"pc_factor_mat_solver_type": "petsc", **(options or {})}, atol)
+
+    def _state(self) -> tuple[PETSc.Vec, PETSc.Vec]:
+        self._u.setArray(self.q)
+        self._v.setArray(self.q_dot)
+        return self._u, self._v
+
+    def _load(self, x: typing.Any, xdot: typing.Any, xddot: typing.Any) -> None:
+        """Copy an accepted state into ``q`` and ``q_dot`` (the acceleration is not kept)."""
+        self.q = x.getArray(readonly=True).copy()
+        self.q_dot = xdot.getArray(readonly=True).copy()
+
+    def _F(self, ts, t, x, xdot, xddot, F):
+        F.setArray(self.model.residual(*(v.getArray(readonly=True) for v in (x, xdot, xddot))))
+
+    def _J(self, ts, t, x, xdot, xddot, shift_v, shift_a, J, P):
+        M, C, K = self.model.linearisation(x.getArray(readonly=True),
+                                           xdot.getArray(readonly=True))
+        J.setValues(self._rows, self._rows, np.asarray(K + shift_v * C + shift_a * M).ravel())
+        J.assemble()
+        self.convergence.jacobian_assembled(J)

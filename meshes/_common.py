@@ -11,7 +11,7 @@ from mpi4py import MPI
 
 import numpy as np
 
-from fenicsfriction.contact import geometry
+from fenicsfriction.studies.contact import geometry
 
 TAGS = {"BODY1": geometry.BODY1, "BODY2": geometry.BODY2, "SLAVE": geometry.SLAVE,
         "LOAD": geometry.LOAD, "MASTER": geometry.MASTER, "FIXED": geometry.FIXED,

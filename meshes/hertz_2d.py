@@ -2,7 +2,7 @@
 
 from _common import build, parser
 
-from fenicsfriction.contact import geometry
+from fenicsfriction.studies.contact import geometry
 
 if __name__ == "__main__":
     p = parser("hertz_2d", __doc__)

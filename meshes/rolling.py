@@ -8,7 +8,7 @@ from mpi4py import MPI
 
 from _common import parser
 
-from fenicsfriction.scenes.rolling import geometry
+from fenicsfriction.studies.rolling import geometry
 
 #: per dimension: cells over a and the block's half-width and depth over a (the 2D half-plane's
 #: displacement diverges logarithmically: its block is wider)

@@ -1,5 +1,6 @@
-"""The one-d.o.f. oscillator on a belt (fenicsfriction.reduced.belt): linear stability of steady
-sliding, the classic stick-slip cycle in closed form, momentum balance across events."""
+"""The one-d.o.f. oscillator on a belt (fenicsfriction.studies.oscillators.belt): linear
+stability of steady sliding, the classic stick-slip cycle in closed form, momentum balance
+across events."""
 
 import json
 
@@ -8,8 +9,8 @@ import pytest
 from scipy.integrate import trapezoid
 
 from fenicsfriction import laws
-from fenicsfriction.reduced.belt import BeltOscillator
 from fenicsfriction.statistics import BeltSummary, belt_summary, displacement_extrema, limit_cycle
+from fenicsfriction.studies.oscillators.belt import BeltOscillator
 
 
 def classic(**kwargs) -> BeltOscillator:

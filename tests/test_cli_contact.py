@@ -15,7 +15,7 @@ import pytest
 from cli_errors import assert_one_error_line
 
 from fenicsfriction.cli import main
-from fenicsfriction.scenes.contact import closed_forms
+from fenicsfriction.studies.contact import closed_forms
 
 #: the mesh size at the contact of the Hertz mesh at refine 0 (0.005 R, R = 1), a twentieth of
 #: the default half-width a = R/10

@@ -9,8 +9,8 @@ import pytest
 from cli_errors import assert_one_error_line
 
 from fenicsfriction.cli import main
-from fenicsfriction.reduced.rolling.kalker import creep_coefficients
-from fenicsfriction.scenes.rolling import RollingContact, closed_forms
+from fenicsfriction.studies.rolling import RollingContact, closed_forms
+from fenicsfriction.studies.rolling.kalker import creep_coefficients
 
 #: the issue's wheel-rail example (SI): a along the rolling direction
 WHEEL = ["--a", "6.304e-3", "--b", "12.61e-3", "--G", "82e9", "--nu", "0.28", "--mu", "0.3",

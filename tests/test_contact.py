@@ -113,7 +113,7 @@ def test_parallel_solve_matches_the_serial_one(dim):
     """The patch under pressure on this communicator (slave and master facets on different
     ranks under MPI) against the same problem solved on each rank alone: the contact forces
     agree to the solver tolerance."""
-    from fenicsfriction.scenes.contact.validation import Patch
+    from fenicsfriction.studies.contact.validation import Patch
 
     scene = Patch(dim=dim, n_upper=3 if dim == 3 else 5, n_lower=4 if dim == 3 else 7)
     summary, model = scene.run(MPI.COMM_WORLD)
@@ -131,7 +131,7 @@ def test_two_pass_contact_passes_the_patch_test_and_one_pass_does_not(dim):
     """Taylor & Papadopoulos (1991): node-to-segment contact transmits a uniform pressure
     across non-matching meshes only with both surfaces slave in turn. Two passes: the
     deviation left is the penalty's (c_n = 1e4 against E = 1: a few 1e-3)."""
-    from fenicsfriction.scenes.contact.validation import Patch
+    from fenicsfriction.studies.contact.validation import Patch
 
     one, _ = Patch(dim=dim, passes=1).run()
     two, _ = Patch(dim=dim, passes=2).run()
@@ -141,7 +141,7 @@ def test_two_pass_contact_passes_the_patch_test_and_one_pass_does_not(dim):
 
 def test_search_between_solves_reaches_a_fixed_point():
     """solve_with_search returns a state whose own search keeps the pairing."""
-    from fenicsfriction.scenes.contact.validation import Patch
+    from fenicsfriction.studies.contact.validation import Patch
 
     _, model = Patch(dim=2).run()
     contact = model.contacts[0]
@@ -157,7 +157,7 @@ def test_perturbed_lagrangian_approaches_the_compliance_law_as_its_penalty_grows
     and with the compliance law (the same linear normal penalty, friction regularised by a
     small ε): the normal pressures coincide, and the tangential tractions draw together as ε_T
     grows (the stick spring stiffens towards the regularised law's rigid stick)."""
-    from fenicsfriction.scenes.contact.validation import Cattaneo
+    from fenicsfriction.studies.contact.validation import Cattaneo
 
     common = {"h_contact": 0.01, "increments": 2}
     _, model = Cattaneo(eps=1e-6, **common).run()
@@ -181,7 +181,7 @@ def test_hertz_converges_as_the_compliance_stiffens():
     """Hertz's line contact with linear compliance c_n: the compliance adds p/c_n to the
     approach, so the half-width and peak pressure converge to the Signorini limit like 1/c_n:
     each decade of c_n shrinks the change by about ten."""
-    from fenicsfriction.scenes.contact.validation import Hertz
+    from fenicsfriction.studies.contact.validation import Hertz
 
     widths, peaks = [], []
     for c_n in (1e2, 1e3, 1e4):
@@ -201,8 +201,8 @@ def test_hertz_sphere_matches_hertz_within_its_mesh_accuracy():
     ellipse fitted through the contact nodes' pressures gives the contact radius and peak
     pressure (measured +0.21 % and +0.73 %); the gap's sign change along the facets' edges
     places the radius only to within an element, h/a = 20 % (measured -7.7 %)."""
-    from fenicsfriction.scenes.contact.closed_forms import fit_hertz_pressure
-    from fenicsfriction.scenes.contact.validation import Hertz
+    from fenicsfriction.studies.contact.closed_forms import fit_hertz_pressure
+    from fenicsfriction.studies.contact.validation import Hertz
 
     scene = Hertz(dim=3)
     summary, model = scene.run()

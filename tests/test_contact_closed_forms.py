@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from fenicsfriction.scenes.contact import closed_forms
+from fenicsfriction.studies.contact import closed_forms
 
 
 def test_hertz_fit_recovers_the_profile_from_nodes_that_miss_its_edge():

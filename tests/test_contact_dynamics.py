@@ -15,7 +15,7 @@ from mpi4py import MPI
 import numpy as np
 import pytest
 
-from fenicsfriction.scenes.contact.impact import PressAndDrag
+from fenicsfriction.studies.contact.impact import PressAndDrag
 
 #: the mesh at the contact: coarse (1286 dofs), what the claims need is the contact's dynamics
 H = 0.05
@@ -23,7 +23,7 @@ H = 0.05
 
 def _static_penetration(scene: PressAndDrag) -> float:
     """Hertz's peak pressure over c_n: the static penetration of linear compliance."""
-    from fenicsfriction.scenes.contact.closed_forms import hertz_line_contact
+    from fenicsfriction.studies.contact.closed_forms import hertz_line_contact
     _, p0 = hertz_line_contact(scene.load, scene.radius, scene.E_star)
     return p0 / scene.c_n
 

@@ -1,4 +1,4 @@
-"""The two-body contact meshes (fenicsfriction.contact.geometry) against closed forms.
+"""The two-body contact meshes (fenicsfriction.studies.contact.geometry) against closed forms.
 
 Every test runs on any number of ranks (the meshes are built on rank 0 and distributed); sums
 over facets use each rank's owned facets and an allreduce.
@@ -30,8 +30,8 @@ import pytest
 import ufl
 from dolfinx import fem
 
-from fenicsfriction.contact import geometry
-from fenicsfriction.contact.geometry import (
+from fenicsfriction.studies.contact import geometry
+from fenicsfriction.studies.contact.geometry import (
     BODY1,
     BODY2,
     FIXED,

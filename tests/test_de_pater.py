@@ -11,8 +11,8 @@ shift of its own, the same for any β; it is measured with identical bodies and 
 
 import pytest
 
-from fenicsfriction.scenes.contact import closed_forms
-from fenicsfriction.scenes.contact.validation import Cattaneo
+from fenicsfriction.studies.contact import closed_forms
+from fenicsfriction.studies.contact.validation import Cattaneo
 
 #: a mesh of 10 nodes across the contact half-width: the shifts below change by < 5 % from it
 #: to 20 (measured: 0.640 % and 0.639 % of a with identical bodies)

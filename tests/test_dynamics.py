@@ -206,7 +206,7 @@ def test_the_observer_records_the_integrals_assembled_one_by_one():
     from dolfinx import fem
 
     from fenicsfriction import _compat
-    from fenicsfriction.scenes.block import observables
+    from fenicsfriction.studies.block import observables
 
     model = dynamic_state("observer")
     comm = model.msh.comm

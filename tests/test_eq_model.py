@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy import integrate, stats
 
-from fenicsfriction.reduced.interface import EQModel, critical_stiffness
+from fenicsfriction.studies.multicontact import EQModel, critical_stiffness
 
 # P_c broad enough that the contacts forget their common start within a few lives (a renewal
 # process's oscillation decays like exp(−2π² σ²/x_c²) per life), and supported on x > 0

@@ -18,7 +18,7 @@ import pytest
 import ufl
 
 from fenicsfriction.io import FieldWriter
-from fenicsfriction.scenes.interface_slider import InterfaceSlider, InterfaceSliderModel
+from fenicsfriction.studies.multicontact import InterfaceSlider, InterfaceSliderModel
 
 #: a slider whose contacts break one after the other from the pushed edge: thresholds within
 #: ±5 %, so the stretch (decaying from the edge over sqrt(E H / k) = 6 node spacings) decides

@@ -1,4 +1,4 @@
-"""Event-located integration of piecewise-smooth systems (fenicsfriction.reduced.events).
+"""Event-located integration of piecewise-smooth systems (fenicsfriction.events).
 
 Every rank integrates the same sequential system (PETSc objects on COMM_SELF).
 """
@@ -6,8 +6,8 @@ Every rank integrates the same sequential system (PETSc objects on COMM_SELF).
 import numpy as np
 import pytest
 
+from fenicsfriction.events import HybridError, integrate_hybrid
 from fenicsfriction.petsc_options import EVENTS_LOCATED_TO_RESOLUTION
-from fenicsfriction.reduced.events import HybridError, integrate_hybrid
 from fenicsfriction.statistics import mode_intervals
 
 OMEGA = 2.0

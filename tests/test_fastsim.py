@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 import scipy.integrate
 
-from fenicsfriction.reduced.rolling.fastsim import (
+from fenicsfriction.studies.rolling.fastsim import (
     creep_curve,
     fastsim,
     flexibilities,
     linear_theory,
 )
-from fenicsfriction.reduced.rolling.kalker import creep_coefficients
+from fenicsfriction.studies.rolling.kalker import creep_coefficients
 
 # the wheel-rail example, SI units
 A, B, G, NU, FN, MU = 6.304e-3, 12.61e-3, 82e9, 0.28, 106.7e3, 0.3

@@ -1,11 +1,15 @@
-"""Slip fronts of the FK-EQ chain (fenicsfriction.reduced.interface.frenkel_kontorova): the
+"""Slip fronts of the FK-EQ chain (fenicsfriction.studies.multicontact.frenkel_kontorova): the
 front speed against the continuum travelling wave and the sound speed, the energy balance across
 located breaks, pinning by a threshold spread, and hysteresis under a force cycle."""
 
 import numpy as np
 import pytest
 
-from fenicsfriction.reduced.interface.frenkel_kontorova import FKChain, TriangleRamp, front_speeds
+from fenicsfriction.studies.multicontact.frenkel_kontorova import (
+    FKChain,
+    TriangleRamp,
+    front_speeds,
+)
 
 # κ = k + K = 1.25: f_min = 0.75, f_max = 1.25, kink width a sqrt(g/κ)
 PARAMETERS = {"m": 1.0, "eta": 1.0, "k": 1.0, "K": 0.25, "u_s": 1.0}

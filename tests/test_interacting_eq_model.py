@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from fenicsfriction.reduced.interface import (
+from fenicsfriction.studies.multicontact import (
     EQModel,
     InteractingEQModel,
     coupling_map,

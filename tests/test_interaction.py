@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import scipy.integrate
 
-from fenicsfriction.reduced.interface.interaction import (
+from fenicsfriction.studies.multicontact.interaction import (
     LatticeInteraction,
     break_response,
     contact_forces,

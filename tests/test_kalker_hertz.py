@@ -8,14 +8,14 @@ import numpy as np
 import pytest
 import scipy.special
 
-from fenicsfriction.reduced.rolling.hertz import (
+from fenicsfriction.studies.rolling.hertz import (
     HertzEllipse,
     combined_modulus,
     hertz_from_curvatures,
     hertz_from_radii,
     quasi_identical_modulus,
 )
-from fenicsfriction.reduced.rolling.kalker import NU, RATIO, TABLE, creep_coefficients
+from fenicsfriction.studies.rolling.kalker import NU, RATIO, TABLE, creep_coefficients
 
 # ---------------------------------------------------------------- Kalker's coefficients
 

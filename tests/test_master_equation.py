@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from scipy import optimize, stats
 
-from fenicsfriction.reduced.interface import EQModel, MasterEquation, critical_stiffness
+from fenicsfriction.studies.multicontact import EQModel, MasterEquation, critical_stiffness
 
 
 @pytest.mark.parametrize("newborn", [None, stats.norm(loc=0.0, scale=0.1)],

@@ -15,7 +15,7 @@ import pytest
 
 import fenicsfriction as ff
 from fenicsfriction.panagiotopoulos import PanagiotopoulosSolver, ProcessError
-from fenicsfriction.scenes.block import LayeredBlockOnBelt
+from fenicsfriction.studies.block import LayeredBlockOnBelt
 
 COMM = MPI.COMM_WORLD
 

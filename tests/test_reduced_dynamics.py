@@ -1,5 +1,5 @@
-r"""PETSc TS on the few-d.o.f. models (:mod:`fenicsfriction.reduced.dynamics`) against closed
-forms, an energy quadrature, energy conservation and the rigid block's eigenvalues.
+r"""PETSc TS on the few-d.o.f. models (:class:`fenicsfriction.timestepping.ReducedDynamics`)
+against closed forms, an energy quadrature, energy conservation and the rigid block's eigenvalues.
 
 With the default ρ∞ = 1, PETSc's generalized-α (α_m = α_f = γ = 1/2, β = 1/4) advances (x, v)
 by the implicit midpoint rule, x_{n+1} = x_n + h (v_n + v_{n+1})/2,
@@ -22,13 +22,9 @@ import pytest
 import scipy.optimize
 from scipy.integrate import trapezoid
 
-from fenicsfriction.reduced import (
-    BouncingMass,
-    ReducedDynamics,
-    RigidBlock,
-    rigid_block_observables,
-)
-from fenicsfriction.timestepping import DynamicsError
+from fenicsfriction.studies.block import RigidBlock, rigid_block_observables
+from fenicsfriction.studies.oscillators import BouncingMass
+from fenicsfriction.timestepping import DynamicsError, ReducedDynamics
 
 _COUNTER = itertools.count()
 

@@ -15,9 +15,9 @@ import scipy.integrate
 import scipy.optimize
 
 import fenicsfriction as ff
-from fenicsfriction.reduced import RigidBlock
-from fenicsfriction.reduced.rigid_block import rigid_loci
 from fenicsfriction.stability import StabilitySolver
+from fenicsfriction.studies.block import RigidBlock
+from fenicsfriction.studies.block.rigid import rigid_loci
 
 _COUNTER = itertools.count()
 

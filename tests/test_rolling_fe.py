@@ -9,9 +9,9 @@ from mpi4py import MPI
 import numpy as np
 import pytest
 
-from fenicsfriction.reduced.rolling.kalker import creep_coefficients
-from fenicsfriction.scenes.rolling import closed_forms
-from fenicsfriction.scenes.rolling.model import RollingContact, write_xdmf
+from fenicsfriction.studies.rolling import closed_forms
+from fenicsfriction.studies.rolling.kalker import creep_coefficients
+from fenicsfriction.studies.rolling.model import RollingContact, write_xdmf
 
 #: Carter's problem: μ p0/G = 3e-3, saturation at ξ = μ a/R = 6e-3 (ν = 0)
 CARTER = {"dim": 2, "nu": 0.0, "mu": 0.3, "p0": 0.01, "block_size": 100.0}

@@ -10,9 +10,9 @@ import pytest
 import scipy.linalg
 
 from fenicsfriction import laws
+from fenicsfriction.events import HybridError, integrate_hybrid
 from fenicsfriction.petsc_options import EVENTS_LOCATED_TO_RESOLUTION
-from fenicsfriction.reduced.events import HybridError, integrate_hybrid
-from fenicsfriction.reduced.slider import (
+from fenicsfriction.studies.oscillators.slider import (
     Contact,
     Slider,
     SliderMotion,

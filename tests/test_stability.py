@@ -28,8 +28,8 @@ import fenicsfriction as ff
 from fenicsfriction import _compat
 from fenicsfriction.forms import friction
 from fenicsfriction.numerics import dense_eigenvalues
-from fenicsfriction.scenes.block.data import TOP
 from fenicsfriction.stability import Loci, StabilitySolver, unstable_intervals
+from fenicsfriction.studies.block.data import TOP
 
 COMM = MPI.COMM_WORLD
 MAX_MODULUS = 3e4  # [1/s]; the nearest eigenvalues are 2.49e4 below and > 3.5e4 above

@@ -5,8 +5,8 @@ from mpi4py import MPI
 import numpy as np
 import pytest
 
-from fenicsfriction.reduced.interface.interaction import break_response, interaction_matrix
-from fenicsfriction.scenes.interface import ElasticSubstrate, SubstrateBlock
+from fenicsfriction.studies.multicontact import ElasticSubstrate, SubstrateBlock
+from fenicsfriction.studies.multicontact.interaction import break_response, interaction_matrix
 
 # A block as deep as it is wide, graded (p = 2) towards the contacts: node i from the centre
 # sits at r = (w/2)(i/12)², its cells are ~2r/i wide.

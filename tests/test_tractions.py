@@ -16,7 +16,7 @@ import ufl
 
 import fenicsfriction as ff
 from fenicsfriction import _compat, laws
-from fenicsfriction.scenes import BlockOnBelt
+from fenicsfriction.studies.block import BlockOnBelt
 
 COMM = MPI.COMM_WORLD
 
@@ -138,8 +138,8 @@ def test_perturb_normal_velocity_moves_the_y_components_only():
 
 @pytest.mark.skipif(COMM.size > 1, reason="starts its own interpreter; runs in the serial pass")
 def test_reduced_models_and_scenes_import_without_dolfinx():
-    code = ("import sys, fenicsfriction.reduced, fenicsfriction.scenes, "
-            "fenicsfriction.scenes.block, fenicsfriction.reduced.rigid_block; "
+    code = ("import sys, fenicsfriction.studies, fenicsfriction.studies.block.data, "
+            "fenicsfriction.studies.block.slab, fenicsfriction.studies.block.rigid; "
             "assert 'dolfinx' not in sys.modules, sorted(m for m in sys.modules if 'dolfinx' in m)")
     env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_"))}
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,

@@ -64,7 +64,7 @@ class LazyChoices:
 def _scene_flags() -> argparse.ArgumentParser:
     """Flags shared by the commands that follow the steady state in μ (None: scene default)."""
     flags = Parser(add_help=False)
-    flags.add_argument("scene", choices=LazyChoices("fenicsfriction.scenes", "SCENES"),
+    flags.add_argument("scene", choices=LazyChoices("fenicsfriction.studies.block.slab", "SCENES"),
                        help="scene to run: block (rigid belt) or block-on-slab (elastic slab)")
     flags.add_argument("--mu-max", type=float, required=True, help="last friction coefficient")
     flags.add_argument("--steps", type=int, default=30, help="continuation increments (NINCT)")
@@ -131,7 +131,8 @@ def add_block_parsers(commands: typing.Any) -> None:
         description="Generalized-α (TSALPHA2) integration from the steady sliding state at --mu "
                     "plus a normal velocity perturbation; TS/SNES options as -dynamics_<option> "
                     "after the flags (e.g. -dynamics_ts_adapt_type basic).")
-    dynamics.add_argument("scene", choices=LazyChoices("fenicsfriction.scenes", "SCENES"),
+    dynamics.add_argument("scene",
+                          choices=LazyChoices("fenicsfriction.studies.block.slab", "SCENES"),
                           help="scene to run: block (rigid belt) or block-on-slab")
     dynamics.add_argument("--mu", type=float, required=True, help="friction coefficient")
     dynamics.add_argument("--t-end", type=float, required=True, help="final time [s]")
@@ -160,7 +161,8 @@ def add_block_parsers(commands: typing.Any) -> None:
 
 def add_oscillator_parsers(commands: typing.Any) -> None:
     """``stability-map mdof`` and ``oscillator mdof|belt``."""
-    readings = {"choices": LazyChoices("fenicsfriction.reduced.slider.table2", "TABLE2_READINGS"),
+    readings = {"choices": LazyChoices("fenicsfriction.studies.oscillators.slider.table2",
+                                       "TABLE2_READINGS"),
                 "default": "paper",
                 "metavar": "READING",
                 "help": "reading of the paper's dimensionless Table 2 model: %(choices)s "

@@ -24,12 +24,12 @@ from fenicsfriction import io, plotting, results
 from fenicsfriction.cli.common import flag, output_folder, scene_from_flags, stop_line
 from fenicsfriction.laws import check
 from fenicsfriction.results import CsvRows
-from fenicsfriction.scenes import SCENES
 from fenicsfriction.signals import Interrupted, StopSignals
+from fenicsfriction.studies.block.slab import SCENES
 
 if typing.TYPE_CHECKING:
-    from fenicsfriction.scenes.block import BlockModel, BlockOnBelt
     from fenicsfriction.steady import SteadySolver
+    from fenicsfriction.studies.block import BlockModel, BlockOnBelt
 
 __all__ = ["run_dynamics", "run_stability", "run_steady"]
 
@@ -149,7 +149,6 @@ def run_steady(args: argparse.Namespace, log: logging.Logger) -> int:
 
 def run_stability(args: argparse.Namespace, log: logging.Logger) -> int:
     """Loci of the FE block along μ with the onsets, beside the rigid block's."""
-    from fenicsfriction.reduced.rigid_block import rigid_loci
     from fenicsfriction.stability import (
         EigenSolveError,
         Loci,
@@ -158,6 +157,7 @@ def run_stability(args: argparse.Namespace, log: logging.Logger) -> int:
         unstable_intervals,
     )
     from fenicsfriction.steady import ContinuationError
+    from fenicsfriction.studies.block.rigid import rigid_loci
 
     comm = MPI.COMM_WORLD
     check("--max-frequency", args.max_frequency, args.max_frequency > 0, "must be > 0")

@@ -33,12 +33,12 @@ from fenicsfriction.cli.common import (
 from fenicsfriction.laws import check
 
 if typing.TYPE_CHECKING:
-    from fenicsfriction.scenes.contact.model import TwoBodyModel
+    from fenicsfriction.studies.contact.model import TwoBodyModel
 
 __all__ = ["run_contact"]
 
 #: the logger of the model, whose debug line reports each solve of the load's approach
-_MODEL_LOGGER = "fenicsfriction.scenes.contact.model"
+_MODEL_LOGGER = "fenicsfriction.studies.contact.model"
 
 #: half-widths of the window of deformed.png around the contact, in contact half-widths
 _WINDOW = (2.5, 1.2)
@@ -132,7 +132,7 @@ def _hertz_outputs(scene: typing.Any, summary: dict, model: TwoBodyModel, out: p
                    comm: MPI.Comm, log: logging.Logger,
                    tractions: typing.Sequence[tuple[np.ndarray, str]] = ()) -> None:
     """surface.csv, pressure.png, deformed.png (2D), traction.png (Cattaneo), bodies.xdmf."""
-    from fenicsfriction.scenes.contact import closed_forms
+    from fenicsfriction.studies.contact import closed_forms
 
     a, p0 = scene.closed_form()
     values = model.surface_values()
@@ -182,7 +182,7 @@ def _hertz_outputs(scene: typing.Any, summary: dict, model: TwoBodyModel, out: p
 
 
 def _run_hertz(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
-    from fenicsfriction.scenes.contact.validation import Hertz
+    from fenicsfriction.studies.contact.validation import Hertz
 
     scene = scene_from_flags(Hertz, args)
     out = output_folder(args.out)
@@ -208,7 +208,7 @@ def _run_hertz(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) ->
 
 
 def _run_cattaneo(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
-    from fenicsfriction.scenes.contact.validation import Cattaneo
+    from fenicsfriction.studies.contact.validation import Cattaneo
 
     sequence = args.eps_sequence
     if sequence is not None:
@@ -260,7 +260,7 @@ def _run_cattaneo(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm)
 
 
 def _run_patch(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
-    from fenicsfriction.scenes.contact.validation import Patch
+    from fenicsfriction.studies.contact.validation import Patch
 
     pairings = {"1": {"one_pass": 1}, "2": {"two_pass": 2},
                 "both": {"one_pass": 1, "two_pass": 2}}[args.passes]

@@ -30,7 +30,7 @@ def _eq_model(args: argparse.Namespace) -> typing.Any:
     from scipy import stats
 
     from fenicsfriction.laws import check_positive
-    from fenicsfriction.reduced.interface import EQModel
+    from fenicsfriction.studies.multicontact import EQModel
 
     newborn = None
     if args.newborn == "gaussian":
@@ -44,7 +44,7 @@ def _interacting(args: argparse.Namespace, model: typing.Any) -> typing.Any:
     """The model's contacts on a lattice, coupled by ``--coupling``; None without it."""
     if args.coupling is None:
         return None
-    from fenicsfriction.reduced.interface import InteractingEQModel
+    from fenicsfriction.studies.multicontact import InteractingEQModel
 
     return InteractingEQModel.lattice(model, args.coupling, nu=args.nu)
 
@@ -56,7 +56,7 @@ def _interface_json(result: typing.Any) -> dict[str, typing.Any]:
 
 
 def _run_eq(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
-    from fenicsfriction.reduced.interface import MasterEquation
+    from fenicsfriction.studies.multicontact import MasterEquation
 
     model = _eq_model(args)
     interacting = _interacting(args, model)
@@ -106,7 +106,7 @@ def _run_eq(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> in
 
 
 def _run_master_equation(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
-    from fenicsfriction.reduced.interface import MasterEquation
+    from fenicsfriction.studies.multicontact import MasterEquation
 
     model = _eq_model(args)
     out = output_folder(args.out, comm)
@@ -133,7 +133,7 @@ def _run_master_equation(args: argparse.Namespace, log: logging.Logger, comm: MP
 
 def _run_stability_map(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
     from fenicsfriction.laws import check
-    from fenicsfriction.reduced.interface import instability_map
+    from fenicsfriction.studies.multicontact import instability_map
 
     check("--K", args.K, (args.K is None) != (args.couplings is None),
           "give --K (drive stiffnesses) or --couplings (interacting contacts), one of the two")
@@ -178,7 +178,7 @@ def _run_coupling_map(args: argparse.Namespace, log: logging.Logger, comm: MPI.C
     import math
 
     from fenicsfriction.laws import check
-    from fenicsfriction.reduced.interface import coupling_map
+    from fenicsfriction.studies.multicontact import coupling_map
 
     n_side = math.isqrt(args.N)
     check("--N", args.N, n_side**2 == args.N, "must be a square n² with --couplings (e.g. 256)")
@@ -223,7 +223,7 @@ def _run_coupling_map(args: argparse.Namespace, log: logging.Logger, comm: MPI.C
 # --- the elastic interaction of contacts --------------------------------------------------------
 
 def _run_interaction(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
-    from fenicsfriction.reduced.interface import (
+    from fenicsfriction.studies.multicontact import (
         LatticeInteraction,
         fit_power_laws,
         radial_profile,
@@ -272,7 +272,7 @@ def _run_interaction(args: argparse.Namespace, log: logging.Logger, comm: MPI.Co
 # --- Frenkel-Kontorova slip fronts --------------------------------------------------------------
 
 def _run_fk(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
-    from fenicsfriction.reduced.interface.frenkel_kontorova import FKChain, front_speeds
+    from fenicsfriction.studies.multicontact.frenkel_kontorova import FKChain, front_speeds
 
     chain = FKChain(n=args.n, m=args.m, eta=args.eta, g=args.g, k=args.k, K=args.K,
                     u_s=args.u_s)
@@ -338,7 +338,7 @@ def _run_fk(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> in
 
 def _run_slider(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
     from fenicsfriction.io import FieldWriter
-    from fenicsfriction.scenes.interface_slider import InterfaceSlider, InterfaceSliderModel
+    from fenicsfriction.studies.multicontact import InterfaceSlider, InterfaceSliderModel
 
     names = ("L", "H", "nx", "ny", "E", "nu", "rho", "k", "threshold", "spread", "delay",
              "push_speed", "seed")

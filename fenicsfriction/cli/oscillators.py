@@ -31,7 +31,11 @@ __all__ = ["run_oscillator", "run_stability_map"]
 
 def run_stability_map(args: argparse.Namespace, log: logging.Logger) -> int:
     """Averaging and Floquet growth rates over a range of forcing frequencies, with bands."""
-    from fenicsfriction.reduced.slider import TABLE2_PAPER_BANDS, stability_map, table2_slider
+    from fenicsfriction.studies.oscillators.slider import (
+        TABLE2_PAPER_BANDS,
+        stability_map,
+        table2_slider,
+    )
 
     lo, hi = args.omega_range
     check("--omega-range", f"{lo:g}:{hi:g}", 0 < lo < hi, "needs 0 < LO < HI")
@@ -70,9 +74,9 @@ def _belt(args: argparse.Namespace, table: CsvRows,
     Returns:
         (summary, what to plot).
     """
-    from fenicsfriction.reduced import BeltOscillator
-    from fenicsfriction.reduced.belt import STICK
     from fenicsfriction.statistics import belt_summary
+    from fenicsfriction.studies.oscillators import BeltOscillator
+    from fenicsfriction.studies.oscillators.belt import STICK
 
     law: dict[str, typing.Callable[[], laws.FrictionCoefficient]] = {
            "constant": lambda: laws.ConstantFriction(args.mu_k),
@@ -126,9 +130,9 @@ def _slider(args: argparse.Namespace, table: CsvRows,
         (summary, what to plot, the failure of the integration or None). A run the
         integration could not finish is summarised up to where it stopped.
     """
-    from fenicsfriction.reduced.events import HybridError, integrate_hybrid
-    from fenicsfriction.reduced.slider import SliderMotion, table2_slider
+    from fenicsfriction.events import HybridError, integrate_hybrid
     from fenicsfriction.statistics import mode_intervals
+    from fenicsfriction.studies.oscillators.slider import SliderMotion, table2_slider
 
     slider = table2_slider(args.omega, reading=args.reading)
     motion = SliderMotion(slider, normal_force=args.normal_force, coupled=args.coupled,

@@ -59,7 +59,7 @@ def _fastsim_records(p: dict, args: argparse.Namespace,
                      xi: typing.Sequence[float]) -> tuple[list, list]:
     """(records, FASTSIM results) of the parameters ``p`` at the creepages ``xi`` (with the
     flags' η and φ)."""
-    from fenicsfriction.reduced.rolling.fastsim import creep_curve
+    from fenicsfriction.studies.rolling.fastsim import creep_curve
 
     grid = {k: p[k] for k in _METHOD_FLAGS["fastsim"] if k in p}
     points = creep_curve(p["a"], p["b"], p["G"], p["nu"], p["mu"], p["Fn"], xi=np.asarray(xi),
@@ -82,7 +82,7 @@ def _fastsim_traction(result: typing.Any, p: dict, path: pathlib.Path) -> None:
 
 def _cylinders(p: dict) -> tuple[float, float]:
     """Hertz's peak pressure p0 and the relative radius R of Carter's cylinders (2D)."""
-    from fenicsfriction.scenes.rolling import RollingContact
+    from fenicsfriction.studies.rolling import RollingContact
 
     scene = RollingContact(dim=2, a=p["a"], G=p["G"], nu=p["nu"], mu=p["mu"], Fn=p["Fn"])
     return scene.peak_pressure, scene.radius
@@ -90,7 +90,7 @@ def _cylinders(p: dict) -> tuple[float, float]:
 
 def _fe_model(p: dict, comm: MPI.Comm) -> typing.Any:
     """The finite element model of the parameters ``p`` (built once, re-solved per creepage)."""
-    from fenicsfriction.scenes.rolling import RollingContact
+    from fenicsfriction.studies.rolling import RollingContact
 
     renamed = {"normal": "pressure", "eps_sequence": "eps"}
     fields: dict[str, typing.Any] = {renamed.get(k, k): (tuple(v) if k == "eps_sequence" else v)
@@ -125,7 +125,7 @@ def _fe_traction(result: typing.Any, p: dict, dim: int, path: pathlib.Path) -> N
              f"{result.Fx / (p['mu'] * result.Fn):.4f}, adhesion {result.adhesion_fraction:.1%}")
     bound = p["mu"] * result.pressure
     if dim == 2:
-        from fenicsfriction.scenes.rolling import closed_forms
+        from fenicsfriction.studies.rolling import closed_forms
         p0, radius = _cylinders(p)
         grid = np.linspace(-p["a"], p["a"], 401)
         exact = (grid, closed_forms.carter_traction(grid, xi, p["mu"], p["a"], p0, radius),
@@ -152,7 +152,7 @@ def _creep_curve_png(records: list[dict], p: dict, args: argparse.Namespace,
                "FASTSIM" if method == "fastsim" else "finite elements (complete theory)",
                "o-" if method == "fastsim" else "s")]
     if method == "fastsim" or p["dim"] == 3:
-        from fenicsfriction.reduced.rolling.fastsim import creep_curve, linear_theory
+        from fenicsfriction.studies.rolling.fastsim import creep_curve, linear_theory
         if method != "fastsim":
             others = creep_curve(p["a"], p["b"], p["G"], p["nu"], p["mu"], p["Fn"], xi=fine,
                                  eta=np.full(len(fine), args.eta),
@@ -163,7 +163,7 @@ def _creep_curve_png(records: list[dict], p: dict, args: argparse.Namespace,
             linear = np.clip(slope * fine / scale, -1.0, 1.0)
             curves.append((fine, linear, "Kalker's linear theory (C11), clipped at μFn", "k:"))
     else:
-        from fenicsfriction.scenes.rolling.closed_forms import carter_force
+        from fenicsfriction.studies.rolling.closed_forms import carter_force
         p0, radius = _cylinders(p)
         curves.append((fine, np.array([carter_force(x, p["mu"], p["a"], p0, radius)
                                        for x in fine]) / scale, "Carter (1926)", "k-"))
@@ -229,7 +229,7 @@ def _run(args: argparse.Namespace, log: logging.Logger) -> int:
                 "method": "fe", "parameters": p, "failure": str(err)}, comm)
             stop_line(f"rolling fe: {err}", comm)
             return 1
-        from fenicsfriction.scenes.rolling import write_xdmf
+        from fenicsfriction.studies.rolling import write_xdmf
         write_xdmf(out / "rolling.xdmf", model)
         if comm.rank == 0:
             _fe_traction(solutions[-1], p, model.dim, out / "traction.png")

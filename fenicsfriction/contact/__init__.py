@@ -1,7 +1,7 @@
 """Two deformable bodies in frictional contact (Pop): node-to-segment contact elements
 carrying the interface law of Martins & Oden (1986) between a slave surface and a master one,
-in the same residual as the bulk terms (:mod:`fenicsfriction.forms`); the gmsh geometries of
-the two-body scenes (:mod:`fenicsfriction.contact.geometry`)."""
+in the same residual as the bulk terms (:mod:`fenicsfriction.forms`). The scenes that use them
+are in :mod:`fenicsfriction.studies.contact` and :mod:`fenicsfriction.studies.block`."""
 
 from fenicsfriction.contact.kinematics import Projection, project
 from fenicsfriction.contact.node_to_segment import ContactOperator, NodeToSegment, solve_with_search

@@ -1,0 +1,75 @@
+"""gmsh models read into distributed dolfinx meshes: the session on rank 0, shared by the scenes
+that build their meshes with gmsh (two-body contact, rolling contact).
+
+The builder owns the gmsh session: it initialises gmsh without the user's configuration files
+and finalises it; where gmsh has ``isInitialized`` (not 4.8) and reports a session open
+already, it uses it and removes only its own model.
+"""
+
+from __future__ import annotations
+
+import itertools
+import typing
+
+from mpi4py import MPI
+
+from fenicsfriction import _compat
+
+__all__ = ["gmsh_mesh"]
+
+_model_numbers = itertools.count()
+
+
+def gmsh_mesh(comm: MPI.Comm, name: str, gdim: int,
+              construct: typing.Callable[[typing.Any], None], msh_file: str | None = None
+              ) -> tuple[typing.Any, typing.Any, typing.Any]:
+    """Run ``construct(gmsh)`` (geometry, physical groups, size control) on rank 0, mesh it,
+    write ``msh_file`` if given, and read the model into a mesh distributed over ``comm``.
+
+    An error on rank 0 is broadcast, so that every rank raises instead of waiting.
+
+    Args:
+        comm: the communicator of the mesh; gmsh runs on its rank 0.
+        name: the geometry's name (in the gmsh model's name and in error messages).
+        gdim: the geometric (and topological) dimension, 2 or 3.
+        construct: ``construct(gmsh)`` builds the geometry, its physical groups and its mesh
+            size control in the current gmsh model.
+        msh_file: where to write the ``.msh`` file, or None.
+
+    Returns:
+        ``(mesh, cell_tags, facet_tags)``, the tags from the physical groups.
+    """
+    root = 0
+    model = None
+    owns_session = True
+    error = None
+    session: typing.Any = None  # the gmsh module, once there is something to close (rank 0)
+    if comm.rank == root:
+        try:
+            import gmsh
+            owns_session = not getattr(gmsh, "isInitialized", lambda: False)()
+            if owns_session:  # without the user's gmshrc: the same mesh everywhere
+                gmsh.initialize(readConfigFiles=False)
+                session = gmsh
+            gmsh.option.setNumber("General.Terminal", 0)
+            gmsh.model.add(f"fenicsfriction-{name}-{next(_model_numbers)}")
+            session = gmsh  # to be closed (finalised, or our model removed)
+            construct(gmsh)
+            gmsh.model.mesh.generate(gdim)
+            if msh_file is not None:
+                gmsh.write(str(msh_file))
+            model = gmsh.model
+        except Exception as e:  # broadcast below: the other ranks must not wait for the mesh
+            error = f"building the {name} mesh with gmsh failed: {type(e).__name__}: {e}"
+    try:
+        error = comm.bcast(error, root=root)
+        if error is not None:
+            raise RuntimeError(error)
+        msh, cell_tags, facet_tags = _compat.model_to_mesh(model, comm, root, gdim)
+    finally:
+        if session is not None:
+            if owns_session:
+                session.finalize()
+            else:
+                session.model.remove()
+    return msh, cell_tags, facet_tags

@@ -1,0 +1,190 @@
+r"""Dynamics between two bodies: the cylinder pressed onto the block, then dragged.
+
+The 2D Hertz geometry with inertia: a load P (per unit length) switched on at t = 0 on the
+cylinder's flat top pushes it from rest into the block, about whose static Hertz state it then
+oscillates (a suddenly applied load: the approach overshoots to about twice the static one).
+From ``drag_start`` a tangential traction Q = ``q_ratio`` μP pulls the top: above μP the
+cylinder slides, and when the traction is released (``drag_end``) the contact passes from
+slide to stick, where the regularised friction's slope is steepest (Pop's remark: the
+step is cut back until Newton converges, PETSc TS's rejection of a failed step).
+
+The energy balance closes the run: kinetic + elastic + stored in the compliance − work of the
+loads + dissipated by the interface = its initial value, to the integrator's accuracy (second
+order; generalized-α with ρ∞ = 1 adds no numerical dissipation).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import typing
+
+from mpi4py import MPI
+
+import numpy as np
+import ufl
+
+from fenicsfriction import _compat
+from fenicsfriction.dynamics import CentralDifference, DynamicsSolver
+from fenicsfriction.laws import check
+from fenicsfriction.studies.contact import closed_forms, geometry
+from fenicsfriction.studies.contact.geometry import LOAD
+from fenicsfriction.studies.contact.model import TwoBodyModel
+from fenicsfriction.studies.contact.validation import _Bodies
+
+__all__ = ["PressAndDrag"]
+
+SCHEMES = ("alpha2", "central")
+
+
+@dataclasses.dataclass
+class PressAndDrag(_Bodies):
+    """The cylinder of radius ``radius`` pressed on the block and dragged.
+
+    Args:
+        load: P [force/length]; ``None``: the load of a Hertz half-width R/10.
+        radius: R [length].
+        density: both bodies' mass density [mass/length³].
+        mu: friction coefficient (0: frictionless, no drag).
+        eps: regularisation of the slip rate [length/time]. Against the contact's speeds
+            (~1e-3 at the drag): with ε = 1e-4 and dt = 0.02 the stick dashpots
+            (c_T d/ε per node, far stiffer than 1/dt²) make Newton fail at most stick
+            transitions and the energy balance drifts (docs/contact.md).
+        b_n: normal damping coefficient (exponent m_n).
+        q_ratio: the drag Q/(μP) between ``drag_start`` and ``drag_end``.
+        drag_start, drag_end, t_end: times [time].
+        h_contact: the mesh size at the contact [length].
+        rho_infinity: generalized-α's spectral radius at infinite frequency (1: no numerical
+            dissipation; below 1 it damps the ringing of the stiff stick dashpots, which the
+            trapezoidal rule would otherwise carry undamped).
+    """
+
+    load: float | None = None
+    radius: float = 1.0
+    density: float = 1.0
+    c_n: float = 1e3
+    mu: float = 0.3
+    eps: float = 1e-3
+    b_n: float = 0.0
+    q_ratio: float = 1.5
+    drag_start: float = 10.0
+    drag_end: float = 20.0
+    t_end: float = 30.0
+    h_contact: float = 0.02
+    rho_infinity: float = 0.8
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.load is None:
+            self.load = closed_forms.hertz_load(self.radius / 10, self.radius, self.E_star)
+        check("load", self.load, self.load > 0, "the load must be > 0")
+        check("density", self.density, self.density > 0, "must be > 0")
+        check("mu", self.mu, self.mu >= 0, "must be >= 0")
+        check("eps", self.eps, self.eps > 0, "must be > 0")
+        check("drag_start", self.drag_start, 0 <= self.drag_start <= self.drag_end,
+              "0 <= drag_start <= drag_end")
+        check("t_end", self.t_end, self.t_end > 0, "must be > 0")
+
+    def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
+        mesh = geometry.hertz_2d(comm, R=self.radius, h_contact=self.h_contact)
+        return TwoBodyModel(mesh, self.materials, self.c_n, self.m_n, mu=self.mu,
+                            eps=self.eps, passes=self.passes, density=self.density,
+                            b_n=self.b_n)
+
+    def traction(self, t: float) -> np.ndarray:
+        """The traction on the cylinder's top at time t: −P/(2R) normal, the drag between
+        ``drag_start`` and ``drag_end``."""
+        assert self.load is not None
+        p = self.load / (2 * self.radius)
+        drag = self.q_ratio * self.mu * p if self.drag_start <= t < self.drag_end else 0.0
+        return np.array([drag, -p])
+
+    def run(self, scheme: str = "alpha2", dt: float = 0.05, comm: MPI.Comm = MPI.COMM_WORLD,
+            model: TwoBodyModel | None = None,
+            on_step: typing.Callable[[dict], None] | None = None) -> tuple[list[dict], dict]:
+        """Integrate; returns one record per step (time, energies, approach, slip) and a
+        summary (energy balance error, largest penetration, cut-backs, Newton iterations)."""
+        check("scheme", scheme, scheme in SCHEMES, f"one of {', '.join(SCHEMES)}")
+        model = model or self.build(comm)
+        assert self.load is not None
+        energy = _EnergyBalance(model)
+        if scheme == "alpha2":
+            solver: typing.Any = DynamicsSolver(
+                model.residual, prefix="press_", atol=1e-10 * self.load,
+                options={"ts_alpha_radius": self.rho_infinity})
+        else:
+            solver = CentralDifference(model.residual)
+
+        def observe(t: float) -> dict:
+            record = energy.record(t)  # with the load of the step that ends at t
+            model.shear.value = self.traction(t)  # the load of the next step
+            return record
+
+        # the drag switches within a step: set the load of the first step before it starts
+        model.shear.value = self.traction(0.0)
+        records = solver.run(self.t_end, dt, observe=observe, on_step=on_step)
+        balance = np.array([r["balance"] for r in records])
+        summary = {
+            "scheme": scheme, "dt": dt, "steps": len(records) - 1, "dofs": model.dofs,
+            "energy_error": float(np.max(np.abs(balance - balance[0]))
+                                  / max(abs(r["work"]) for r in records[1:])),
+            "max_penetration": float(max(r["max_penetration"] for r in records)),
+            "rejected_steps": int(sum(r["rejected_steps"] for r in records)),
+            "newton_iterations": int(sum(r["newton_iterations"] for r in records)),
+            "stable_dt": getattr(solver, "stable_dt", None),
+        }
+        return records, summary
+
+
+class _EnergyBalance:
+    """Energies of the two bodies and the work and dissipation integrated in time
+    (trapezoidal rule on the powers)."""
+
+    def __init__(self, model: TwoBodyModel):
+        self.model = model
+        u, u_dot = model.u, model.residual.u_dot
+        dx = model.dx
+        assert model.density is not None, "a dynamic model"
+        eps = ufl.sym(ufl.grad(u))
+        forms = {"kinetic": 0.5 * model.density * ufl.inner(u_dot, u_dot) * dx}
+        elastic = 0.0
+        for tag, material in zip((1, 2), model.materials, strict=True):
+            mu = material.E / (2 * (1 + material.nu))
+            lmbda = material.E * material.nu / ((1 + material.nu) * (1 - 2 * material.nu))
+            elastic = elastic + (mu * ufl.inner(eps, eps) + 0.5 * lmbda * ufl.tr(eps) ** 2) \
+                * dx(tag)
+        forms["elastic"] = elastic
+        # the work of the (stepwise constant) load over a step, exact: t · (u_n - u_{n-1})
+        from dolfinx import fem
+        self.u_previous = fem.Function(u.function_space)
+        forms["work"] = ufl.inner(model.shear, u - self.u_previous) * model.ds(LOAD)
+        self.forms = {k: _compat.form(f) for k, f in forms.items()}
+        self.contact = [(_compat.form(c.potential),
+                         _compat.form(c.dissipation) if c.relative_velocity is not None
+                         else None) for c in model.contacts]
+        self.last: tuple[float, float] | None = None  # t, dissipated power
+        self.work = 0.0
+        self.dissipated = 0.0
+
+    def _scalar(self, form: typing.Any) -> float:
+        from dolfinx import fem
+        return self.model.comm.allreduce(fem.assemble_scalar(form))
+
+    def record(self, t: float) -> dict:
+        for contact in self.model.contacts:  # the pairing the step was solved with
+            contact.update(search=not contact.searched)
+        values = {k: self._scalar(f) for k, f in self.forms.items()}
+        stored = sum(self._scalar(p) for p, _ in self.contact)
+        dissipation = sum(self._scalar(d) for _, d in self.contact if d is not None)
+        if self.last is not None:
+            t0, d0 = self.last
+            self.work += values["work"]
+            self.dissipated += 0.5 * (t - t0) * (d0 + dissipation)
+        self.last = (t, dissipation)
+        self.u_previous.x.array[:] = self.model.u.x.array
+        penetration = self.model.comm.allreduce(
+            -min(0.0, float(self.model.nodal_gap().min(initial=0.0))), op=MPI.MAX)
+        total = values["kinetic"] + values["elastic"] + stored
+        return {"kinetic": values["kinetic"], "elastic": values["elastic"],
+                "contact_energy": stored, "work": self.work, "dissipated": self.dissipated,
+                "balance": total - self.work + self.dissipated,
+                "max_penetration": penetration}

@@ -1,0 +1,351 @@
+r"""Two elastic bodies pressed together: the finite element model of the contact scenes.
+
+Both bodies live in one mesh (:class:`fenicsfriction.studies.contact.geometry.TwoBodyMesh`),
+each with its own Hooke's law; the interface law acts between the slave surface (body 1) and the
+master surface (body 2) through node-to-segment contact
+(:class:`fenicsfriction.contact.NodeToSegment`), optionally in two passes (each surface slave in
+turn, each pass with weight 1/2).
+
+Friction in a quasi-static scene follows Pop's incremental formulation: the slave
+velocity of the regularised law is the increment :math:`(u - u_{old})/\Delta t` of a pseudo time
+step (``dt``, 1 by default, so ε is a slip increment), and each load increment is one Newton
+solve started from the last.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import logging
+import typing
+
+from mpi4py import MPI
+
+import dolfinx.fem.petsc
+import numpy as np
+import ufl
+from dolfinx import fem, mesh
+
+from fenicsfriction import _compat, forms
+from fenicsfriction.contact import NodeToSegment, facet_nodes, solve_with_search
+from fenicsfriction.contact.node_to_segment import NodalValues
+from fenicsfriction.laws import check
+from fenicsfriction.steady import SteadySolver
+from fenicsfriction.studies.contact.geometry import (
+    BODY1,
+    BODY2,
+    FIXED,
+    LOAD,
+    MASTER,
+    SLAVE,
+    SYMMETRY_X,
+    SYMMETRY_Y,
+    TwoBodyMesh,
+)
+
+__all__ = ["Material", "SurfaceValues", "TwoBodyModel"]
+
+log = logging.getLogger(__name__)
+
+
+@dataclasses.dataclass(frozen=True)
+class Material:
+    """Isotropic linear elasticity: Young's modulus ``E`` [force/length²], Poisson's ``nu``."""
+
+    E: float
+    nu: float
+
+    def __post_init__(self) -> None:
+        check("E", self.E, self.E > 0, "Young's modulus must be > 0")
+        check("nu", self.nu, -1 < self.nu < 0.5, "Poisson's ratio must be in (-1, 0.5)")
+
+
+@dataclasses.dataclass
+class SurfaceValues:
+    """Nodal values on the slave surface, gathered on every rank, sorted by x, then y, z.
+
+    Attributes:
+        x: reference coordinates of the slave nodes (n, dim).
+        weight: each node's tributary length (2D) or area (3D).
+        gap: the normal gap to the master surface (< 0: penetration).
+        pressure: the contact pressure of the law at the node.
+        traction: the tangential traction vector (zeros when frictionless), (n, dim).
+        force: the contact force on the node from all passes (n, dim) per unit weight.
+    """
+
+    x: np.ndarray
+    weight: np.ndarray
+    gap: np.ndarray
+    pressure: np.ndarray
+    traction: np.ndarray
+    force: np.ndarray
+
+
+class TwoBodyModel:
+    """Body 1 (slave) on body 2 (master), a traction on body 1's :data:`LOAD` face.
+
+    Args:
+        geometry: the mesh and its tags.
+        materials: body 1's and body 2's :class:`Material`.
+        c_n, m_n: normal compliance (pressure c_n d^m_n) [force/length^(2+m_n)], [-].
+        mu: friction coefficient (0: frictionless, no friction term).
+        eps: regularisation of the slip increment [length per pseudo-time].
+        passes: 1 (body 1's surface is the slave) or 2 (each surface in turn).
+        clamp: body 2's :data:`FIXED` face clamped (True) or on rollers (normal component
+            fixed only: a patch test's free lateral expansion).
+        density: both bodies' mass density [mass/length³]: a dynamic model (inertia, the
+            friction on the slip rate u̇, normal damping ``b_n``, the LOAD face under the
+            traction ``shear`` in every direction: no platen, inertia carries body 1); ``None``
+            (default): quasi-static.
+        b_n: normal damping coefficient (dynamic models), exponent ``m_n``.
+        formulation, eps_T: the contact law (``"compliance"`` or ``"perturbed-lagrangian"``
+            with the tangential penalty ``eps_T``; :class:`~fenicsfriction.contact.NodeToSegment`).
+        fix_load_face: also fix the tangential displacement of the :data:`LOAD` face
+            (removes the sliding mode of a frictionless body 1 in a full model); else the
+            face carries the tangential traction ``shear``.
+
+    The normal load is applied through the approach: the :data:`LOAD` face is moved by
+    ``approach`` towards body 2 (a rigid platen), and :meth:`solve_for_load` finds the approach
+    whose contact force is the load asked for. Under a prescribed force instead, body 1 would
+    float on its contact springs, whose stiffness vanishes where the contact zone is small,
+    and Newton would creep along the contact's active set.
+
+    Attributes:
+        V, u, u_old: the displacement space, the displacement, the last increment's.
+        approach: the normal displacement of the LOAD face towards body 2 (``fem.Constant``).
+        shear: the tangential traction on the LOAD face (a vector ``fem.Constant``).
+        contacts: the node-to-segment couplings (one per pass).
+        residual, solver: the residual and its :class:`~fenicsfriction.steady.SteadySolver`.
+    """
+
+    def __init__(self, geometry: TwoBodyMesh, materials: tuple[Material, Material],
+                 c_n: float, m_n: float = 1.0, mu: float = 0.0, eps: float = 1e-6,
+                 passes: int = 1, fix_load_face: bool = False,
+                 regularisation: str = "c1", clamp: bool = True,
+                 density: float | None = None, b_n: float = 0.0,
+                 formulation: str = "compliance", eps_T: float | None = None):
+        check("passes", passes, passes in (1, 2), "1 or 2")
+        check("c_n", c_n, c_n > 0, "the normal compliance coefficient must be > 0")
+        check("m_n", m_n, m_n >= 1, "the normal exponent must be >= 1")
+        check("mu", mu, mu >= 0, "the friction coefficient must be >= 0")
+        check("eps", eps, eps > 0, "the regularisation parameter must be > 0")
+        self.geometry = geometry
+        msh, cell_tags, facet_tags = geometry.mesh, geometry.cell_tags, geometry.facet_tags
+        self.comm: MPI.Comm = msh.comm
+        self.dim = dim = msh.geometry.dim
+        self.V = V = _compat.vector_function_space(msh, 1)
+        self.u = fem.Function(V, name="displacement")
+        self.u_old = fem.Function(V, name="previous_displacement")
+        u_dot, u_ddot = fem.Function(V, name="velocity"), fem.Function(V, name="acceleration")
+        v = ufl.TestFunction(V)
+        dx = ufl.Measure("dx", domain=msh, subdomain_data=cell_tags)
+        ds = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags)
+        self.approach = fem.Constant(msh, 0.0)
+        self.shear = fem.Constant(msh, np.zeros(dim))
+        form = forms.surface_traction(self.shear, v, ds(LOAD))
+        self.dx, self.ds = dx, ds
+        self.materials = materials
+        for tag, material in zip((BODY1, BODY2), materials, strict=True):
+            form += forms.elasticity(self.u, v, material.E, material.nu, dx(tag))
+        self.dynamic = density is not None
+        if density is not None:
+            check("density", density, density > 0, "the mass density must be > 0")
+            form += forms.inertia(density, u_ddot, v, dx)
+        self.density = density
+        self.mu = fem.Constant(msh, float(mu))
+        self.eps = fem.Constant(msh, float(eps))
+        self.dt = fem.Constant(msh, 1.0)
+        law: dict = {"b_n": b_n}
+        if self.dynamic:
+            law.update(velocity=u_dot, fields=[u_dot])
+        if mu > 0:
+            law.update({"c_T": self.mu * c_n, "m_T": m_n, "eps": self.eps,
+                        "regularisation": regularisation})
+            if not self.dynamic:
+                law.update({"velocity": (self.u - self.u_old) / self.dt,
+                            "fields": [self.u_old], "time_step": self.dt})
+            self.eps_T = fem.Constant(msh, float(eps_T if eps_T is not None else 0.0))
+            law.update({"formulation": formulation, "eps_T": self.eps_T})
+        pairs = [(SLAVE, MASTER), (MASTER, SLAVE)][:passes]
+        self.contacts = [NodeToSegment(self.u, facet_tags, slave, master, c_n=c_n, m_n=m_n,
+                                       weight=1.0 / passes, **law)
+                         for slave, master in pairs]
+        self.residual = forms.Residual(form, self.u, u_dot, u_ddot, v,
+                                       bcs=self._bcs(fix_load_face, clamp),
+                                       couplings=self.contacts)
+        cells = cell_tags.indices[cell_tags.values == BODY1]
+        nodes = _compat.cell_dofs(_compat.scalar_function_space(msh, "Lagrange", 1), cells)
+        self._body1_rows = nodes[nodes < V.dofmap.index_map.size_local]
+        self._body1_dofs = nodes * dim + dim - 1  # their normal components (local, ghosts too)
+
+    @functools.cached_property
+    def solver(self) -> SteadySolver:
+        """Newton on the quasi-static residual (built at first use: a dynamic model, whose
+        friction acts on u̇, is solved by the time integrators instead)."""
+        return SteadySolver(self.residual, prefix="contact_", linear_solver="lu")
+
+    def _bcs(self, fix_load_face: bool, clamp: bool) -> list:
+        V, facet_tags, fdim = self.V, self.geometry.facet_tags, self.dim - 1
+        fixed = facet_tags.indices[facet_tags.values == FIXED]
+        if clamp:
+            bcs = [fem.dirichletbc(np.zeros(self.dim),
+                                   fem.locate_dofs_topological(V, fdim, fixed), V)]
+        else:
+            bcs = [self._component_bc(self.dim - 1, fixed)]
+        for axis, tag in ((0, SYMMETRY_X), (1, SYMMETRY_Y)):
+            facets = facet_tags.indices[facet_tags.values == tag]
+            if self.comm.allreduce(len(facets)) > 0:
+                bcs.append(self._component_bc(axis, facets))
+        load_face = facet_tags.indices[facet_tags.values == LOAD]
+        self._platen = fem.Constant(self.geometry.mesh, 0.0)  # -approach
+        if not self.dynamic:
+            bcs.append(self._component_bc(self.dim - 1, load_face, self._platen))
+        if fix_load_face:
+            bcs += [self._component_bc(axis, load_face) for axis in range(self.dim - 1)]
+        return bcs
+
+    def _component_bc(self, axis: int, facets: np.ndarray,
+                      value: typing.Any = 0.0) -> fem.DirichletBC:
+        dofs = fem.locate_dofs_topological(self.V.sub(axis), self.dim - 1, facets)
+        return fem.dirichletbc(value, dofs, self.V.sub(axis))
+
+    def rollers(self, axes: typing.Sequence[int]) -> None:
+        """Add rollers on the planes x_axis = 0 of both bodies (patch tests: no rigid motion
+        in the plane, free lateral expansion)."""
+        for axis in axes:
+            facets = mesh.locate_entities_boundary(
+                self.geometry.mesh, self.dim - 1, lambda x, a=axis: np.isclose(x[a], 0.0))
+            self.residual.bcs.append(self._component_bc(axis, facets))
+
+    def solve_at(self, approach: float) -> typing.Any:
+        """Equilibrium with the LOAD face moved by ``approach`` towards body 2 (Newton from the
+        current state, the pairing searched again until it holds); returns the report."""
+        # a deeper approach starts from body 1 moved rigidly with its face: the contact zone
+        # of a rigid indentation is wider than the elastic one, and Newton's active set shrinks
+        # to it in a few iterations (growing it takes about one node per iteration); a
+        # shallower one from the last state, whose zone also shrinks
+        increase = approach - float(self.approach.value)
+        if increase > 0:
+            self.u.x.array[self._body1_dofs] -= increase
+            self.u.x.scatter_forward()
+        self._platen.value = -approach
+        self.approach.value = approach
+        return solve_with_search(self.solver, self.contacts)
+
+    def normal_force(self) -> float:
+        """The contact force on body 1 along the approach (all passes, all ranks): the load."""
+        return self.comm.allreduce(float(self._contact_force()[self._body1_rows, -1].sum()))
+
+    def solve_for_load(self, load: float, guess: float, rtol: float = 1e-6,
+                       max_solves: int = 30) -> dict:
+        """The approach whose contact force is ``load`` (total in 3D, per unit length in 2D).
+
+        The force grows like a power of the approach (δ^{3/2} for Hertz in 3D, about δ in 2D),
+        so the approach is found by secant steps on log force against log approach, from
+        ``guess`` (any approach that makes contact). Returns ``approach``, ``load`` (reached),
+        ``newton_iterations`` (all solves) and ``solves``.
+        """
+        check("load", load, load > 0, "the load must be > 0")
+        check("guess", guess, guess > 0, "the first approach must be > 0")
+        history: list[tuple[float, float]] = []
+        iterations, delta = 0, guess
+        for solves in range(1, max_solves + 1):
+            report = self.solve_at(delta)
+            iterations += report.iterations
+            force = self.normal_force()
+            log.debug("approach %.6g: contact force %.6g (load %.6g), %d Newton iterations",
+                      delta, force, load, report.iterations)
+            if force > 0:
+                history.append((np.log(delta), np.log(force)))
+            if abs(force / load - 1) < rtol:
+                return {"approach": delta, "load": force, "newton_iterations": iterations,
+                        "solves": solves}
+            if len(history) < 2:
+                delta *= 2.0 if force <= 0 else (load / force) ** 0.7
+                continue
+            (x0, y0), (x1, y1) = history[-2], history[-1]
+            slope = (y1 - y0) / (x1 - x0) if x1 != x0 else 1.0
+            delta = float(np.exp(x1 + (np.log(load) - y1) / max(slope, 0.3)))
+        raise RuntimeError(f"solve_for_load: the contact force {force:.6g} did not reach the "
+                           f"load {load:.6g} within {max_solves} solves (max_solves)")
+
+    def surface_values(self) -> SurfaceValues:
+        """Nodal values on the slave surface of the first pass (see :class:`SurfaceValues`)."""
+        contact = self.contacts[0]
+        contact.update()
+        weight = contact.nodal_weights
+        values = self._surface_nodal()
+        if contact.traction is None:
+            values = np.column_stack([values, np.zeros((len(weight), self.dim))])
+        force = self._contact_force()
+        owned = np.flatnonzero(weight > 0)
+        x = contact.nodal_space.tabulate_dof_coordinates()[owned, :self.dim]
+        local = np.column_stack([x, weight[owned], values[owned],
+                                 force[owned] / weight[owned, None]])
+        rows = np.vstack(self.comm.allgather(local))
+        rows = rows[np.lexsort(rows[:, :self.dim].T[::-1])]  # by x, then y (then z)
+        d = self.dim
+        return SurfaceValues(x=rows[:, :d], weight=rows[:, d], gap=rows[:, d + 1],
+                             pressure=rows[:, d + 2], traction=rows[:, d + 3:2 * d + 3],
+                             force=rows[:, 2 * d + 3:])
+
+    @functools.cached_property
+    def _surface_nodal(self) -> NodalValues:
+        """Gap, pressure and (with friction) the traction's components at the slave nodes."""
+        contact = self.contacts[0]
+        traction = contact.traction
+        return contact.nodal_values(
+            [contact.projection.gap, contact.pressure,
+             *([] if traction is None else [traction[k] for k in range(self.dim)])])
+
+    @functools.cached_property
+    def _gap_nodal(self) -> NodalValues:
+        contact = self.contacts[0]
+        return contact.nodal_values([contact.projection.gap])
+
+    def nodal_gap(self) -> np.ndarray:
+        """The gap at each owned node of the first pass's slave surface (0 off it), for the
+        contact's current pairing and mirrors (``update`` them first)."""
+        return self._gap_nodal()[:, 0]
+
+    def contact_edge(self) -> np.ndarray:
+        """Points where the gap changes sign along the slave facets' edges (linear
+        interpolation of the nodal gaps), gathered on every rank: the contact zone's boundary
+        (its two ends in 2D, a ring in 3D), second-order accurate where the gap is smooth."""
+        contact = self.contacts[0]
+        contact.update()
+        gap = fem.Function(contact.nodal_space)
+        owned = self.nodal_gap()
+        gap.x.array[:len(owned)] = owned
+        gap.x.scatter_forward()
+        facets = facet_nodes(self.V, self.geometry.facet_tags, SLAVE, outward=False)
+        edges = np.vstack([facets[:, [i, j]] for i in range(self.dim)
+                           for j in range(i + 1, self.dim)]).reshape(-1, 2)
+        g = gap.x.array[edges]
+        crossing = g[:, 0] * g[:, 1] < 0
+        x = contact.nodal_space.tabulate_dof_coordinates()[:, :self.dim]
+        a, b = edges[crossing, 0], edges[crossing, 1]
+        t = (g[crossing, 0] / (g[crossing, 0] - g[crossing, 1]))[:, None]
+        points = x[a] + t * (x[b] - x[a])
+        return np.vstack(self.comm.allgather(points))
+
+    @functools.cached_property
+    def _force_operators(self) -> list:
+        """The contacts' residuals alone (no Jacobian), for their forces."""
+        return [contact.operator({}) for contact in self.contacts]
+
+    def _contact_force(self) -> np.ndarray:
+        """The contact force of every pass on each node (owned nodes, (n, dim))."""
+        b = dolfinx.fem.petsc.create_vector(self._force_operators[0].F)
+        b.set(0.0)
+        for operator in self._force_operators:
+            operator.add_to_residual(b)
+        force = -b.getArray().reshape(-1, self.dim).copy()
+        b.destroy()
+        return force
+
+    @property
+    def dofs(self) -> int:
+        """Number of displacement unknowns."""
+        index_map = self.V.dofmap.index_map
+        return index_map.size_global * self.V.dofmap.index_map_bs

@@ -1,0 +1,366 @@
+r"""The validation scenes of two-body contact, each against its closed form.
+
+* :class:`Hertz` — an elastic cylinder (2D, plane strain) or sphere (3D, quarter model) pressed
+  on an elastic block: contact half-width/radius and peak pressure against Hertz's
+  (:mod:`~fenicsfriction.studies.contact.closed_forms`), converging as the mesh is refined and
+  as the compliance stiffens (c_n → ∞: the Signorini limit).
+* :class:`Patch` — two blocks with non-matching meshes under a uniform pressure must transmit
+  it uniformly (Taylor & Papadopoulos 1991's contact patch test), one pass or two.
+* :class:`Cattaneo` — the 2D cylinder, then a tangential force rising to Q = q μP in
+  increments (Pop's incremental formulation): the stick zone and the tangential traction
+  against Cattaneo-Mindlin's, with Kalker's sequential ε → 0.
+
+Units are the user's (consistent); the defaults are dimensionless: R = 1, E = 1, and the load
+giving a contact half-width (radius) of R/10.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+import typing
+
+from mpi4py import MPI
+
+import numpy as np
+
+from fenicsfriction.laws import check
+from fenicsfriction.studies.contact import closed_forms, geometry
+from fenicsfriction.studies.contact.model import Material, SurfaceValues, TwoBodyModel
+
+__all__ = ["Cattaneo", "Hertz", "Patch"]
+
+#: the regularisation during Cattaneo's normal loading, relative to the contact half-width
+NORMAL_LOADING_EPS = 1e-2
+
+
+@dataclasses.dataclass
+class _Bodies:
+    """Two elastic bodies and their interface law (shared by the scenes).
+
+    Args:
+        E1, nu1: body 1's (cylinder, sphere, upper block) Young's modulus [force/length²] and
+            Poisson's ratio.
+        E2, nu2: body 2's (the block below).
+        c_n: normal compliance coefficient [force/length^(2+m_n)]; pressure c_n d^m_n.
+        m_n: normal compliance exponent (1: a linear penalty).
+        passes: 1 (body 1's surface is the slave) or 2 (each surface slave in turn).
+    """
+
+    E1: float = 1.0
+    nu1: float = 0.3
+    E2: float = 1.0
+    nu2: float = 0.3
+    c_n: float = 1e4
+    m_n: float = 1.0
+    passes: int = 1
+
+    def __post_init__(self) -> None:
+        self.E_star  # noqa: B018  (validates E1, nu1, E2, nu2, naming each)
+        check("c_n", self.c_n, self.c_n > 0, "the normal compliance coefficient must be > 0")
+        check("m_n", self.m_n, self.m_n >= 1, "the normal exponent must be >= 1")
+        check("passes", self.passes, self.passes in (1, 2), "1 or 2")
+
+    @property
+    def materials(self) -> tuple[Material, Material]:
+        return Material(self.E1, self.nu1), Material(self.E2, self.nu2)
+
+    @property
+    def E_star(self) -> float:
+        """The effective modulus :math:`E^*` (plane strain)."""
+        return closed_forms.effective_modulus(self.E1, self.nu1, self.E2, self.nu2)
+
+
+@dataclasses.dataclass
+class Hertz(_Bodies):
+    """A cylinder (``dim=2``) or sphere (``dim=3``) of radius ``radius`` on a block.
+
+    Args:
+        dim: 2 (plane strain, load per unit length) or 3 (a quarter model, total load).
+        load: P [force/length] in 2D, F [force] in 3D; ``None``: the load giving a = R/10.
+        radius: R [length].
+        refine: the mesh's refinement level (each halves the element size).
+        h_contact: the element size at the contact before refinement (``None``: the
+            geometry's default, R/200 in 2D and R/50 in 3D).
+    """
+
+    dim: int = 2
+    load: float | None = None
+    radius: float = 1.0
+    refine: int = 0
+    h_contact: float | None = None
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check("dim", self.dim, self.dim in (2, 3), "2 or 3")
+        check("radius", self.radius, self.radius > 0, "the radius must be > 0")
+        check("refine", self.refine, isinstance(self.refine, int) and self.refine >= 0,
+              "an integer >= 0")
+        if self.load is None:
+            self.load = closed_forms.hertz_load(self.radius / 10, self.radius, self.E_star,
+                                                self.dim)
+        check("load", self.load, self.load > 0, "the load must be > 0")
+
+    def closed_form(self) -> tuple[float, float]:
+        """Hertz's half-width (2D) or contact radius (3D) and peak pressure."""
+        assert self.load is not None
+        solution = (closed_forms.hertz_line_contact if self.dim == 2
+                    else closed_forms.hertz_point_contact)
+        return solution(self.load, self.radius, self.E_star)
+
+    def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
+        mesh = (geometry.hertz_2d if self.dim == 2 else geometry.hertz_3d)(
+            comm, R=self.radius, refine=self.refine, h_contact=self.h_contact)
+        # the 2D cylinder's sliding is stopped at its loaded face; the quarter sphere's by the
+        # symmetry planes
+        return TwoBodyModel(mesh, self.materials, self.c_n, self.m_n, passes=self.passes,
+                            fix_load_face=self.dim == 2)
+
+    def run(self, comm: MPI.Comm = MPI.COMM_WORLD, model: TwoBodyModel | None = None
+            ) -> tuple[dict, TwoBodyModel]:
+        """Solve and compare; returns the summary (see ``docs/cli.md``) and the model."""
+        t0 = time.perf_counter()
+        model = model or self.build(comm)
+        assert self.load is not None
+        a, p0 = self.closed_form()
+        # the quarter model carries a quarter of the load
+        share = 1.0 if self.dim == 2 else 0.25
+        solved = model.solve_for_load(share * self.load, guess=a**2 / self.radius, rtol=1e-5)
+        edge = model.contact_edge()
+        values = model.surface_values()
+        measured = (np.ptp(edge[:, 0]) / 2 if self.dim == 2
+                    else float(np.mean(np.linalg.norm(edge[:, :2], axis=1))))
+        width = "half_width" if self.dim == 2 else "contact_radius"
+        summary = {
+            "scene": "hertz", "dim": self.dim, "load": solved["load"] / share,
+            "parameters": {"radius": self.radius, "E1": self.E1, "nu1": self.nu1,
+                           "E2": self.E2, "nu2": self.nu2, "c_n": self.c_n, "m_n": self.m_n,
+                           "refine": self.refine, "passes": self.passes,
+                           "h_contact": model.geometry.parameters["h_contact"]},
+            "dofs": model.dofs, "ranks": comm.size,
+            width: measured, f"hertz_{width}": a,
+            "max_pressure": float(values.pressure.max()), "hertz_max_pressure": p0,
+            f"{width}_error": measured / a - 1,
+            "max_pressure_error": float(values.pressure.max()) / p0 - 1,
+            "approach": solved["approach"], "newton_iterations": solved["newton_iterations"],
+            "solves": solved["solves"], "wall_time_s": time.perf_counter() - t0,
+        }
+        return summary, model
+
+
+@dataclasses.dataclass
+class Patch(_Bodies):
+    """Two stacked blocks (non-matching meshes) under a uniform pressure.
+
+    Args:
+        dim: 2 or 3.
+        pressure: the pressure applied (through the platen's approach) [force/length²].
+        n_upper, n_lower: elements across the upper and the lower block (coprime: the
+            interface nodes then coincide only at the ends).
+    """
+
+    dim: int = 2
+    pressure: float = 0.01
+    n_upper: int = 5
+    n_lower: int = 7
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check("dim", self.dim, self.dim in (2, 3), "2 or 3")
+        check("pressure", self.pressure, self.pressure > 0, "the pressure must be > 0")
+        for name in ("n_upper", "n_lower"):
+            value = getattr(self, name)
+            check(name, value, isinstance(value, int) and value >= 1, "an integer >= 1")
+
+    def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
+        mesh = (geometry.patch_2d if self.dim == 2 else geometry.patch_3d)(
+            comm, n_upper=self.n_upper, n_lower=self.n_lower)
+        model = TwoBodyModel(mesh, self.materials, self.c_n, self.m_n, passes=self.passes,
+                             clamp=False)
+        model.rollers(range(self.dim - 1))
+        return model
+
+    def run(self, comm: MPI.Comm = MPI.COMM_WORLD) -> tuple[dict, TwoBodyModel]:
+        """The pressure transmitted at the slave nodes (all passes' forces per tributary
+        length/area) and its largest deviation from the pressure applied."""
+        t0 = time.perf_counter()
+        model = self.build(comm)
+        guess = (self.pressure / self.c_n) ** (1 / self.m_n) + self.pressure / self.E1
+        solved = model.solve_for_load(self.pressure, guess=guess, rtol=1e-10)
+        values = model.surface_values()
+        transmitted = values.force[:, -1]
+        summary = {
+            "scene": "patch", "dim": self.dim, "load": self.pressure,
+            "parameters": {"E1": self.E1, "nu1": self.nu1, "E2": self.E2, "nu2": self.nu2,
+                           "c_n": self.c_n, "m_n": self.m_n, "passes": self.passes,
+                           "n_upper": self.n_upper, "n_lower": self.n_lower},
+            "dofs": model.dofs, "ranks": comm.size,
+            "pressure_deviation": float(np.max(np.abs(transmitted / self.pressure - 1))),
+            "newton_iterations": solved["newton_iterations"],
+            "wall_time_s": time.perf_counter() - t0,
+        }
+        return summary, model
+
+
+@dataclasses.dataclass
+class Cattaneo(Hertz):
+    """The 2D Hertz cylinder with friction, then a tangential force Q rising to ``q_ratio`` μP.
+
+    Args:
+        mu: friction coefficient.
+        q_ratio: Q / (μ P), in [0, 1).
+        increments: load increments of Q (the quasi-static path; the stick zone only shrinks).
+        eps: the regularisation of the slip increment [length] (c1: Pop, eq. 15); a
+            sequence ε_k → 0 is Kalker's sequential process.
+        formulation: ``"compliance"`` (the regularised law) or ``"perturbed-lagrangian"``
+            (Pop, eq. 27: penalties ε_N = ``c_n`` and ε_T = ``eps_T`` [force/length³]).
+    """
+
+    mu: float = 0.3
+    q_ratio: float = 0.5
+    increments: int = 10
+    eps: float = 1e-6
+    formulation: str = "compliance"
+    eps_T: float = 1e4
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check("dim", self.dim, self.dim == 2, "Cattaneo-Mindlin is built in 2D")
+        check("mu", self.mu, self.mu > 0, "the friction coefficient must be > 0")
+        check("q_ratio", self.q_ratio, 0 <= self.q_ratio < 1, "Q/(mu P) in [0, 1)")
+        check("increments", self.increments,
+              isinstance(self.increments, int) and self.increments >= 1, "an integer >= 1")
+        check("eps", self.eps, self.eps > 0, "the regularisation must be > 0")
+
+    def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
+        mesh = geometry.hertz_2d(comm, R=self.radius, refine=self.refine,
+                                 h_contact=self.h_contact)
+        return TwoBodyModel(mesh, self.materials, self.c_n, self.m_n, mu=self.mu,
+                            eps=self.eps, passes=self.passes, formulation=self.formulation,
+                            eps_T=self.eps_T)
+
+    def stick_zone(self, values: SurfaceValues, tol: float = 1e-3) -> tuple[float, float]:
+        """(stick half-width, slip half-width): the extent of the contact nodes whose traction
+        is below the friction bound by more than ``tol`` (stick) and of all contact nodes."""
+        contact = values.pressure > 0
+        utilisation = np.linalg.norm(values.traction, axis=1) / np.where(
+            contact, self.mu * values.pressure, 1.0)
+        stick = contact & (utilisation < 1 - tol)
+        x = values.x[:, 0]
+        return (float(np.ptp(x[stick]) / 2) if stick.any() else 0.0,
+                float(np.ptp(x[contact]) / 2) if contact.any() else 0.0)
+
+    def load_normal(self, comm: MPI.Comm = MPI.COMM_WORLD, model: TwoBodyModel | None = None
+                    ) -> tuple[dict, TwoBodyModel]:
+        """The normal load P alone (:meth:`Hertz.run`), under a wide regularisation: identical
+        bodies (Dundurs' β = 0) do not slip under it (Johnson 1985, chapter 5), and the
+        friction only holds the cylinder's sliding mode. Returns Hertz's summary and the
+        model."""
+        model = model or self.build(comm)
+        a, _ = self.closed_form()
+        model.eps.value = NORMAL_LOADING_EPS * a
+        model.eps_T.value = self.E_star / self.radius  # the perturbed Lagrangian's: a soft spring
+        return Hertz.run(self, comm, model)
+
+    def load_tangential(self, model: TwoBodyModel, eps: float | None = None,
+                        on_increment: typing.Callable[[dict], None] | None = None) -> dict:
+        """Q from 0 to ``q_ratio`` μP in :attr:`increments` steps under the regularisation
+        ``eps`` (default :attr:`eps`), from the model's current (normally loaded) state.
+
+        Returns ``eps``, ``stick_half_width`` (and Cattaneo's), ``traction_error_l2`` (the
+        relative L2 error of the final tangential traction against Cattaneo-Mindlin's),
+        ``newton_iterations`` (all increments) and ``increments`` (one row per increment).
+        """
+        eps = self.eps if eps is None else eps
+        check("eps", eps, eps > 0, "the regularisation must be > 0")
+        assert self.load is not None
+        a, p0 = self.closed_form()
+        model.eps.value = eps
+        model.eps_T.value = self.eps_T
+        rows = []
+        for k in range(1, self.increments + 1):
+            for contact in model.contacts:
+                contact.commit()
+            model.u_old.x.array[:] = model.u.x.array
+            q = self.q_ratio * k / self.increments
+            model.shear.value = np.array([q * self.mu * self.load / (2 * self.radius), 0.0])
+            report = model.solve_at(float(model.approach.value))
+            values = model.surface_values()
+            stick, _ = self.stick_zone(values)
+            row = {"q_ratio": q, "stick_half_width": stick,
+                   "cattaneo_stick_half_width": closed_forms.cattaneo_stick_half_width(a, q),
+                   "newton_iterations": report.iterations}
+            rows.append(row)
+            if on_increment is not None:
+                on_increment(row)
+        values = model.surface_values()
+        exact = closed_forms.cattaneo_traction(values.x[:, 0], a, p0, self.mu, self.q_ratio)
+        # the traction on the cylinder opposes Q: its x component is -q(x)
+        error = float(np.sqrt(np.sum(values.weight * (-values.traction[:, 0] - exact) ** 2)
+                              / np.sum(values.weight * exact**2)))
+        return {"eps": eps, "stick_half_width": rows[-1]["stick_half_width"],
+                "cattaneo_stick_half_width": rows[-1]["cattaneo_stick_half_width"],
+                "traction_error_l2": error,
+                "newton_iterations": sum(r["newton_iterations"] for r in rows),
+                "increments": rows}
+
+    def _summary(self, normal: dict, tangential: dict, t0: float) -> dict:
+        summary = dict(normal)
+        summary.update({
+            "scene": "cattaneo", "q_ratio": self.q_ratio, "mu": self.mu,
+            "formulation": self.formulation, "eps": tangential["eps"],
+            "stick_half_width": tangential["stick_half_width"],
+            "cattaneo_stick_half_width": tangential["cattaneo_stick_half_width"],
+            "traction_error_l2": tangential["traction_error_l2"],
+            "increments": tangential["increments"],
+            "newton_iterations": normal["newton_iterations"] + tangential["newton_iterations"],
+            "wall_time_s": time.perf_counter() - t0})
+        summary["parameters"] = {**normal["parameters"], "mu": self.mu, "eps": self.eps,
+                                 "increments": self.increments,
+                                 "formulation": self.formulation, "eps_T": self.eps_T}
+        return summary
+
+    def run(self, comm: MPI.Comm = MPI.COMM_WORLD, model: TwoBodyModel | None = None,
+            on_increment: typing.Callable[[dict], None] | None = None
+            ) -> tuple[dict, TwoBodyModel]:
+        """Normal load, then Q in increments; the summary adds ``q_ratio``,
+        ``stick_half_width`` (and Cattaneo's), the traction error and one row per
+        increment."""
+        t0 = time.perf_counter()
+        normal, model = self.load_normal(comm, model)
+        tangential = self.load_tangential(model, on_increment=on_increment)
+        return self._summary(normal, tangential, t0), model
+
+    def run_sequence(self, eps_values: typing.Sequence[float], comm: MPI.Comm = MPI.COMM_WORLD,
+                     model: TwoBodyModel | None = None,
+                     on_increment: typing.Callable[[dict], None] | None = None
+                     ) -> tuple[dict, TwoBodyModel]:
+        """Kalker's sequential process: the tangential loading for each ε of ``eps_values``
+        in turn, each from the same normally loaded state (the normal solve is done once; the
+        friction law's history is the loading path, so each ε reruns the whole path, Newton
+        starting every increment from the last increment of the same ε).
+
+        The summary is :meth:`run`'s for the last ε, with ``eps_sequence``: one entry per ε
+        (see :meth:`load_tangential`). ``on_increment`` receives each row with its ``eps``.
+        """
+        check("eps_sequence", list(eps_values), len(eps_values) >= 1, "at least one value")
+        for eps in eps_values:
+            check("eps_sequence", list(eps_values), eps > 0, "every ε must be > 0")
+        t0 = time.perf_counter()
+        normal, model = self.load_normal(comm, model)
+        loaded = model.u.x.array.copy()
+        multipliers = [c.traction_old.x.array.copy() for c in model.contacts]
+        sequence = []
+        for eps in eps_values:
+            model.u.x.array[:] = loaded
+            for contact, values in zip(model.contacts, multipliers, strict=True):
+                contact.traction_old.x.array[:] = values
+            model.shear.value = np.zeros(2)
+            callback = None if on_increment is None else (
+                lambda row, eps=eps: on_increment({"eps": eps, **row}))
+            sequence.append(self.load_tangential(model, eps, on_increment=callback))
+        summary = self._summary(normal, sequence[-1], t0)
+        summary["newton_iterations"] = normal["newton_iterations"] + sum(
+            s["newton_iterations"] for s in sequence)
+        summary["eps_sequence"] = sequence
+        return summary, model
