@@ -42,7 +42,7 @@ demo: setup
 	FENICSFRICTION_DEMO_OUT=$(OUT)/slider $(MPIRUN) $(PY) demos/demo_slider_table2.py
 	FENICSFRICTION_DEMO_OUT=$(OUT)/two_body_contact $(MPIRUN) $(PY) demos/demo_two_body_contact.py
 	FENICSFRICTION_DEMO_OUT=$(OUT)/rolling_contact $(MPIRUN) $(PY) demos/demo_rolling_contact.py
-	FENICSFRICTION_DEMO_OUT=$(OUT)/interface $(MPIRUN) $(PY) demos/demo_interface.py
+	FENICSFRICTION_DEMO_OUT=$(OUT)/multicontact $(MPIRUN) $(PY) demos/demo_multicontact.py
 	$(PY) -m fenicsfriction rolling curve --method fastsim --xi-range 0:3e-3:31 --a 6.304e-3 \
 	    --b 12.61e-3 --G 82e9 --nu 0.28 --mu 0.3 --Fn 106.7e3 --out $(OUT)/rolling-fastsim
 
@@ -78,7 +78,7 @@ benchmark: setup
 	$(PY) benchmarks/bench_rolling_fe.py --out $(OUT)/benchmarks
 	$(PY) benchmarks/bench_rolling_methods.py --out $(OUT)/benchmarks
 	$(PY) benchmarks/bench_panagiotopoulos.py --out $(OUT)/benchmarks
-	$(PY) benchmarks/bench_interface.py --out $(OUT)/benchmarks
+	$(PY) benchmarks/bench_multicontact.py --out $(OUT)/benchmarks
 	$(PY) benchmarks/bench_interaction.py --out $(OUT)/benchmarks
 	$(PY) benchmarks/bench_slider.py --out $(OUT)/benchmarks
 

@@ -26,14 +26,14 @@ from _common import parser as benchmark_parser
 from _common import save
 
 from fenicsfriction.results import write_summary
-from fenicsfriction.studies.multicontact import InterfaceSlider, InterfaceSliderModel
+from fenicsfriction.studies.multicontact import ElasticSlider, ElasticSliderModel
 
 T_END = 4e-3
 
 
 def run(nx: int, ny: int, dt: float, comm: MPI.Comm) -> dict:
-    scene = InterfaceSlider(nx=nx, ny=ny, spread=0.05, delay=1e-4, push_speed=1e-3, seed=3)
-    model = InterfaceSliderModel(scene, comm)
+    scene = ElasticSlider(nx=nx, ny=ny, spread=0.05, delay=1e-4, push_speed=1e-3, seed=3)
+    model = ElasticSliderModel(scene, comm)
     t0 = time.perf_counter()
     history = model.run(T_END, dt)
     seconds = time.perf_counter() - t0

@@ -77,7 +77,7 @@ def test_fk_front_runs_near_the_continuum_travelling_wave(shared_tmp_path):
                  "--t-end", "30", "--out", str(out)]) == 0
     summary = _json(out)
     # g = 100: the chain's front is within 1-2 % of the continuum's away from f_min, f_max
-    # (docs/interface-fk.md); 5 % here
+    # (docs/multicontact-fk.md); 5 % here
     assert summary["front_speed"] == pytest.approx(summary["continuum_front_speed"], rel=0.05)
     assert summary["energy_residual"] < 1e-5 * 120
     for name in ("fk.csv", "fk.png"):
@@ -91,7 +91,7 @@ def test_interaction_response_falls_like_r_minus_3_beyond_the_correlation_length
                  "--out", str(out)]) == 0
     summary = _json(out)
     # beyond λ_c the broken contact's dipole is unscreened: δf ∝ r^-3 (Braun (slides));
-    # the fit over r in (3 λ_c, n/4) measures -2.9 on 512² lattices (docs/interface-interaction.md)
+    # the fit over r in (3 λ_c, n/4) measures -2.9 on 512² lattices (docs/multicontact-interaction.md)
     assert summary["far_exponent"] == pytest.approx(-3.0, abs=0.35)
     assert (out / "interaction.png").stat().st_size > 0
 

@@ -18,12 +18,12 @@ import pytest
 import ufl
 
 from fenicsfriction.io import FieldWriter
-from fenicsfriction.studies.multicontact import InterfaceSlider, InterfaceSliderModel
+from fenicsfriction.studies.multicontact import ElasticSlider, ElasticSliderModel
 
 #: a slider whose contacts break one after the other from the pushed edge: thresholds within
 #: ±5 %, so the stretch (decaying from the edge over sqrt(E H / k) = 6 node spacings) decides
 #: the order; a broken contact stays off for 0.1 ms, shedding its load to its neighbours
-PUSHED = InterfaceSlider(nx=20, ny=2, push_speed=2e-3, spread=0.05, delay=1e-4, seed=3)
+PUSHED = ElasticSlider(nx=20, ny=2, push_speed=2e-3, spread=0.05, delay=1e-4, seed=3)
 
 
 def _settle_crossing(times: np.ndarray, values: np.ndarray) -> float:
@@ -35,8 +35,8 @@ def _settle_crossing(times: np.ndarray, values: np.ndarray) -> float:
 def test_unbreakable_stiff_slider_oscillates_as_a_rigid_block_on_its_springs():
     # E H / k = 1e3 m², screening length 32 m >> L: the slider moves as a rigid block of mass
     # rho H per unit length on springs k per unit length, omega^2 = k / (rho H)
-    scene = InterfaceSlider(nx=10, ny=2, E=1e11, k=1e8, threshold=np.inf, k_push=0.0)
-    model = InterfaceSliderModel(scene, MPI.COMM_WORLD)
+    scene = ElasticSlider(nx=10, ny=2, E=1e11, k=1e8, threshold=np.inf, k_push=0.0)
+    model = ElasticSliderModel(scene, MPI.COMM_WORLD)
     period = 2 * np.pi / np.sqrt(scene.k / (scene.rho * scene.H))
     model.residual.u_dot.x.array[0::2] = 1e-3
 
@@ -54,8 +54,8 @@ def test_unbreakable_stiff_slider_oscillates_as_a_rigid_block_on_its_springs():
 
 @pytest.mark.parametrize("delay", [0.0, 2e-5])
 def test_energy_lost_equals_the_spring_energy_the_breaks_released(delay):
-    scene = InterfaceSlider(nx=10, ny=2, k_push=0.0, threshold=1e-6, spread=0.5, delay=delay)
-    model = InterfaceSliderModel(scene, MPI.COMM_WORLD)
+    scene = ElasticSlider(nx=10, ny=2, k_push=0.0, threshold=1e-6, spread=0.5, delay=delay)
+    model = ElasticSliderModel(scene, MPI.COMM_WORLD)
     model.residual.u_dot.x.array[0::2] = 0.1  # a slider thrown along its base
     initial = sum(model.energies().values())
 
@@ -76,7 +76,7 @@ def test_energy_lost_equals_the_spring_energy_the_breaks_released(delay):
 
 
 def test_momentum_changes_by_the_impulse_of_the_contacts_and_the_pusher():
-    model = InterfaceSliderModel(PUSHED, MPI.COMM_WORLD)
+    model = ElasticSliderModel(PUSHED, MPI.COMM_WORLD)
 
     def forces(t: float) -> dict:
         model.time.value = t
@@ -97,10 +97,10 @@ def test_momentum_changes_by_the_impulse_of_the_contacts_and_the_pusher():
             impulse, rel=1e-8, abs=1e-10 * PUSHED.rho * PUSHED.L * PUSHED.H * 1e-3)
 
 
-def _quasi_static_first_break_force(scene: InterfaceSlider) -> float:
+def _quasi_static_first_break_force(scene: ElasticSlider) -> float:
     """Pusher force when the edge contact (x = 0) reaches its threshold under a quasi-static
     push: the static elastic problem (all contacts intact) solved once, scaled linearly."""
-    model = InterfaceSliderModel(scene, MPI.COMM_WORLD)
+    model = ElasticSliderModel(scene, MPI.COMM_WORLD)
     model.time.value = 1.0
     R = model.residual
     steady = R.steady()
@@ -115,7 +115,7 @@ def _quasi_static_first_break_force(scene: InterfaceSlider) -> float:
 
 
 def test_fronts_start_at_the_pushed_edge_and_advance_contact_by_contact():
-    model = InterfaceSliderModel(PUSHED, MPI.COMM_WORLD)
+    model = ElasticSliderModel(PUSHED, MPI.COMM_WORLD)
     history = model.run(t_end=2.2e-3, dt=2e-6)
     first = history.breaks[0]
     assert first.x == 0.0
@@ -139,7 +139,7 @@ def test_fronts_start_at_the_pushed_edge_and_advance_contact_by_contact():
 
 @pytest.mark.mpi(min_size=2)
 def test_front_history_is_the_same_on_one_and_on_all_ranks(shared_tmp_path):
-    models = [InterfaceSliderModel(PUSHED, comm) for comm in (MPI.COMM_WORLD, MPI.COMM_SELF)]
+    models = [ElasticSliderModel(PUSHED, comm) for comm in (MPI.COMM_WORLD, MPI.COMM_SELF)]
     with FieldWriter(shared_tmp_path / "fields.xdmf", models[0]) as fields:
         world = models[0].run(t_end=1.5e-3, dt=2e-6,
                               on_step=lambda r: fields.write(r["time"]) if r["time"] > 1.4e-3
@@ -161,4 +161,4 @@ def test_front_history_is_the_same_on_one_and_on_all_ranks(shared_tmp_path):
                                              ("delay", -1.0)])
 def test_bad_scene_parameter_is_named(name, value):
     with pytest.raises(ValueError, match=name):
-        InterfaceSlider(**{name: value})
+        ElasticSlider(**{name: value})

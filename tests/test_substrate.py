@@ -38,7 +38,7 @@ def test_break_response_matches_the_green_tensor_in_the_near_zone():
     What remains is the P1 error at 4-6 cells from a point force, ~(h/r)² ≈ 10% (measured
     2-10% on this mesh; grading keeps h/r fixed under refinement), hence rtol = 0.15. The
     normal-tangential coupling is left out: the block's tilt under a tangential force changes it
-    by 30-70% at these distances (see docs/interface-interaction.md).
+    by 30-70% at these distances (see docs/multicontact-interaction.md).
     """
     positions, _ = _contacts()
     k = 1e-4

@@ -338,13 +338,13 @@ def _run_fk(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> in
 
 def _run_slider(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
     from fenicsfriction.io import FieldWriter
-    from fenicsfriction.studies.multicontact import InterfaceSlider, InterfaceSliderModel
+    from fenicsfriction.studies.multicontact import ElasticSlider, ElasticSliderModel
 
     names = ("L", "H", "nx", "ny", "E", "nu", "rho", "k", "threshold", "spread", "delay",
              "push_speed", "seed")
-    scene = InterfaceSlider(**{n: getattr(args, n) for n in names if getattr(args, n) is not None})
+    scene = ElasticSlider(**{n: getattr(args, n) for n in names if getattr(args, n) is not None})
     out = output_folder(args.out, comm)
-    model = InterfaceSliderModel(scene, comm)
+    model = ElasticSliderModel(scene, comm)
     log.info(f"slider: {scene.nx} x {scene.ny} cells, {scene.nx + 1} EQ contacts on the base, "
              f"pushed at {scene.push_speed:g}; t_end = {args.t_end:g}, dt = {args.dt:g}")
     steps = {"n": 0}

@@ -31,7 +31,7 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "green_tensor": "interaction", "correlation_length": "interaction",
     "fit_power_laws": "interaction", "radial_profile": "interaction",
     "ElasticSubstrate": "substrate", "SubstrateBlock": "substrate",
-    "InterfaceSlider": "slider", "InterfaceSliderModel": "slider", "SliderHistory": "slider",
+    "ElasticSlider": "slider", "ElasticSliderModel": "slider", "SliderHistory": "slider",
     "Break": "slider", "Front": "slider", "fronts": "slider"})
 
 if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers
@@ -75,8 +75,8 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers
     from fenicsfriction.studies.multicontact.slider import (
         Break,
         Front,
-        InterfaceSlider,
-        InterfaceSliderModel,
+        ElasticSlider,
+        ElasticSliderModel,
         SliderHistory,
         fronts,
     )

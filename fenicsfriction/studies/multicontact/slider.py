@@ -7,7 +7,7 @@ from static to kinetic friction", and pushed at its trailing (left) edge; the on
 is a sequence of detachment fronts, as measured by Rubinstein, Cohen & Fineberg (2004),
 "Detachment fronts and the onset of dynamic friction".
 
-The finite element model (:class:`InterfaceSliderModel`) is the package's one residual
+The finite element model (:class:`ElasticSliderModel`) is the package's one residual
 (:mod:`fenicsfriction.forms`) integrated by :class:`~fenicsfriction.dynamics.DynamicsSolver`
 (generalized-α, TSALPHA2):
 
@@ -59,14 +59,14 @@ from fenicsfriction.forms import Residual, elasticity, inertia
 from fenicsfriction.laws import check, check_positive
 from fenicsfriction.results import CsvRows, Record, write_json
 
-__all__ = ["BASE", "LEFT", "Break", "Front", "InterfaceSlider", "InterfaceSliderModel",
+__all__ = ["BASE", "LEFT", "Break", "Front", "ElasticSlider", "ElasticSliderModel",
            "SliderHistory", "fronts"]
 
 BASE, LEFT = 1, 2  # facet tags
 
 
 @dataclasses.dataclass(frozen=True)
-class InterfaceSlider:
+class ElasticSlider:
     """The slider, its EQ contacts and the pusher (SI units; forces per unit breadth in 2D).
 
     Attributes:
@@ -219,7 +219,7 @@ class _TimedSolver(DynamicsSolver):
     """The dynamics solver with the model's clock set at each residual (the pusher's stage
     moves within a step)."""
 
-    def __init__(self, model: InterfaceSliderModel, **kwargs: typing.Any):
+    def __init__(self, model: ElasticSliderModel, **kwargs: typing.Any):
         self.model = model
         super().__init__(model.residual, **kwargs)
 
@@ -228,7 +228,7 @@ class _TimedSolver(DynamicsSolver):
         super()._F(ts, t, x, xdot, xddot, F)
 
 
-class InterfaceSliderModel:
+class ElasticSliderModel:
     """The slider as a finite element model, its EQ contacts and their breaking.
 
     Attributes:
@@ -245,7 +245,7 @@ class InterfaceSliderModel:
 
     CONTACT = BASE
 
-    def __init__(self, scene: InterfaceSlider, comm: MPI.Comm = MPI.COMM_WORLD):
+    def __init__(self, scene: ElasticSlider, comm: MPI.Comm = MPI.COMM_WORLD):
         self.scene = s = scene
         msh = _compat.create_rectangle(comm, (0.0, 0.0), (s.L, s.H), (s.nx, s.ny))
         self.msh = msh

@@ -27,10 +27,10 @@
 # $$ \frac{\partial Q}{\partial X} + \frac{\partial Q}{\partial x} + P(x)Q
 #    = R(x)\int P(\xi)Q(\xi; X)\,d\xi, \qquad P(x) = \frac{P_c(x)}{\int_x^\infty P_c}, $$
 #
-# and $F(X) = N k \int x Q\,dx$. See `docs/interface.md`.
+# and $F(X) = N k \int x Q\,dx$. See `docs/multicontact.md`.
 #
 # Figures go to `FENICSFRICTION_DEMO_OUT` (default `results/interface`). Run it serially or in
-# parallel: `mpirun -n 2 python3 demos/demo_interface.py` (the reduced models run on each rank
+# parallel: `mpirun -n 2 python3 demos/demo_multicontact.py` (the reduced models run on each rank
 # alike; the finite element slider is distributed).
 
 # %%
@@ -47,8 +47,8 @@ from fenicsfriction.studies.multicontact import (
     EQModel,
     FKChain,
     InteractingEQModel,
-    InterfaceSlider,
-    InterfaceSliderModel,
+    ElasticSlider,
+    ElasticSliderModel,
     LatticeInteraction,
     MasterEquation,
     coupling_map,
@@ -168,7 +168,7 @@ r, df = radial_profile(lattice.positions, lattice.break_response((1.0, 0.0, 0.0)
                        centre, edges=np.geomspace(1.0, n / 4, 24))
 laws = fit_power_laws(r, df, near_limit=2.0, far_limit=3 * lam)
 say(f"interaction, λ_c = {lam:g} a: δf ∝ r^{laws.far_exponent:.2f} beyond 3 λ_c "
-    f"(near zone: see docs/interface-interaction.md, −1.05 at λ_c = 256 a)")
+    f"(near zone: see docs/multicontact-interaction.md, −1.05 at λ_c = 256 a)")
 if comm.rank == 0:
     fig, ax = plt.subplots(figsize=(5.5, 3.8))
     ax.loglog(r, df, "o", ms=3, label="|δf(r)|")
@@ -263,7 +263,7 @@ say(f"with ±20 % threshold spread at f = 0.85 the front breaks "
 
 # %% [markdown]
 # **Checks.** At g = 100 the discrete front is within 1-2 % of the continuum wave away from
-# $f_{min}$, $f_{max}$ (`docs/interface-fk.md`; 3 % asserted); the work of f is the stored,
+# $f_{min}$, $f_{max}$ (`docs/multicontact-fk.md`; 3 % asserted); the work of f is the stored,
 # dissipated and broken-contact energy to the integrator's tolerance; the defects pin the
 # front.
 
@@ -281,8 +281,8 @@ assert np.isfinite(pinned.break_time).sum() < chain.n
 # 2009). The furthest contact broken so far is the front.
 
 # %%
-slider = InterfaceSlider(nx=20, ny=2, spread=0.05, delay=1e-4, push_speed=1e-3, seed=3)
-history = InterfaceSliderModel(slider, comm).run(t_end=4e-3, dt=2e-6)
+slider = ElasticSlider(nx=20, ny=2, spread=0.05, delay=1e-4, push_speed=1e-3, seed=3)
+history = ElasticSliderModel(slider, comm).run(t_end=4e-3, dt=2e-6)
 arrested = [f for f in history.fronts if f.arrested]
 say(f"slider: first break at {history.breaks[0].time * 1e3:.3f} ms, x = "
     f"{history.breaks[0].x:.3g} m; {len(arrested)} arrested fronts (precursors); the front "

@@ -19,7 +19,7 @@ bodies (coupling k/(E a) = 0.1, σ = 0.3 x_c) moved quasistatically over four co
 n = 8 … 24: the set-up (the dense stiffness matrix, O(N³)), the run, the time per break, and
 the ratio of the run to the plain model's over the same lives (the baseline, same process).
 
-Writes ``bench_interface.json`` and ``bench_interface.png`` to ``--out`` and prints markdown
+Writes ``bench_multicontact.json`` and ``bench_multicontact.png`` to ``--out`` and prints markdown
 tables. Serial (vectorised NumPy and a two-unknown TS).
 """
 
@@ -140,7 +140,7 @@ def main() -> None:
     _noise(out)
     result = _map(out)
     _interacting(out)
-    write_summary(args.out / "bench_interface.json", out)
+    write_summary(args.out / "bench_multicontact.json", out)
 
     import matplotlib
     matplotlib.use("Agg")
@@ -166,7 +166,7 @@ def main() -> None:
     ax2.set_xlabel("K / (N k)")
     ax2.set_ylabel("σ / x_c")
     ax2.legend()
-    save(fig, args.out / "bench_interface.png", dpi=120)
+    save(fig, args.out / "bench_multicontact.png", dpi=120)
 
 
 if __name__ == "__main__":
