@@ -44,11 +44,11 @@ import numpy as np
 
 import fenicsfriction as ff
 from fenicsfriction.studies.multicontact import (
+    ElasticSlider,
+    ElasticSliderModel,
     EQModel,
     FKChain,
     InteractingEQModel,
-    ElasticSlider,
-    ElasticSliderModel,
     LatticeInteraction,
     MasterEquation,
     coupling_map,

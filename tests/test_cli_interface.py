@@ -91,7 +91,8 @@ def test_interaction_response_falls_like_r_minus_3_beyond_the_correlation_length
                  "--out", str(out)]) == 0
     summary = _json(out)
     # beyond λ_c the broken contact's dipole is unscreened: δf ∝ r^-3 (Braun (slides));
-    # the fit over r in (3 λ_c, n/4) measures -2.9 on 512² lattices (docs/multicontact-interaction.md)
+    # the fit over r in (3 λ_c, n/4) measures -2.9 on 512² lattices
+    # (docs/multicontact-interaction.md)
     assert summary["far_exponent"] == pytest.approx(-3.0, abs=0.35)
     assert (out / "interaction.png").stat().st_size > 0
 

@@ -74,9 +74,9 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers
     )
     from fenicsfriction.studies.multicontact.slider import (
         Break,
-        Front,
         ElasticSlider,
         ElasticSliderModel,
+        Front,
         SliderHistory,
         fronts,
     )
