@@ -89,11 +89,7 @@ _SAME_INSTANT = 1e-9
 
 
 class HybridSystem(typing.Protocol):
-    """A piecewise-smooth first-order system ``dy/dt = rhs(t, y, mode)``.
-
-    Attributes:
-        size: the size of the state y.
-    """
+    """A piecewise-smooth first-order system ``dy/dt = rhs(t, y, mode)``."""
 
     @property
     def size(self) -> int:
