@@ -68,7 +68,7 @@ def demo_page(script: pathlib.Path) -> str:
         if "[markdown]" in marker:
             parts.append("\n".join(re.sub(r"^# ?", "", line) for line in body.strip().splitlines()))
         elif body.strip():
-            parts.append(f"```python\n{body.strip()}\n```")
+            parts.append(f"````python\n{body.strip()}\n````")  # a cell may hold ```
     source = script.relative_to(ROOT).as_posix()
     parts.insert(1, f"*This page is the script `{source}`: run it with `python3 {source}` or "
                     f"`mpirun -n 2 python3 {source}`.*")
