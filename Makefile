@@ -11,7 +11,7 @@ APT_PACKAGES := python3-dolfinx python3-petsc4py python3-slepc4py python3-mpi4py
     python3-basix python3-ffcx python3-numpy python3-scipy python3-matplotlib python3-pytest \
     python3-pytest-mpi python3-pytest-timeout python3-venv python3-pip python3-setuptools \
     python3-wheel python3-dev openmpi-bin build-essential pkg-config libopenblas0-serial \
-    python3-gmsh
+    python3-gmsh python3-sphinx python3-myst-parser python3-sphinxcontrib.bibtex
 # the peer library of benchmarks/bench_getfem.py, installed by `make benchmark` only
 BENCH_PACKAGES := python3-getfem
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
@@ -19,7 +19,7 @@ MPIRUN := mpirun -n $(NP) $(shell [ "$$(id -u)" = 0 ] && echo --allow-run-as-roo
 export OMPI_MCA_rmaps_base_oversubscribe := 1
 export PYTHONDONTWRITEBYTECODE := 1
 
-.PHONY: setup demo lint test test-serial test-mpi test-debian13 benchmark clean
+.PHONY: setup demo lint docs test test-serial test-mpi test-debian13 benchmark clean
 
 $(VENV)/.installed: pyproject.toml
 	@missing=$$(for p in $(APT_PACKAGES); do dpkg-query -W -f='$${Status}' $$p 2>/dev/null \
@@ -56,7 +56,11 @@ test-serial: setup
 test-mpi: setup
 	$(MPIRUN) $(PY) -m mpi4py -m pytest -q --with-mpi tests
 
-test: lint test-serial test-mpi
+# the HTML documentation (Sphinx + MyST, Debian's packages, nothing downloaded), warnings as errors
+docs: setup
+	$(PY) -m sphinx -W --keep-going -q -b html -d build/docs/doctrees docs build/docs/html
+
+test: lint docs test-serial test-mpi
 
 # the same `make test` on Debian 13's FEniCSx (dolfinx 0.9), in a debootstrap chroot (.debian13/)
 test-debian13:

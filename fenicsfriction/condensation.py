@@ -288,7 +288,7 @@ class InterfaceCondensation:
 def condensation_for(split: tuple[ufl.Form, list], V: fem.FunctionSpace, prefix: str = "",
                      max_interface: int = 6000) -> InterfaceCondensation | None:
     """The condensation of a Jacobian split by :func:`interface_split`, or ``None`` where Γ has
-    more than ``max_interface`` dofs, beyond which the dense |Γ|² work outweighs a sparse
+    more than ``max_interface`` dofs, beyond which the dense ``|Γ|²`` work outweighs a sparse
     factorisation."""
     interface = _interface_dofs(V, split[1])
     comm = V.mesh.comm

@@ -221,7 +221,7 @@ class CentralDifference:
     ``safety`` times that bound. Tensor-product Lagrange elements have positive row sums.
 
     Friction is explicit too: inside the regularisation band a sticking node feels a dashpot
-    :math:`c_i = c_T d_i^{m_T} A_i/\varepsilon`, stable only for
+    :math:`c_i = c_T d_i^{m_T} A_i/\\varepsilon`, stable only for
     :math:`\\Delta t < 2 m_i / c_i` — with a small ε far below :math:`2/\\omega_{max}`. Given
     ``band_damping`` (a linear form whose assembled vector holds the :math:`c_i`, e.g.
     ``BlockModel.band_damping()``) the cap also includes :math:`\\min_i 2 m_i/(\\kappa c_i)`,

@@ -55,6 +55,8 @@ from fenicsfriction.timestepping import DynamicsError
 __all__ = ["DEFAULT_OPTIONS", "HybridError", "HybridEvent", "HybridResult", "HybridSystem",
            "Observer", "integrate_hybrid"]
 
+#: PETSc options of the hybrid integration (adaptive Dormand-Prince RK5(4), events located to
+#: ``ts_event_tol``), under the prefix; options in the database win.
 DEFAULT_OPTIONS = {
     "ts_type": "rk",
     "ts_rk_type": "5dp",
@@ -89,11 +91,7 @@ _SAME_INSTANT = 1e-9
 
 
 class HybridSystem(typing.Protocol):
-    """A piecewise-smooth first-order system ``dy/dt = rhs(t, y, mode)``.
-
-    Attributes:
-        size: the size of the state y.
-    """
+    """A piecewise-smooth first-order system ``dy/dt = rhs(t, y, mode)``."""
 
     @property
     def size(self) -> int:

@@ -376,6 +376,7 @@ class EllipticSlipRule:
         return -bound * _vector(direction, self.frame)
 
 
+#: Either slip rule (the type of ``slip_rule`` arguments; ``None`` is Coulomb's isotropic law).
 SlipRule = CoulombSlipRule | EllipticSlipRule
 SLIP_RULES = (CoulombSlipRule, EllipticSlipRule)
 """The slip rules :func:`friction_traction` takes."""

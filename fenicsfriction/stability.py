@@ -80,7 +80,7 @@ class Mode:
 
 
 def mac(a: np.ndarray, b: np.ndarray, comm: MPI.Comm) -> float:
-    """Modal assurance criterion |a^H b|² / ((a^H a)(b^H b)) of distributed complex vectors."""
+    """Modal assurance criterion ``|a^H b|² / ((a^H a)(b^H b))`` of distributed complex vectors."""
     ab, aa, bb = comm.allreduce(np.array([np.vdot(a, b), np.vdot(a, a), np.vdot(b, b)]))
     return float(abs(ab) ** 2 / (aa.real * bb.real))
 

@@ -30,6 +30,8 @@ __all__ = ["DEFAULT_OPTIONS", "Alpha2Integrator", "DynamicsError", "ReducedDynam
 ArrayLike: typing.TypeAlias = typing.Any  # an array of floats, or a float for one d.o.f.
 
 
+#: PETSc options of the TS (generalized-α, fixed steps, Newton with LU), under the solver's
+#: prefix; options in the database win.
 DEFAULT_OPTIONS = {
     "ts_type": "alpha2",
     "ts_alpha_radius": 1.0,

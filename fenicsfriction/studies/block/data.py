@@ -56,6 +56,7 @@ if typing.TYPE_CHECKING:
 
 __all__ = ["CONTACT", "LEFT", "QUADRATURE", "RIGHT", "TOP", "BlockData", "BlockOnBelt"]
 
+#: facet tags of the block's mesh: the base on the belt (Γ_C), the top and the two sides
 CONTACT, TOP, LEFT, RIGHT = 1, 2, 3, 4
 
 
@@ -78,6 +79,7 @@ def _nodal(degree: int) -> tuple[np.ndarray, dict]:
     return np.array([0.0, 1.0]), {}
 
 
+#: the contact rules of ``BlockData.contact_quadrature``: name -> (points on [0, 1], UFL metadata)
 QUADRATURE = {"gauss": _gauss, "gll": _gll, "nodal": _nodal}
 
 

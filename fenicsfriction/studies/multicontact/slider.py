@@ -62,7 +62,8 @@ from fenicsfriction.results import CsvRows, Record, write_json
 __all__ = ["BASE", "LEFT", "Break", "Front", "ElasticSlider", "ElasticSliderModel",
            "SliderHistory", "fronts"]
 
-BASE, LEFT = 1, 2  # facet tags
+#: facet tags of the slider's mesh: the base on the contacts and the left side
+BASE, LEFT = 1, 2
 
 
 @dataclasses.dataclass(frozen=True)

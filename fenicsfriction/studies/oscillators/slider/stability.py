@@ -296,7 +296,7 @@ def stroboscopic_growth(t: np.ndarray, y: np.ndarray, period: float,
     """Growth rate of a time response away from its periodic solution.
 
     From the samples at the multiples of ``period``: d_k = |y(kT) − y((k−1)T)| grows like
-    |ρ|^k for the largest Floquet multiplier ρ, whatever the (unknown) periodic solution.
+    ``|ρ|^k`` for the largest Floquet multiplier ρ, whatever the (unknown) periodic solution.
 
     Args:
         t: recorded times (with the multiples of ``period`` among them, e.g. ``sample_dt``
