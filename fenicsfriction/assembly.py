@@ -55,7 +55,7 @@ def assemble_residual(b: PETSc.Vec, L: fem.FormMetaClass, a: fem.FormMetaClass, 
 
     ``x`` must already hold the state the coefficients of ``L`` see (ghosts updated).
     ``couplings`` are compiled terms that are not integrals of ``L`` (two-body contact,
-    :class:`fenicsfriction.contact.ContactOperator`): each adds its part with
+    :class:`~fenicsfriction.coupling.CouplingOperator`): each adds its part with
     ``add_to_residual(b)``.
     """
     with b.localForm() as b_local:

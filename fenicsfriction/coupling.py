@@ -60,8 +60,9 @@ class Coupling(typing.Protocol):
             solve (:class:`~fenicsfriction.steady.SteadySolver`) and each time step
             (:class:`~fenicsfriction.dynamics.DynamicsSolver`,
             :class:`~fenicsfriction.dynamics.CentralDifference`).
-        m_n: the exponent of its normal compliance; :class:`CentralDifference` bounds the
-            stable step of springs that close later (:meth:`frequency_bound`) only when it is 1.
+        m_n: the exponent of its normal compliance;
+            :class:`~fenicsfriction.dynamics.CentralDifference` bounds the stable step of
+            springs that close later (:meth:`frequency_bound`) only when it is 1.
     """
 
     search_pending: bool

@@ -201,8 +201,8 @@ class CentralDifference:
     with the velocity-dependent forces (friction, damping) evaluated at the predicted
     :math:`\\tilde v_n = v_{n-1/2} + \\tfrac{\\Delta t}{2} a_{n-1}`. The scheme is stable for
     :math:`\\Delta t < 2/\\omega_{max}`, :math:`\\omega_{max}^2` the largest eigenvalue of
-    :math:`\\bar K w = \\omega^2 M_L w` (SLEPc EPS, at the initial state); steps are capped at
-    ``safety`` times that bound. Tensor-product Lagrange elements have positive row sums.
+    :math:`\\bar K w = \\omega^2 M_L w` (a SLEPc eigensolver, at the initial state); steps are
+    capped at ``safety`` times that bound. Tensor-product Lagrange elements have positive row sums.
 
     Friction is explicit too: inside the regularisation band a sticking node feels a dashpot
     :math:`c_i = c_T d_i^{m_T} A_i/\varepsilon`, stable only for
