@@ -11,8 +11,8 @@ with the state:
     J(u) = \begin{pmatrix} K_{II} & K_{I\Gamma} \\ K_{\Gamma I} & J_{\Gamma\Gamma}(u)
     \end{pmatrix},
 
-whether an integral's Jacobian is constant being decided symbolically, by differentiating it
-once more (:func:`interface_split`). The Schur complement of the bulk,
+whether an integral's Jacobian is constant being decided symbolically: ``u`` does not enter it
+(:func:`interface_split`). The Schur complement of the bulk,
 :math:`C = K_{\Gamma I} K_{II}^{-1} K_{I\Gamma}` (|Γ| × |Γ|, dense), is formed once, and each
 Newton system is the bulk's solve with :math:`J_{\Gamma\Gamma}(u) - C` on the interface:
 
@@ -55,6 +55,7 @@ import ufl
 from dolfinx import fem, mesh
 
 from fenicsfriction import mumps_schur
+from fenicsfriction.assembly import split_constant
 from fenicsfriction.reused_lu import factorise_and_keep, lu_solver
 
 __all__ = ["InterfaceCondensation", "condensation_for", "interface_split"]
@@ -70,22 +71,16 @@ def interface_split(jacobian: ufl.Form, u: fem.Function
                     ) -> tuple[ufl.Form, list[ufl.classes.Integral]] | None:
     """``(K0 form, nonlinear integrals)`` of a Jacobian, or ``None`` if it does not split.
 
-    An integral belongs to K0 when its derivative with respect to ``u`` vanishes identically.
+    K0 holds the integrals ``u`` does not enter (:func:`fenicsfriction.assembly.split_constant`).
     The split is usable when every other integral is an exterior-facet integral over tagged
     facets (or all exterior facets), so that B(u) lives on their dofs only.
     """
-    constant: list = []
-    varying: list = []
-    for integral in jacobian.integrals():
-        form = ufl.Form([integral])
-        again = ufl.algorithms.expand_derivatives(ufl.derivative(form, u))
-        (constant if again.empty() else varying).append(integral)
-    if not constant or not varying:
+    constant, varying = split_constant(jacobian, [u])
+    if constant is None or not varying:
         return None
     if any(i.integral_type() != "exterior_facet" for i in varying):
         return None
-    # expanded, so that u (inside the derivative nodes) no longer appears in the bulk's inputs
-    return ufl.algorithms.expand_derivatives(ufl.Form(constant)), varying
+    return constant, varying
 
 
 def _interface_dofs(V: fem.FunctionSpace, integrals: list) -> np.ndarray:

@@ -36,7 +36,14 @@ import ufl
 from dolfinx import fem
 
 from fenicsfriction import _compat
-from fenicsfriction.assembly import CoupledMatrix, assemble_jacobian, assemble_residual
+from fenicsfriction.assembly import (
+    BulkWatcher,
+    CoupledMatrix,
+    assemble_jacobian,
+    assemble_residual,
+    split_constant,
+)
+from fenicsfriction.coupling import CouplingOperator
 from fenicsfriction.forms import Residual
 from fenicsfriction.laws import check
 from fenicsfriction.timestepping import DEFAULT_OPTIONS, Alpha2Integrator, DynamicsError
@@ -72,7 +79,7 @@ class DynamicsSolver(Alpha2Integrator):
             part = residual.derivative(R, field)
             if field is not residual.u and not part.empty():
                 jacobian = jacobian + shift * part
-            constant, other = _split_constant(part)
+            constant, other = split_constant(part, part.coefficients())
             fixed.append(constant)
             varying += [i if shift is None else i.reconstruct(integrand=shift * i.integrand())
                         for i in other]
@@ -88,8 +95,9 @@ class DynamicsSolver(Alpha2Integrator):
                           else _compat.form(ufl.Form(varying)) if varying else None)
         # contact couplings: residual and shifted Jacobian of their own, added to a matrix
         # apart from the one dolfinx assembles into (their pattern follows the pairing)
-        self.couplings = [c.operator({residual.u: 1.0, residual.u_dot: self.shift_v})
-                          for c in residual.couplings]
+        self.couplings: list[CouplingOperator] = [
+            c.operator({residual.u: 1.0, residual.u_dot: self.shift_v})
+            for c in residual.couplings]
         self._coupled = CoupledMatrix(self.A) if self.couplings else None
         if self._coupled is not None:
             self.A = self._coupled.A
@@ -131,44 +139,25 @@ class DynamicsSolver(Alpha2Integrator):
         self.convergence.jacobian_assembled(J)
 
 
-def _search_due(couplings: typing.Sequence) -> None:
+def _search_due(couplings: typing.Sequence[CouplingOperator]) -> None:
     """Mark each contact's pairing to be searched at the next residual evaluation."""
     for coupling in couplings:
         coupling.contact.search_pending = True
 
 
-def _split_constant(jacobian: ufl.Form) -> tuple[ufl.Form | None, list]:
-    """(the integrals of ``jacobian`` that involve no field, the others), derivatives expanded.
-
-    An integral without coefficients (the elastic stiffness, the mass) is the same at every
-    state; only constants (``fem.Constant``) may enter it, and :class:`_ConstantJacobian`
-    watches them.
-    """
-    if jacobian.empty():
-        return None, []
-    expanded = ufl.algorithms.expand_derivatives(jacobian)
-    constant: list = []
-    varying: list = []
-    for integral in expanded.integrals():
-        fields = ufl.algorithms.extract_coefficients(integral.integrand())
-        (varying if fields else constant).append(integral)
-    return (ufl.Form(constant) if constant else None), varying
-
-
 class _ConstantJacobian:
     """K0 + s_v C0 + s_a M0: the state-independent part of the Jacobian (springs and Dirichlet
     rows included), assembled once; the sum is formed again when the shifts change (a new
-    step size) or a constant of K0, C0, M0 does (e.g. the density)."""
+    step size) or an input of K0, C0, M0 does (e.g. the density: ``watcher``)."""
 
     def __init__(self, forms: list[ufl.Form | None], A: PETSc.Mat, residual: Residual):
         self.residual = residual
         self.forms = [None if f is None else _compat.form(f) for f in forms]
-        self.constants = [c for f in forms if f is not None for c in f.constants()]
+        self.watcher = BulkWatcher([f for f in forms if f is not None], self._assemble_parts)
         self.parts: list[PETSc.Mat | None] = [None, None, None]
         self.pattern = A
         self.sum: PETSc.Mat | None = None
         self._key: tuple | None = None
-        self._values: list | None = None
 
     def _assemble_parts(self) -> None:
         for k, form in enumerate(self.forms):
@@ -181,15 +170,10 @@ class _ConstantJacobian:
             assemble_jacobian(self.parts[k], form, self.residual.bcs,
                               self.residual.springs if stiffness else (),
                               diagonal=1.0 if stiffness else 0.0)
-        self._values = [np.array(c.value, copy=True) for c in self.constants]
 
     def matrix(self, shift_v: float, shift_a: float) -> PETSc.Mat:
         """K0 + s_v C0 + s_a M0 for the given shifts."""
-        changed = self._values is None or any(
-            not np.array_equal(c.value, v) for c, v in zip(self.constants, self._values,
-                                                           strict=True))
-        if changed:
-            self._assemble_parts()
+        if self.watcher.refresh():
             self._key = None
         if self._key != (shift_v, shift_a):
             same = PETSc.Mat.Structure.SAME_NONZERO_PATTERN
@@ -217,8 +201,8 @@ class CentralDifference:
     with the velocity-dependent forces (friction, damping) evaluated at the predicted
     :math:`\\tilde v_n = v_{n-1/2} + \\tfrac{\\Delta t}{2} a_{n-1}`. The scheme is stable for
     :math:`\\Delta t < 2/\\omega_{max}`, :math:`\\omega_{max}^2` the largest eigenvalue of
-    :math:`\\bar K w = \\omega^2 M_L w` (SLEPc EPS, at the initial state); steps are capped at
-    ``safety`` times that bound. Tensor-product Lagrange elements have positive row sums.
+    :math:`\\bar K w = \\omega^2 M_L w` (a SLEPc eigensolver, at the initial state); steps are
+    capped at ``safety`` times that bound. Tensor-product Lagrange elements have positive row sums.
 
     Friction is explicit too: inside the regularisation band a sticking node feels a dashpot
     :math:`c_i = c_T d_i^{m_T} A_i/\\varepsilon`, stable only for
@@ -248,7 +232,7 @@ class CentralDifference:
         M.assemble()
         self.lumped = self.b.duplicate()
         M.getRowSum(self.lumped)
-        self.couplings = [c.operator({}) for c in residual.couplings]
+        self.couplings: list[CouplingOperator] = [c.operator({}) for c in residual.couplings]
         bc_dofs = [i for bc in residual.bcs for i in bc.dof_indices()[0]]
         with self.lumped.localForm() as m:
             m.array[bc_dofs] = np.inf  # constrained dofs never accelerate
@@ -288,14 +272,15 @@ class CentralDifference:
         inverse_mass = self.lumped.copy()
         inverse_mass.reciprocal()
         K.diagonalScale(inverse_mass, None)  # M_L^{-1} K̄: same eigenvalues ω²
-        eps = SLEPc.EPS().create(K.getComm())
-        eps.setOperators(K)
-        eps.setProblemType(SLEPc.EPS.ProblemType.NHEP)
-        eps.setWhichEigenpairs(SLEPc.EPS.Which.LARGEST_MAGNITUDE)
-        eps.setTolerances(1e-6, 500)
-        eps.solve()
-        omega2 = max(abs(eps.getEigenvalue(i)) for i in range(eps.getConverged()))
-        for obj in (eps, K, inverse_mass):
+        eigensolver = SLEPc.EPS().create(K.getComm())
+        eigensolver.setOperators(K)
+        eigensolver.setProblemType(SLEPc.EPS.ProblemType.NHEP)
+        eigensolver.setWhichEigenpairs(SLEPc.EPS.Which.LARGEST_MAGNITUDE)
+        eigensolver.setTolerances(1e-6, 500)
+        eigensolver.solve()
+        omega2 = max(abs(eigensolver.getEigenvalue(i))
+                     for i in range(eigensolver.getConverged()))
+        for obj in (eigensolver, K, inverse_mass):
             obj.destroy()
         return 2.0 / np.sqrt(omega2)
 

@@ -58,7 +58,7 @@ EVENTS_LOCATED_TO_RESOLUTION = PETSc.Sys.getVersion() >= (3, 22)
 class RoundoffConvergence:
     r"""SNES convergence test: PETSc's atol/rtol tests on the residual norm, with atol raised at
     each iteration to ``safety`` times the residual's round-off floor
-    :math:`\sqrt{n}\,\varepsilon_{mach}\,\lVert\,|J|\,|x|\,\rVert_\infty`
+    :math:`\sqrt{n}\,\lVert\,|J|\,|x|\,\rVert_\infty` times the machine precision
     (cancellation in :math:`J x`: large when a soft spring carries a large rigid displacement,
     or, in a time step, when the acceleration is differenced from displacements). The bound is
     taken row by row (:math:`|J|` the matrix of the entries' moduli), not as
@@ -100,8 +100,8 @@ class RoundoffConvergence:
             self._moduli = moduli
 
     def floor(self, x: PETSc.Vec) -> float:
-        """sqrt(n) ε_mach ‖|J| |x|‖_∞ with the last assembled Jacobian J (AIJ matrices; else
-        sqrt(n) ε_mach ‖J‖_∞ ‖x‖_∞)."""
+        """sqrt(n) ‖|J| |x|‖_∞ times the machine precision, with the last assembled Jacobian J
+        (AIJ matrices; else sqrt(n) ‖J‖_∞ ‖x‖_∞)."""
         scale = np.sqrt(x.getSize()) * np.finfo(float).eps
         if self._moduli is None:
             return float(scale * self._jacobian_norm * x.norm(PETSc.NormType.INFINITY))

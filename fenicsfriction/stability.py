@@ -23,6 +23,7 @@ PETSc/SLEPc options live under the prefix (default ``stability_``).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import typing
 
 from mpi4py import MPI
@@ -34,7 +35,13 @@ import numpy as np
 import scipy.optimize
 
 from fenicsfriction import _compat
-from fenicsfriction.assembly import CoupledMatrix, assemble_jacobian
+from fenicsfriction.assembly import (
+    BulkWatcher,
+    CoupledMatrix,
+    assemble_jacobian,
+    split_constant,
+)
+from fenicsfriction.coupling import CouplingOperator
 from fenicsfriction.forms import Residual
 from fenicsfriction.laws import check
 from fenicsfriction.numerics import bisect
@@ -106,8 +113,9 @@ class StabilitySolver:
         self.residual_tol = residual_tol
         self.comm = residual.V.mesh.comm
         M, C, K = residual.linearisation()
+        operators = (("K", K), ("C", C), ("M", M))
         self._forms = {name: None if form.empty() else _compat.form(form)
-                       for name, form in (("K", K), ("C", C), ("M", M))}
+                       for name, form in operators}
         if self._forms["K"] is None or self._forms["M"] is None:
             raise ValueError("the residual has no stiffness or no inertia: nothing to oscillate")
         self.K = dolfinx.fem.petsc.create_matrix(self._forms["K"])
@@ -117,13 +125,19 @@ class StabilitySolver:
         # contact couplings: their K̄ and C parts (derivatives in u and u̇ about u̇ = 0) are
         # added to matrices of the pencil apart from the ones dolfinx assembles into
         u, u_dot = residual.u, residual.u_dot
-        self._couplings = {
+        self._couplings: dict[str, list[CouplingOperator]] = {
             "K": [c.operator({u: 1.0}, rest=[u_dot]) for c in residual.couplings],
             "C": [c.operator({u_dot: 1.0}, rest=[u_dot]) for c in residual.couplings]}
         self._coupled = {name: CoupledMatrix(getattr(self, name))
                          for name in ("K", "C") if residual.couplings}
         for name, coupled in self._coupled.items():
             setattr(self, name, coupled.A)
+        # an operator the state enters nowhere (the mass; C without friction) is assembled
+        # again only when one of its inputs (e.g. the density) has changed
+        state = (u, u_dot, residual.u_ddot)
+        self._watchers = {name: BulkWatcher([form], functools.partial(self._assemble, name))
+                          for name, form in operators
+                          if not form.empty() and not split_constant(form, state)[1]}
         self.pep = SLEPc.PEP().create(self.comm)
         self.pep.setOptionsPrefix(prefix)
         self.pep.setOperators([self.K, self.C, self.M])
@@ -137,18 +151,29 @@ class StabilitySolver:
                               for key in ("ncv", "mpd")}
         self._norms = (1.0, 1.0, 1.0)
 
+    def _assemble(self, name: str) -> None:
+        """Assemble the integrals of K̄ (nodal springs included), C or M (``name``)."""
+        coupled = self._coupled.get(name)
+        integrals = getattr(self, name) if coupled is None else coupled.base
+        if self._forms[name] is not None:
+            stiffness = name == "K"
+            assemble_jacobian(integrals, self._forms[name], self.residual.bcs,
+                              self.residual.springs if stiffness else (),
+                              1.0 if stiffness else 0.0)
+        else:
+            integrals.zeroEntries()
+            integrals.assemble()
+
     def assemble(self) -> None:
         """Assemble K̄ (nodal springs included), C and M at the residual's current state."""
         bcs = self.residual.bcs
-        assemble_jacobian(self.M, self._forms["M"], bcs, (), 0.0)
-        for name, springs, diagonal in (("K", self.residual.springs, 1.0), ("C", (), 0.0)):
-            coupled = self._coupled.get(name)
-            integrals = getattr(self, name) if coupled is None else coupled.base
-            if self._forms[name] is not None:
-                assemble_jacobian(integrals, self._forms[name], bcs, springs, diagonal)
+        for name in ("M", "K", "C"):
+            watcher = self._watchers.get(name)
+            if watcher is None:
+                self._assemble(name)
             else:
-                integrals.zeroEntries()
-                integrals.assemble()
+                watcher.refresh()
+            coupled = self._coupled.get(name)
             if coupled is not None and coupled.assemble(self._couplings[name], bcs):
                 # the spectral transformation's factorisation is set up anew
                 self.pep.setOperators([self.K, self.C, self.M])

@@ -35,12 +35,18 @@ import ufl
 from dolfinx import fem
 
 from fenicsfriction import _compat
-from fenicsfriction.assembly import CoupledMatrix, assemble_jacobian, assemble_residual
+from fenicsfriction.assembly import (
+    BulkWatcher,
+    CoupledMatrix,
+    assemble_jacobian,
+    assemble_residual,
+)
 from fenicsfriction.condensation import (
     InterfaceCondensation,
     condensation_for,
     interface_split,
 )
+from fenicsfriction.coupling import CouplingOperator
 from fenicsfriction.forms import Residual
 from fenicsfriction.laws import check
 from fenicsfriction.petsc_options import RoundoffConvergence, options_with_defaults
@@ -127,10 +133,11 @@ class SteadySolver:
         jit_cache_dir: FFCx cache directory (default: dolfinx's); ``jit_time_s`` records the
             time spent compiling (or loading) the two forms.
         roundoff_safety: the absolute tolerance is raised, at each iteration, to this multiple
-            of the residual's round-off floor sqrt(n) ε_mach ‖J‖_∞ ‖u‖_∞ (cancellation in J u,
-            large when a soft spring carries a large rigid displacement); 0 disables it. The
-            bound over-estimates the floor Newton actually reaches by 10-100x on the block
-            (e.g. 7e-4 against 5e-6 on the 32x24 mesh), so a factor 1 is safe.
+            of the residual's round-off floor, sqrt(n) ‖J‖_∞ ‖u‖_∞ times the machine
+            precision (cancellation in J u, large when a soft spring carries a large rigid
+            displacement); 0 disables it. The bound over-estimates the floor Newton actually
+            reaches by 10-100x on the block (e.g. 7e-4 against 5e-6 on the 32x24 mesh), so a
+            factor 1 is safe.
         linear_solver: how Newton's linear systems are solved (one of
             :data:`LINEAR_SOLVERS`). ``"condensed"``: the linear bulk condensed onto the
             nonlinear interface (one factorisation of the bulk for the whole continuation,
@@ -170,8 +177,9 @@ class SteadySolver:
         self.x = self.b.duplicate()
         # the contact couplings' steady residual and its derivative in u; with them the
         # integrals are assembled apart (dolfinx assembles only into its own pattern)
-        self.couplings = [c.operator({self.u: 1.0}, rest=[residual.u_dot], jit_cache_dir=
-                                     jit_cache_dir) for c in residual.couplings]
+        self.couplings: list[CouplingOperator] = [
+            c.operator({self.u: 1.0}, rest=[residual.u_dot], jit_cache_dir=jit_cache_dir)
+            for c in residual.couplings]
         self._coupled = CoupledMatrix(self.A) if self.couplings else None
         if self._coupled is not None:
             self.A = self._coupled.A
@@ -203,7 +211,8 @@ class SteadySolver:
             self.snes.getKSP().getPC().setFromOptions()
             self.convergence = RoundoffConvergence(self.snes, roundoff_safety)  # reads options
         pc = self.snes.getKSP().getPC()
-        self._bulk = None
+        self._bulk: PETSc.Mat | None = None
+        self._bulk_watcher: BulkWatcher | None = None
         if self.preconditioner is not None and pc.getType() == "python":
             # its factorisations are set up at the first solve, after the defaults are gone
             self.preconditioner.option_defaults = dict(options or {})
@@ -219,13 +228,12 @@ class SteadySolver:
             bulk_form, interface = split
             self._a_interface = _compat.form(ufl.Form(interface), jit_cache_dir)
             self._a_bulk = _compat.form(bulk_form, jit_cache_dir)
-            # what the bulk depends on besides u (constants, fields): a change of any of them
-            # (a continued bulk parameter) re-assembles the bulk and refactorises
-            self._bulk_inputs = [*ufl.algorithms.analysis.extract_constants(bulk_form),
-                                 *ufl.algorithms.analysis.extract_coefficients(bulk_form)]
             assemble_jacobian(self.A, self.a, residual.bcs, residual.springs)  # full pattern
             self._bulk = self.A.duplicate(copy=True)  # so the copy in _J keeps it
-            self._assemble_bulk()
+            # a change of what the bulk depends on besides u (a continued bulk parameter)
+            # re-assembles the bulk and refactorises
+            self._bulk_watcher = BulkWatcher([bulk_form], self._assemble_bulk)
+            self._bulk_watcher.refresh()
         self.snes.setConvergenceTest(self.convergence)
 
     def _update(self, x: PETSc.Vec) -> None:
@@ -238,13 +246,8 @@ class SteadySolver:
         assemble_residual(b, self.L, self.a, self.residual.bcs, x, self.residual.springs,
                           self.couplings)
 
-    def _bulk_values(self) -> list[np.ndarray]:
-        return [np.array(c.value if hasattr(c, "value") else c.x.array)
-                for c in self._bulk_inputs]
-
     def _assemble_bulk(self) -> None:
         assemble_jacobian(self._bulk, self._a_bulk, self.residual.bcs, self.residual.springs)
-        self._bulk_state = self._bulk_values()
 
     @property
     def condensation(self) -> InterfaceCondensation | None:
@@ -255,10 +258,8 @@ class SteadySolver:
     def _J(self, snes, x, A, P):
         if self.preconditioner is not None:
             self.preconditioner.krylov_count(snes.getKSP().getIterationNumber())
-        if self._bulk is not None:
-            if any(not np.array_equal(a, b)
-                   for a, b in zip(self._bulk_values(), self._bulk_state, strict=True)):
-                self._assemble_bulk()
+        if self._bulk_watcher is not None:
+            if self._bulk_watcher.refresh():
                 assert self.preconditioner is not None
                 self.preconditioner.stale = True
             assemble_jacobian(A, self._a_interface, self.residual.bcs, base=self._bulk)

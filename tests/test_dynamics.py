@@ -257,8 +257,10 @@ def test_the_jacobian_with_its_constant_part_assembled_once_is_the_full_jacobian
         full.axpy(-1.0, split)
         assert full.norm() < 1e-12 * norm, (shift_v, shift_a)
     solver._J(solver.ts, 0.0, *state, 2e5, 4e10, split, split)
+    assert solver._bulk.watcher.assemblies == 1  # new shifts re-form the sum, not the parts
     model.rho.value = 2 * model.rho.value
     solver._J(solver.ts, 0.0, *state, 2e5, 4e10, full, full)
+    assert solver._bulk.watcher.assemblies == 2
     full.axpy(-1.0, split)
     assert full.norm() > 1e-3 * split.norm()  # the mass doubled: s_a M0 changed
 

@@ -63,6 +63,8 @@ Value = typing.Any
 class NodeToSegment:
     r"""Slave nodes of one tagged surface against the facets of another, same residual.
 
+    A :class:`~fenicsfriction.coupling.Coupling`: what the solvers ask of ``Residual.couplings``.
+
     Args:
         u: the displacement (degree-1 Lagrange vectors on the mesh holding both bodies).
         facet_tags: the mesh's facet tags.

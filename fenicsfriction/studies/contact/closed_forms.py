@@ -2,7 +2,8 @@ r"""The closed forms the two-body scenes are checked against (Johnson 1985, *Con
 Mechanics*, chapters 4 and 7; Hertz 1882; Cattaneo 1938, Mindlin 1949).
 
 Two elastic bodies of moduli :math:`E_i`, Poisson ratios :math:`\nu_i` act as one of effective
-modulus :math:`1/E^* = (1-\nu_1^2)/E_1 + (1-\nu_2^2)/E_2` against a rigid flat.
+modulus :math:`1/E^* = (1-\nu_1^2)/E_1 + (1-\nu_2^2)/E_2` against a rigid flat
+(:mod:`fenicsfriction.elasticity`, with Hertz's pressure profile).
 """
 
 from __future__ import annotations
@@ -11,6 +12,8 @@ import math
 
 import numpy as np
 
+from fenicsfriction import elasticity
+from fenicsfriction.elasticity import hertz_pressure
 from fenicsfriction.laws import check
 
 __all__ = ["cattaneo_stick_half_width", "cattaneo_traction", "dundurs_beta", "effective_modulus",
@@ -19,12 +22,11 @@ __all__ = ["cattaneo_stick_half_width", "cattaneo_traction", "dundurs_beta", "ef
 
 
 def effective_modulus(E1: float, nu1: float, E2: float, nu2: float) -> float:
-    """:math:`E^*` of two elastic bodies (plane strain in 2D)."""
-    for name, value in (("E1", E1), ("E2", E2)):
-        check(name, value, value > 0, "Young's modulus must be > 0")
+    """:func:`fenicsfriction.elasticity.effective_modulus` of two bodies the finite element
+    scenes can model: compressible (ν < 0.5; the displacement formulation locks at 0.5)."""
     for name, value in (("nu1", nu1), ("nu2", nu2)):
-        check(name, value, -1 < value < 0.5, "Poisson's ratio must be in (-1, 0.5)")
-    return 1.0 / ((1 - nu1**2) / E1 + (1 - nu2**2) / E2)
+        check(name, value, value < 0.5, "Poisson's ratio must be in (-1, 0.5)")
+    return elasticity.effective_modulus(E1, nu1, E2, nu2)
 
 
 def dundurs_beta(E1: float, nu1: float, E2: float, nu2: float) -> float:
@@ -69,11 +71,6 @@ def hertz_load(half_width: float, radius: float, E_star: float, dim: int = 2) ->
     a = half_width
     return (a**2 * math.pi * E_star / (4 * radius) if dim == 2
             else 4 * E_star * a**3 / (3 * radius))
-
-
-def hertz_pressure(r: np.ndarray, a: float, p0: float) -> np.ndarray:
-    """:math:`p(r) = p_0\\sqrt{1 - r^2/a^2}` inside the contact, 0 outside."""
-    return p0 * np.sqrt(np.clip(1 - (np.asarray(r) / a) ** 2, 0.0, None))
 
 
 def fit_hertz_pressure(r: np.ndarray, pressure: np.ndarray) -> tuple[float, float]:

@@ -27,7 +27,7 @@ import typing
 from fenicsfriction._lazy import attach
 
 __getattr__, __dir__, __all__ = attach(__name__, {
-    "HertzEllipse": "hertz", "combined_modulus": "hertz", "hertz_from_curvatures": "hertz",
+    "HertzEllipse": "hertz", "hertz_from_curvatures": "hertz",
     "hertz_from_radii": "hertz", "quasi_identical_modulus": "hertz",
     "KalkerCoefficients": "kalker", "creep_coefficients": "kalker",
     "FastsimResult": "fastsim", "LinearForces": "fastsim", "creep_curve": "fastsim",
@@ -46,7 +46,6 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers
     )
     from fenicsfriction.studies.rolling.hertz import (
         HertzEllipse,
-        combined_modulus,
         hertz_from_curvatures,
         hertz_from_radii,
         quasi_identical_modulus,

@@ -36,8 +36,8 @@ import math
 
 import numpy as np
 
+from fenicsfriction.elasticity import hertz_pressure
 from fenicsfriction.laws import check, check_positive
-from fenicsfriction.studies.contact.closed_forms import hertz_pressure
 
 __all__ = ["carter_force", "carter_stick_half_width", "carter_traction", "ellipse_load",
            "hertz_line_radius", "mindlin_stick_radius", "mindlin_traction"]

@@ -4,7 +4,7 @@ Two bodies whose undeformed gap near the first point of contact is
 :math:`h = A x^2 + B y^2` (:math:`x` the rolling direction; :math:`A, B > 0` the relative
 curvatures, half the sums of the bodies' principal curvatures in the x-z and y-z planes,
 the principal axes of both bodies aligned), of combined modulus :math:`E^*`
-(:math:`1/E^* = (1-\nu_1^2)/E_1 + (1-\nu_2^2)/E_2`; :math:`E^* = G/(1-\nu)` for
+(:func:`fenicsfriction.elasticity.effective_modulus`; :math:`E^* = G/(1-\nu)` for
 quasi-identical bodies), pressed together by :math:`F_n`, touch on an ellipse under the
 pressure :math:`p = p_0\sqrt{1 - x^2/a^2 - y^2/b^2}`, :math:`p_0 = 3F_n/(2\pi ab)`. Its long
 semi-axis :math:`l` lies along the smaller curvature :math:`A_l`, the short one is
@@ -37,9 +37,10 @@ import numpy.typing as npt
 import scipy.optimize
 import scipy.special
 
+from fenicsfriction.elasticity import check_poisson_ratio
 from fenicsfriction.laws import check, check_positive
 
-__all__ = ["HertzEllipse", "combined_modulus", "hertz_from_curvatures", "hertz_from_radii",
+__all__ = ["HertzEllipse", "hertz_from_curvatures", "hertz_from_radii",
            "quasi_identical_modulus"]
 
 
@@ -81,24 +82,10 @@ class HertzEllipse:
         return self.p0 * np.sqrt(np.clip(1.0 - r2, 0.0, None))
 
 
-def _check_poisson(name: str, nu: float) -> None:
-    check(name, nu, isinstance(nu, (int, float)) and math.isfinite(nu) and -1.0 < nu <= 0.5,
-          "Poisson's ratio must be in (-1, 0.5]")
-
-
-def combined_modulus(E1: float, nu1: float, E2: float, nu2: float) -> float:
-    """E* with 1/E* = (1 - nu1²)/E1 + (1 - nu2²)/E2 [force/length²] (Johnson 1985, §4.2)."""
-    check_positive("E1", E1)
-    check_positive("E2", E2)
-    _check_poisson("nu1", nu1)
-    _check_poisson("nu2", nu2)
-    return 1.0 / ((1.0 - nu1**2) / E1 + (1.0 - nu2**2) / E2)
-
-
 def quasi_identical_modulus(G: float, nu: float) -> float:
     """E* = G / (1 - nu) of two bodies of the same shear modulus G and Poisson's ratio nu."""
     check_positive("G", G)
-    _check_poisson("nu", nu)
+    check_poisson_ratio("nu", nu)
     return G / (1.0 - nu)
 
 
@@ -127,7 +114,8 @@ def hertz_from_curvatures(A: float, B: float, Fn: float, E_star: float) -> Hertz
         A: relative curvature in the x-z plane (rolling direction) [1/length], > 0.
         B: relative curvature in the y-z plane [1/length], > 0.
         Fn: normal load [force], > 0.
-        E_star: combined modulus [force/length²] (:func:`combined_modulus`,
+        E_star: effective modulus [force/length²]
+            (:func:`fenicsfriction.elasticity.effective_modulus`,
             :func:`quasi_identical_modulus`), > 0.
     """
     for name, value in (("A", A), ("B", B), ("Fn", Fn), ("E_star", E_star)):
@@ -155,7 +143,7 @@ def hertz_from_radii(R1x: float, R1y: float, R2x: float, R2y: float, Fn: float,
         R2x: body 2's radius in the x-z plane [length].
         R2y: body 2's radius in the y-z plane [length].
         Fn: normal load [force], > 0.
-        E_star: combined modulus [force/length²], > 0.
+        E_star: effective modulus [force/length²], > 0.
     """
     for name, value in (("R1x", R1x), ("R1y", R1y), ("R2x", R2x), ("R2y", R2y)):
         check(name, value, isinstance(value, (int, float)) and value != 0.0
