@@ -58,6 +58,7 @@ test-mpi: setup
 
 # the HTML documentation (Sphinx + MyST, Debian's packages, nothing downloaded), warnings as errors
 docs: setup
+	rm -rf build/docs  # afresh: pickled doctrees of another Sphinx (Debian 12 vs 13) break the build
 	$(PY) -m sphinx -W --keep-going -q -b html -d build/docs/doctrees docs build/docs/html
 
 test: lint docs test-serial test-mpi
