@@ -62,7 +62,7 @@ say = ff.results.get_logger(comm=comm).info
 # At rest the inertia term $\langle \rho \ddot u, v\rangle$ drops out of the steady form.
 
 # %%
-scene = ff.BlockOnBelt(mu=0.0)
+scene = ff.BlockOnBelt()  # the paper's law, eq. (36), with μ = 0
 model = scene.build(comm=comm, with_friction=True)
 R = model.residual
 say(f"R has {len(R.form.integrals())} integrals; steady form keeps "

@@ -22,6 +22,7 @@ import pytest
 import scipy.optimize
 from scipy.integrate import trapezoid
 
+from fenicsfriction.laws import InterfaceLaw
 from fenicsfriction.studies.block import RigidBlock, rigid_block_observables
 from fenicsfriction.studies.oscillators import BouncingMass
 from fenicsfriction.timestepping import DynamicsError, ReducedDynamics
@@ -296,7 +297,7 @@ def rigid_block(mu: float) -> RigidBlock:
     viscous = tuple(2 * zeta * np.sqrt(k * m)
                     for zeta, k, m in zip((0.005, 0.04, 0.04), np.diag(K), np.diag(M),
                                               strict=True))
-    return RigidBlock(mu=mu, viscous=viscous, **data)
+    return RigidBlock(viscous=viscous, **data, law=InterfaceLaw(mu=mu))
 
 
 def test_modal_damping_gives_the_asked_damping_ratios_at_mu_0():
@@ -314,7 +315,8 @@ def test_modal_damping_gives_the_asked_damping_ratios_at_mu_0():
     # frequencies: tangential (spring) < normal/rotation; the x ratio is the smallest one
     assert measured[np.argmin(abs(lam))] == pytest.approx(ratios[0], rel=1e-9)
     assert sorted(measured) == pytest.approx(sorted(ratios), rel=1e-9)
-    assert RigidBlock.with_modal_damping(ratios, mu=1.0, **data).viscous == pytest.approx(
+    damped = RigidBlock.with_modal_damping(ratios, law=InterfaceLaw(mu=1.0), **data)
+    assert damped.viscous == pytest.approx(
         rigid_block(1.0).viscous, rel=1e-12)
     with pytest.raises(ValueError, match="viscous"):
         RigidBlock(viscous=(1.0, float("nan"), 1.0))
@@ -391,7 +393,7 @@ def test_rigid_block_probe_tractions_integrate_to_the_resultants():
     partly lifted state; friction is μ × pressure while slipping (|w| = U ≫ ε)."""
     rb = rigid_block(0.5)
     q_steady = rb.steady_state()
-    q_tilted = q_steady + np.array([0.0, 0.4 * (q_steady[1] + rb.g), 8e-6])  # lifts the rear
+    q_tilted = q_steady + np.array([0.0, 0.4 * (q_steady[1] + rb.law.g), 8e-6])  # lifts the rear
     for q in (q_steady, q_tilted):
         x = np.linspace(0.0, rb.L, 4001)
         probes = [rigid_block_observables(rb, q, np.zeros(3), probe_x=xi) for xi in x]

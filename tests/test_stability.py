@@ -247,9 +247,8 @@ def test_stiffness_is_symmetric_but_for_the_friction_coupling():
 
     ff.continuation(steady, model.mu, np.linspace(0.1, 0.5, 5))
     solver.assemble()
-    term = model.thickness * friction(
-        residual.u, residual.u_dot, residual.v, model.normal, model.friction_c_T, model.m_T,
-        model.gap, model.belt_velocity, model.eps, model.ds_contact, model.scene.regularisation)
+    term = model.thickness * friction(residual.u, residual.u_dot, residual.v, model.normal,
+                                      model.law, model.belt_velocity, model.ds_contact)
     a = _compat.form(residual.at_rest(residual.derivative(term, residual.u)))
     F = dolfinx.fem.petsc.assemble_matrix(a)
     F.assemble()

@@ -23,7 +23,7 @@ from mpi4py import MPI
 import numpy as np
 import ufl
 
-from fenicsfriction import _compat
+from fenicsfriction import _compat, laws
 from fenicsfriction.dynamics import CentralDifference, DynamicsSolver
 from fenicsfriction.laws import check
 from fenicsfriction.studies.contact import closed_forms, geometry
@@ -86,9 +86,14 @@ class PressAndDrag(_Bodies):
 
     def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
         mesh = geometry.hertz_2d(comm, R=self.radius, h_contact=self.h_contact)
-        return TwoBodyModel(mesh, self.materials, self.c_n, self.m_n, mu=self.mu,
-                            eps=self.eps, passes=self.passes, density=self.density,
-                            b_n=self.b_n)
+        return TwoBodyModel(mesh, self.materials, self.law, passes=self.passes,
+                            density=self.density)
+
+    @property
+    def law(self) -> laws.InterfaceLaw:
+        """The interface law: compliance, μ, ε and the normal damping b_n."""
+        return laws.InterfaceLaw(c_n=self.c_n, m_n=self.m_n, mu=self.mu, eps=self.eps,
+                                 b_n=self.b_n)
 
     def traction(self, t: float) -> np.ndarray:
         """The traction on the cylinder's top at time t: −P/(2R) normal, the drag between

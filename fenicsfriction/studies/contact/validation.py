@@ -24,6 +24,7 @@ from mpi4py import MPI
 
 import numpy as np
 
+from fenicsfriction import laws
 from fenicsfriction.laws import check
 from fenicsfriction.studies.contact import closed_forms, geometry
 from fenicsfriction.studies.contact.model import Material, SurfaceValues, TwoBodyModel
@@ -64,6 +65,11 @@ class _Bodies:
     @property
     def materials(self) -> tuple[Material, Material]:
         return Material(self.E1, self.nu1), Material(self.E2, self.nu2)
+
+    @property
+    def law(self) -> laws.InterfaceLaw:
+        """The interface law the model is built with (frictionless here)."""
+        return laws.InterfaceLaw(c_n=self.c_n, m_n=self.m_n)
 
     @property
     def E_star(self) -> float:
@@ -113,7 +119,7 @@ class Hertz(_Bodies):
             comm, R=self.radius, refine=self.refine, h_contact=self.h_contact)
         # the 2D cylinder's sliding is stopped at its loaded face; the quarter sphere's by the
         # symmetry planes
-        return TwoBodyModel(mesh, self.materials, self.c_n, self.m_n, passes=self.passes,
+        return TwoBodyModel(mesh, self.materials, self.law, passes=self.passes,
                             fix_load_face=self.dim == 2)
 
     def run(self, comm: MPI.Comm = MPI.COMM_WORLD, model: TwoBodyModel | None = None
@@ -175,8 +181,7 @@ class Patch(_Bodies):
     def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
         mesh = (geometry.patch_2d if self.dim == 2 else geometry.patch_3d)(
             comm, n_upper=self.n_upper, n_lower=self.n_lower)
-        model = TwoBodyModel(mesh, self.materials, self.c_n, self.m_n, passes=self.passes,
-                             clamp=False)
+        model = TwoBodyModel(mesh, self.materials, self.law, passes=self.passes, clamp=False)
         model.rollers(range(self.dim - 1))
         return model
 
@@ -213,7 +218,7 @@ class Cattaneo(Hertz):
         eps: the regularisation of the slip increment [length] (c1: Pop, eq. 15); a
             sequence ε_k → 0 is Kalker's sequential process.
         formulation: ``"compliance"`` (the regularised law) or ``"perturbed-lagrangian"``
-            (Pop, eq. 27: penalties ε_N = ``c_n`` and ε_T = ``eps_T`` [force/length³]).
+            (Pop, eq. 27: penalties ε_N = ``c_n`` and κ_T = ``penalty_T`` [force/length³]).
     """
 
     mu: float = 0.3
@@ -221,7 +226,7 @@ class Cattaneo(Hertz):
     increments: int = 10
     eps: float = 1e-6
     formulation: str = "compliance"
-    eps_T: float = 1e4
+    penalty_T: float = 1e4
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -235,9 +240,13 @@ class Cattaneo(Hertz):
     def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
         mesh = geometry.hertz_2d(comm, R=self.radius, refine=self.refine,
                                  h_contact=self.h_contact)
-        return TwoBodyModel(mesh, self.materials, self.c_n, self.m_n, mu=self.mu,
-                            eps=self.eps, passes=self.passes, formulation=self.formulation,
-                            eps_T=self.eps_T)
+        return TwoBodyModel(mesh, self.materials, self.law, passes=self.passes,
+                            formulation=self.formulation, penalty_T=self.penalty_T)
+
+    @property
+    def law(self) -> laws.InterfaceLaw:
+        """The interface law: compliance, μ and the regularisation ε of the slip increment."""
+        return laws.InterfaceLaw(c_n=self.c_n, m_n=self.m_n, mu=self.mu, eps=self.eps)
 
     def stick_zone(self, values: SurfaceValues, tol: float = 1e-3) -> tuple[float, float]:
         """(stick half-width, slip half-width): the extent of the contact nodes whose traction
@@ -259,7 +268,8 @@ class Cattaneo(Hertz):
         model = model or self.build(comm)
         a, _ = self.closed_form()
         model.eps.value = NORMAL_LOADING_EPS * a
-        model.eps_T.value = self.E_star / self.radius  # the perturbed Lagrangian's: a soft spring
+        # the perturbed Lagrangian's: a soft spring
+        model.penalty_T.value = self.E_star / self.radius
         return Hertz.run(self, comm, model)
 
     def load_tangential(self, model: TwoBodyModel, eps: float | None = None,
@@ -276,7 +286,7 @@ class Cattaneo(Hertz):
         assert self.load is not None
         a, p0 = self.closed_form()
         model.eps.value = eps
-        model.eps_T.value = self.eps_T
+        model.penalty_T.value = self.penalty_T
         rows = []
         for k in range(1, self.increments + 1):
             for contact in model.contacts:
@@ -317,7 +327,7 @@ class Cattaneo(Hertz):
             "wall_time_s": time.perf_counter() - t0})
         summary["parameters"] = {**normal["parameters"], "mu": self.mu, "eps": self.eps,
                                  "increments": self.increments,
-                                 "formulation": self.formulation, "eps_T": self.eps_T}
+                                 "formulation": self.formulation, "penalty_T": self.penalty_T}
         return summary
 
     def run(self, comm: MPI.Comm = MPI.COMM_WORLD, model: TwoBodyModel | None = None,

@@ -21,8 +21,9 @@ for all v vanishing on the far faces, with the slip s (per unit rolling distance
   :math:`s = \Delta u_\tau - \Delta u_\tau^{old} - \Delta\delta` with
   :math:`\Delta u_\tau = 2u_\tau`, the tractions of the increment committed before the next.
 
-:math:`p_\tau` is :func:`fenicsfriction.laws.friction_traction` with :math:`d = p_n`,
-:math:`c_T = \mu`, :math:`m_T = 1` (the package's one interface law and its regularisations);
+:math:`p_\tau` is the friction traction of the package's one interface law
+(:class:`fenicsfriction.laws.InterfaceLaw`, its regularisations) with unit linear compliance read
+on the pressure: :math:`c_n = 1`, :math:`m_n = m_T = 1`, :math:`d = p_n`;
 ε → 0 by Kalker's sequential process (Kalker 1986, section 6,
 :func:`fenicsfriction.steady.epsilon_sequence`). The residual is one UFL form
 (:func:`fenicsfriction.forms.elasticity` and :func:`fenicsfriction.forms.surface_traction`)
@@ -325,8 +326,10 @@ class RollingModel:
             self.slip = rolling_slip(self.u, w, dim)
         else:
             self.slip = shift_slip(self.u, self.u_old, self.increment, dim)
-        self.traction = laws.friction_traction(self.p_n, self.slip, self.mu, 1, self.eps,
-                                               scene.regularisation)
+        #: the interface law on the pressure (c_n = 1, m_n = 1: its bound is μ p_n)
+        self.law = laws.InterfaceLaw(c_n=1.0, m_n=1.0, mu=self.mu, eps=self.eps,
+                                     regularisation=scene.regularisation)
+        self.traction = self.law.friction_traction(self.p_n, self.slip)
         self.weight = self._upwind_weight() if kinematics == "rolling" else 1.0
         form = forms.elasticity(self.u, v, E, scene.nu, self.dx) \
             + forms.surface_traction(self.weight * self.contact_traction(), v, self.ds(CONTACT))
@@ -360,12 +363,13 @@ class RollingModel:
         self.approach = fem.Constant(self.msh, 0.0)
         c_n = s.c_n if s.c_n is not None else 1e3 * s.E_star / s.a
         gap = self.x[0] ** 2 / (4 * s.radius) - self.approach / 2
+        law = laws.InterfaceLaw(c_n=c_n, m_n=1, g=gap)
         form = forms.elasticity(u_n, v, self.E, s.nu, self.dx) \
-            + forms.normal_compliance(u_n, v, n, c_n, 1, gap, self.ds(CONTACT))
+            + forms.normal_compliance(u_n, v, n, law, self.ds(CONTACT))
         zero = fem.Function(self.V)
         residual = forms.Residual(form, u_n, zero, zero, v, bcs=[self._clamp()])
         solver = SteadySolver(residual, prefix="rolling_normal_")
-        pressure = laws.normal_traction(laws.penetration(forms.normal_part(u_n, n), gap), c_n, 1)
+        pressure = law.normal_traction(laws.penetration(forms.normal_part(u_n, n), gap))
         load = _compat.form(pressure * self.ds(CONTACT))
         # the secant on log(force) against log(approach), from the rigid indentation's approach
         # a²/(2R): the force grows about linearly with it
