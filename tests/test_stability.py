@@ -167,8 +167,8 @@ def test_stiffness_and_damping_are_the_derivatives_of_the_residual():
     the terms independent of u̇ round identically in both evaluations and cancel. Measured:
     3e-10; friction is 38 % of C δu̇, normal damping the rest.
     """
-    model, _ = sliding_block(COMM, 0.6, prefix("fd"), b_n=0.381e10,
-                             regularisation="smooth", eps=0.1)
+    model, _ = sliding_block(COMM, 0.6, prefix("fd"), law=ff.InterfaceLaw(
+        b_n=0.381e10, regularisation="smooth", eps=0.1))
     residual = model.residual
     solver = StabilitySolver(residual, prefix=prefix("fd_pep"))
     solver.assemble()

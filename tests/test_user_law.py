@@ -1,0 +1,128 @@
+"""A researcher's friction law, written once here (outside the package) and passed unchanged to
+the finite element block, the rigid block and the law's own derivatives.
+
+μ(s, p) = (μ_k + (μ_s - μ_k) e^{-s/v_s}) (1 + p/p_ref)^α falls with the slip speed s and rises
+with the pressure p; it uses only operations valid on UFL, NumPy and the law's dual numbers.
+"""
+
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import dolfinx.fem.petsc
+import numpy as np
+import pytest
+import scipy.integrate
+from dolfinx import fem
+
+import fenicsfriction as ff
+from fenicsfriction import _compat, laws
+from fenicsfriction.studies.block import RigidBlock, rigid_block_observables
+
+MU_S, MU_K, V_S, P_REF, ALPHA = 0.6, 0.4, 0.1, 0.2, 0.3
+
+
+def user_mu(speed, pressure):
+    """The user's law: Stribeck-like in the speed, a power of the pressure."""
+    return (MU_K + (MU_S - MU_K) * laws.exp(-speed / V_S)) * (1 + pressure / P_REF) ** ALPHA
+
+
+LAW = ff.InterfaceLaw(friction_coefficient=user_mu, eps=1e-3)
+
+
+@pytest.mark.parametrize("w", [-0.3, -2e-4, 5e-4, 0.05])
+@pytest.mark.parametrize("regularisation", ["c1", "smooth"])
+def test_numpy_derivatives_of_the_user_law_are_its_central_differences(w, regularisation):
+    """∂t/∂d and ∂t/∂w from dual numbers against central differences, h = 1e-6 of the variable:
+    truncation h² |t'''| and round-off ε_mach |t|/h, both below 1e-7 relative."""
+    law = LAW.replace(regularisation=regularisation)
+    d = np.array([2e-5, 6e-5, 1e-4])
+    dt_dd, dt_dw = law.friction_traction_derivatives(d, w)
+    h_d, h_w = 1e-6 * d, 1e-6 * max(abs(w), law.eps)
+    fd_d = (law.friction_traction(d + h_d, w) - law.friction_traction(d - h_d, w)) / (2 * h_d)
+    fd_w = (law.friction_traction(d, w + h_w) - law.friction_traction(d, w - h_w)) / (2 * h_w)
+    np.testing.assert_allclose(dt_dd, fd_d, rtol=1e-7)
+    np.testing.assert_allclose(dt_dw, fd_w, rtol=1e-7, atol=1e-7 * np.abs(fd_w).max())
+
+
+def test_rigid_block_with_the_user_law_slides_where_the_spring_balances_mu_p():
+    """Steady sliding of the rigid block: the spring holds B0 ∫ μ(U, p(s)) p(s) ds, computed
+    here by adaptive quadrature on the block's penetration profile (statics and the law, not the
+    block's own integration rule); tolerance: the Newton tolerance 1e-12 of the weight plus the
+    64-point Gauss rule on a smooth integrand."""
+    block = RigidBlock(law=LAW)
+    q = block.steady_state()
+    observed = rigid_block_observables(block, q, np.zeros(3))
+    U = block.belt_speed
+
+    def traction(s):
+        d = max(-q[1] - q[2] * s, 0.0)
+        p = LAW.c_n * d**LAW.m_n
+        return user_mu(U, p) * p
+
+    expected = block.B0 * scipy.integrate.quad(traction, -block.L / 2, block.L / 2,
+                                               epsabs=0, epsrel=1e-13)[0]
+    assert observed["spring_force"] == pytest.approx(-expected, rel=1e-9)
+    assert observed["friction_force"] == pytest.approx(expected, rel=1e-9)
+    # the law acts: the pressure-dependent coefficient is not μ at p = 0
+    assert expected / observed["normal_force"] > MU_K * 1.001
+
+
+@pytest.fixture(scope="module")
+def fe_block():
+    scene = ff.BlockOnBelt(law=LAW)
+    model = scene.build(MPI.COMM_WORLD)
+    model.initial_guess()
+    solver = ff.SteadySolver(model.residual, prefix="user_law_", options=model.solver_options())
+    report = solver.solve()
+    return scene, model, report
+
+
+def test_fe_block_with_the_user_law_balances_spring_and_friction(fe_block):
+    """Statics: the spring force equals the friction resultant, which is the law's μ(U, p) p
+    integrated over Γ_C (the UFL integral of the law, written here, not the model's); rows
+    of a converged residual: 1e-8 of the load."""
+    scene, model, _ = fe_block
+    q = model.quantities()
+    spring = model.spring.force(model.residual.u)
+    assert spring == pytest.approx(-q.friction_force, abs=1e-8 * scene.weight)
+    p = model.pressure()
+    expected = model.msh.comm.allreduce(fem.assemble_scalar(_compat.form(
+        scene.B0 * user_mu(scene.belt_speed, p) * p * model.ds_contact)), op=MPI.SUM)
+    assert q.friction_force == pytest.approx(expected, rel=1e-10)
+    assert q.friction_force / q.normal_force > MU_K * 1.001
+
+
+def test_jacobian_with_the_user_law_passes_the_taylor_test(fe_block):
+    """‖R(u + h δ) - R(u) - h J δ‖ falls as h² (ufl.derivative of the residual holding the user's
+    law, through Residual.steady_jacobian): the ratio of successive remainders at h, h/2 is 4."""
+    _, model, _ = fe_block
+    R = model.residual
+    F, J = _compat.form(R.steady()), _compat.form(R.steady_jacobian())
+    u0 = R.u.x.array.copy()
+    rng = np.random.default_rng(0)
+    delta = fem.Function(R.V)
+    delta.x.array[:] = 1e-6 * rng.standard_normal(len(u0))
+    delta.x.scatter_forward()
+
+    def residual() -> np.ndarray:
+        b = dolfinx.fem.petsc.assemble_vector(F)
+        b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        return b
+
+    b0 = residual()
+    A = dolfinx.fem.petsc.assemble_matrix(J)
+    A.assemble()
+    Jd = A.createVecLeft()
+    A.mult(_compat.petsc_vec(delta), Jd)
+    remainders = []
+    for h in (1.0, 0.5, 0.25):
+        R.u.x.array[:] = u0 + h * delta.x.array
+        R.u.x.scatter_forward()
+        b = residual()
+        b.axpy(-1.0, b0)
+        b.axpy(-h, Jd)
+        remainders.append(b.norm())
+    R.u.x.array[:] = u0
+    R.u.x.scatter_forward()
+    rates = np.log2(np.array(remainders[:-1]) / np.array(remainders[1:]))
+    assert rates == pytest.approx([2.0, 2.0], abs=0.1), remainders
