@@ -16,6 +16,7 @@ from dolfinx import fem
 
 import fenicsfriction as ff
 from fenicsfriction import _compat, laws
+from fenicsfriction.contact import solve_with_search
 from fenicsfriction.studies.block import RigidBlock, rigid_block_observables
 
 MU_S, MU_K, V_S, P_REF, ALPHA = 0.6, 0.4, 0.1, 0.2, 0.3
@@ -126,3 +127,27 @@ def test_jacobian_with_the_user_law_passes_the_taylor_test(fe_block):
     R.u.x.scatter_forward()
     rates = np.log2(np.array(remainders[:-1]) / np.array(remainders[1:]))
     assert rates == pytest.approx([2.0, 2.0], abs=0.1), remainders
+
+
+def test_block_on_a_stiff_slab_with_the_user_law_carries_mu_p_at_every_node():
+    """Two-body node-to-segment contact (the block on a slab 1e3 times stiffer) with the same
+    law object: in steady sliding every slave node slips at U, so the friction resultant is
+    B0 Σ_i A_i μ(U, p_i) p_i over the nodes' tributary lengths A_i and penetrations (read off the
+    nodes, the law evaluated here), and the spring holds it. Tolerance 1e-6: the slab's top
+    tilts by its compression (~1e-4 of the penetration over the block's length), which moves
+    the x-component of the traction by its square."""
+    scene = ff.BlockOnSlab(slab_E=1.4e9, slab_thickness=5.0, law=LAW)
+    model = scene.build(MPI.COMM_WORLD)
+    model.initial_guess()
+    solver = ff.SteadySolver(model.residual, prefix="user_law_slab_",
+                             options=model.solver_options())
+    solve_with_search(solver, [model.contact])  # the block slides ~23 cm along the slab
+    q = model.quantities()
+    d, slip, _ = model.nodal_contact()
+    lengths = model.contact.nodal_weights[model.contact.pairing.slave_nodes]
+    p = LAW.c_n * d**LAW.m_n
+    local = scene.B0 * np.sum(lengths * user_mu(np.abs(slip), p) * p)
+    expected = model.msh.comm.allreduce(local, op=MPI.SUM)
+    assert np.allclose(np.abs(slip), scene.belt_speed, rtol=1e-9)
+    assert q.friction_force == pytest.approx(expected, rel=1e-6)
+    assert model.spring.force(model.residual.u) == pytest.approx(-expected, rel=1e-6)
