@@ -252,8 +252,8 @@ class Cattaneo(Hertz):
         """(stick half-width, slip half-width): the extent of the contact nodes whose traction
         is below the friction bound by more than ``tol`` (stick) and of all contact nodes."""
         contact = values.pressure > 0
-        utilisation = np.linalg.norm(values.traction, axis=1) / np.where(
-            contact, self.mu * values.pressure, 1.0)
+        bound = self.law.coefficient(0.0, values.pressure) * values.pressure  # μ p_n
+        utilisation = np.linalg.norm(values.traction, axis=1) / np.where(contact, bound, 1.0)
         stick = contact & (utilisation < 1 - tol)
         x = values.x[:, 0]
         return (float(np.ptp(x[stick]) / 2) if stick.any() else 0.0,
