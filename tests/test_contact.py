@@ -163,7 +163,7 @@ def test_perturbed_lagrangian_approaches_the_compliance_law_as_its_penalty_grows
     from fenicsfriction.studies.contact.validation import Cattaneo
 
     common = {"h_contact": 0.01, "increments": 2}
-    _, model = Cattaneo(eps=1e-6, **common).run()
+    _, model = Cattaneo(**common).with_law(eps=1e-6).run()
     reference = model.surface_values()
     scale = np.abs(reference.traction).max()
     distances = []
@@ -189,7 +189,7 @@ def test_hertz_converges_as_the_compliance_stiffens():
 
     widths, peaks = [], []
     for c_n in (1e2, 1e3, 1e4):
-        summary, _ = Hertz(c_n=c_n, h_contact=0.01).run()
+        summary, _ = Hertz(h_contact=0.01).with_law(c_n=c_n).run()
         widths.append(summary["half_width"])
         peaks.append(summary["max_pressure"])
     for values in (widths, peaks):
