@@ -796,6 +796,31 @@ class InterfaceLaw:
             return self.mu + 0 * speed
         return self.friction_coefficient(speed, pressure)
 
+    def coefficient_slope(self, speed: typing.Any, pressure: typing.Any) -> np.ndarray:
+        """∂μ/∂speed at ``speed`` >= 0 and ``pressure`` (NumPy): a law's own ``derivative``
+        where it has one (the laws of this module), else the law evaluated on dual numbers
+        (a user's function needs no derivative)."""
+        law = self.friction_coefficient
+        if law is None:
+            return 0.0 * np.asarray(speed, dtype=float)
+        derivative = getattr(law, "derivative", None)
+        if derivative is not None:
+            return derivative(speed)
+        return _Dual.lift(law(_Dual(speed, 1.0), pressure)).slope
+
+    def direction(self, w: typing.Any) -> typing.Any:
+        """The regularised direction :math:`\\phi_\\varepsilon'(w)` of the slip ``w`` (UFL
+        vector or NumPy), of the law's regularisation and ε (:data:`REGULARISATIONS`)."""
+        return REGULARISATIONS[self.regularisation][1](w, self.eps)
+
+    def friction_force(self, normal_force: typing.Any, w: typing.Any) -> typing.Any:
+        """The regularised friction force of a point contact pressed with the normal force
+        ``normal_force`` N at slip velocity ``w`` (NumPy, one tangent direction):
+        :math:`-\\mu(|w|, N)\\, N\\, \\phi_\\varepsilon'(w)`, the traction of
+        :meth:`friction_traction` with the bound μN of a mesh-free model (the compliance
+        c_n, m_n is not used: N is the model's own; μ reads N as its pressure)."""
+        return -self.coefficient(abs(w), normal_force) * normal_force * self.direction(w)
+
     def _c_T(self, d: Scalar) -> typing.Any:
         """c_T of :func:`fenicsfriction.laws.friction_traction`: μ c_n, or c_n μ(|w|, p_e) as a
         function of the slip speed."""
