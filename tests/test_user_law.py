@@ -18,6 +18,7 @@ import fenicsfriction as ff
 from fenicsfriction import _compat, laws
 from fenicsfriction.contact import solve_with_search
 from fenicsfriction.studies.block import RigidBlock, rigid_block_observables
+from fenicsfriction.studies.oscillators import BeltOscillator
 
 MU_S, MU_K, V_S, P_REF, ALPHA = 0.6, 0.4, 0.1, 0.2, 0.3
 
@@ -151,3 +152,75 @@ def test_block_on_a_stiff_slab_with_the_user_law_carries_mu_p_at_every_node():
     assert np.allclose(np.abs(slip), scene.belt_speed, rtol=1e-9)
     assert q.friction_force == pytest.approx(expected, rel=1e-6)
     assert model.spring.force(model.residual.u) == pytest.approx(-expected, rel=1e-6)
+
+
+class _BeltSpeed:
+    """The belt speed U as the scalar parameter of :func:`fenicsfriction.continuation`: the
+    model holds the belt's velocity as a vector ``fem.Constant`` U e_x."""
+
+    def __init__(self, velocity: fem.Constant):
+        self.velocity = velocity
+        self.direction = velocity.value / np.linalg.norm(velocity.value)
+
+    @property
+    def value(self) -> float:
+        return float(self.velocity.value @ self.direction)
+
+    @value.setter
+    def value(self, speed: float) -> None:
+        self.velocity.value = speed * self.direction
+
+
+def test_continuation_in_the_belt_speed_keeps_the_user_law_in_balance():
+    """A steady continuation of the FE block with the user's law over the belt speed U, from
+    2 v_s down to v_s/2, where μ(U, p) rises by 28 % with the Stribeck term: at every step the
+    spring holds the friction resultant, which is the user's μ(U, p) p integrated over Γ_C
+    at that U (the UFL integral written here). The balance is the sum of the residual's rows
+    along the belt, so Cauchy-Schwarz bounds it by sqrt(n) times the residual norm each step's
+    Newton stopped at; the friction against its integral as in the single solve above."""
+    scene = ff.BlockOnBelt(law=LAW)
+    model = scene.build(MPI.COMM_WORLD)
+    model.initial_guess()
+    solver = ff.SteadySolver(model.residual, prefix="user_law_path_",
+                             options=model.solver_options())
+    solver.solve()
+    speed = _BeltSpeed(model.belt_velocity)
+    assert speed.value == pytest.approx(scene.belt_speed)
+    comm = model.msh.comm
+
+    def check() -> dict:
+        q = model.quantities()
+        spring = model.spring.force(model.residual.u)
+        p = model.pressure()
+        expected = comm.allreduce(fem.assemble_scalar(_compat.form(
+            scene.B0 * user_mu(speed.value, p) * p * model.ds_contact)), op=MPI.SUM)
+        return {"spring": spring, "friction": q.friction_force, "expected": expected,
+                "normal": q.normal_force}
+
+    targets = np.linspace(2 * V_S, V_S / 2, 7)
+    records = ff.continuation(solver, speed, targets, observe=check)
+    assert [r["value"] for r in records] == pytest.approx(targets)
+    for r in records:
+        dofmap = model.residual.V.dofmap
+        bound = np.sqrt(dofmap.index_map.size_global * dofmap.index_map_bs) * r["residual_norm"]
+        assert abs(r["spring"] + r["friction"]) <= bound, (r, bound)
+        assert r["friction"] == pytest.approx(r["expected"], rel=1e-10)
+    # the path moves: the slower belt pulls harder (the user's μ falls with the speed)
+    ratio = records[-1]["friction"] / records[0]["friction"]
+    assert ratio > 1.1, ratio
+
+
+def test_point_contact_force_and_slope_of_the_user_law():
+    """The mesh-free models' pieces of the law (belt oscillator, m.d.o.f. slider): the friction
+    force of a point contact is -μ(|w|, N) N φ'_ε(w) (the smooth direction written here), and
+    the speed slope of the user's μ (dual numbers) is its central difference (step 1e-6 v_s:
+    truncation ~1e-12, round-off ~1e-10 relative)."""
+    law = LAW.replace(regularisation="smooth")
+    N, w = 2.0, np.array([-0.3, -1e-4, 0.0, 2e-4, 0.05])
+    expected = -user_mu(np.abs(w), N) * N * w / np.sqrt(w**2 + law.eps**2)
+    assert law.friction_force(N, w) == pytest.approx(expected, rel=1e-14, abs=0)
+    s, h = np.array([1e-3, 0.05, 0.3]), 1e-6 * V_S
+    central = (user_mu(s + h, N) - user_mu(s - h, N)) / (2 * h)
+    assert law.coefficient_slope(s, N) == pytest.approx(central, rel=1e-7)
+    belt = BeltOscillator(m=1.0, k=1.0, c=0.1, N=N, v_belt=0.05, law=law)
+    assert belt.effective_damping() == pytest.approx(0.1 + N * central[1], rel=1e-7)
