@@ -142,7 +142,7 @@ def run_mesh(dim: int, refine: int, repeats: int, comm: MPI.Comm, passes: int = 
         t0 = time.perf_counter()
         mesh = (geometry.hertz_2d if dim == 2 else geometry.hertz_3d)(comm, refine=refine)
         t1 = time.perf_counter()
-        model = TwoBodyModel(mesh, scene.materials, scene.c_n, scene.m_n, passes=passes,
+        model = TwoBodyModel(mesh, scene.materials, scene.law, passes=passes,
                              fix_load_face=dim == 2)
         t2 = time.perf_counter()
         row = measure(scene, model, comm)

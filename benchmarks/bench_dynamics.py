@@ -64,7 +64,8 @@ class Scene:
     """The block at its steady sliding state, reset before every run."""
 
     def __init__(self, comm: MPI.Comm, eps: float = EPS):
-        self.model = ff.BlockOnBelt(mu=MU, belt_speed=BELT_SPEED, b_n=B_N, eps=eps).build(comm)
+        law = ff.InterfaceLaw(mu=MU, b_n=B_N, eps=eps)
+        self.model = ff.BlockOnBelt(belt_speed=BELT_SPEED, law=law).build(comm)
         self.model.initial_guess()
         steady = ff.SteadySolver(self.model.residual, prefix="bench_steady_",
                                  options=self.model.solver_options())

@@ -65,8 +65,8 @@ def getfem_worker(refine: int, repeats: int) -> dict:
     md.add_fem_variable("u", mf)
     lmbda = s.E * s.nu / ((1 + s.nu) * (1 - 2 * s.nu))
     shear = s.E / (2 * (1 + s.nu))
-    data = {"B0": s.B0, "lam": lmbda, "G": shear, "c_n": s.c_n, "m_n": s.m_n, "g": s.g,
-            "eps": s.eps, "mu": 0.0}
+    data = {"B0": s.B0, "lam": lmbda, "G": shear, "c_n": s.law.c_n, "m_n": s.law.m_n, "g": s.law.g,
+            "eps": s.law.eps, "mu": 0.0}
     for name, value in data.items():
         md.add_initialized_data(name, [value])
     md.add_initialized_data("b", [0.0, -s.weight / (s.L * s.H * s.B0)])
@@ -110,8 +110,8 @@ def getfem_worker(refine: int, repeats: int) -> dict:
 
     best = None
     for _ in range(repeats):
-        d0 = (s.contact_pressure / s.c_n) ** (1 / s.m_n)
-        md.set_variable("u", np.tile([0.0, -(d0 + s.g)], n // 2))
+        d0 = (s.contact_pressure / s.law.c_n) ** (1 / s.law.m_n)
+        md.set_variable("u", np.tile([0.0, -(d0 + s.law.g)], n // 2))
         steps = []
         for mu in MU_STEPS:
             md.set_variable("mu", [mu])
@@ -121,7 +121,7 @@ def getfem_worker(refine: int, repeats: int) -> dict:
             steps.append({"mu": float(mu), "newton_iterations": iterations,
                           "wall_time_s": time.perf_counter() - t0,
                           "spring_force": float(-s.K_x * u[spring_dof]),
-                          "max_penetration": float(np.maximum(-u[base_y] - s.g, 0).max())})
+                          "max_penetration": float(np.maximum(-u[base_y] - s.law.g, 0).max())})
         total = sum(step["wall_time_s"] for step in steps)
         if best is None or total < best["solve_time_s"]:
             best = {"solve_time_s": total, "steps": steps}

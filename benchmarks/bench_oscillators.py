@@ -71,7 +71,7 @@ class _TightFloquet:
 
 def _belt(out: dict) -> None:
     oscillator = BeltOscillator(m=1.0, k=1.0, c=0.0, N=1.0, v_belt=0.5,
-                                friction=laws.ConstantFriction(0.3), mu_static=0.6)
+                                law=laws.ConstantFriction(0.3), mu_static=0.6)
     exact = oscillator.classic_limit_cycle()
     runs = []
     cases = [("events", rtol, None) for rtol in EVENT_RTOL] + \

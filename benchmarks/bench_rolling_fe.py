@@ -27,28 +27,29 @@ from fenicsfriction.studies.rolling import closed_forms
 from fenicsfriction.studies.rolling.kalker import creep_coefficients
 from fenicsfriction.studies.rolling.model import RollingContact
 
-CARTER = {"dim": 2, "nu": 0.0, "mu": 0.3, "p0": 0.01}
+CARTER = {"dim": 2, "nu": 0.0, "p0": 0.01}
+MU = 0.3
 SMALL = 1e-6  # creepage of the linear theory (far below μ p0/G = 3e-3)
 
 
 def carter_row(cells: int, block: float) -> dict:
-    scene = RollingContact(**CARTER, cells_per_a=cells, block_size=block)
+    scene = RollingContact(**CARTER, cells_per_a=cells, block_size=block).with_law(mu=MU)
     model = scene.build()
     row = {"cells_per_a": cells, "block_size": block, "dofs": model.dofs}
     result = model.solve((SMALL, 0.0, 0.0))
     slope = np.pi * scene.a * scene.E_star / 2
     row["slope_error"] = -result.Fx / SMALL / slope - 1
-    saturation = scene.mu * scene.a / scene.radius
+    saturation = scene.law.mu * scene.a / scene.radius
     for q in (0.2, 0.5):
         xi = q * saturation
         result = model.solve((xi, 0.0, 0.0))
-        c = closed_forms.carter_stick_half_width(xi, scene.mu, scene.a, scene.radius)
-        exact = closed_forms.carter_traction(result.x[:, 0], xi, scene.mu, scene.a,
+        c = closed_forms.carter_stick_half_width(xi, scene.law.mu, scene.a, scene.radius)
+        exact = closed_forms.carter_traction(result.x[:, 0], xi, scene.law.mu, scene.a,
                                              scene.peak_pressure, scene.radius)
-        force = closed_forms.carter_force(xi, scene.mu, scene.a, scene.peak_pressure,
+        force = closed_forms.carter_force(xi, scene.law.mu, scene.a, scene.peak_pressure,
                                           scene.radius)
         row[f"q{q}"] = {
-            "force_error_over_muP": (result.Fx - force) / (scene.mu * scene.normal_load),
+            "force_error_over_muP": (result.Fx - force) / (scene.law.mu * scene.normal_load),
             "stick_end": float(result.x[result.stick(), 0].min()), "carter_stick_end": 1 - 2 * c,
             "traction_error_l2": float(np.linalg.norm(result.traction[:, 0] - exact)
                                        / np.linalg.norm(exact)),
@@ -59,7 +60,7 @@ def carter_row(cells: int, block: float) -> dict:
 
 def kalker_row(cells: int, nu: float, b: float) -> dict:
     scene = RollingContact(dim=3, nu=nu, b=b, p0=0.01, cells_per_a=cells, block_size=10.0,
-                           growth=1.5, eps=(10.0, 1.0, 0.1))
+                           growth=1.5, eps_sequence=(10.0, 1.0, 0.1))
     model = scene.build()
     area = scene.a * b
     fx = model.solve((SMALL, 0.0, 0.0))

@@ -68,8 +68,9 @@ def fe_rows(cells: list[int], comm: MPI.Comm) -> list[dict]:
     rows = []
     for n in cells:
         t0 = time.perf_counter()
-        scene = RollingContact(dim=3, block_size=10.0, growth=1.5, cells_per_a=n, eps=EPS,
-                               **CASE)
+        scene = RollingContact(dim=3, block_size=10.0, growth=1.5, cells_per_a=n,
+                               eps_sequence=EPS, **{k: v for k, v in CASE.items() if k != "mu"}
+                               ).with_law(mu=CASE["mu"])
         model = scene.build(comm)
         setup = time.perf_counter() - t0
         results = model.creep_curve([(xi, 0.0, 0.0) for xi in CREEPAGES])

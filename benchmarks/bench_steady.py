@@ -130,7 +130,7 @@ def run_mesh(refine: int, comm: MPI.Comm) -> dict:
         for mu in MU_SAMPLES:
             if np.isclose(q["mu"], mu):
                 samples[mu] = {**q, "penetration": None if uy is None
-                               else np.maximum(-uy - model.scene.g, 0.0)}
+                               else np.maximum(-uy - model.scene.law.g, 0.0)}
         return q
 
     # the baseline in the same run: a sparse LU at every Newton iteration, each step started

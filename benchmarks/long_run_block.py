@@ -134,7 +134,7 @@ def verdict(s: dict[str, np.ndarray], weight: float, stick_min: float) -> dict:
 
 def run_rigid(eps: float, t_end: float, out: pathlib.Path) -> pathlib.Path:
     """The rigid block of the same data to ``t_end``; its time series, written as it goes."""
-    scene = ff.BlockOnBelt(mu=MU, belt_speed=BELT_SPEED, b_n=B_N, eps=eps)
+    scene = ff.BlockOnBelt(belt_speed=BELT_SPEED, law=ff.InterfaceLaw(mu=MU, b_n=B_N, eps=eps))
     block = RigidBlock.from_scene(scene)
     solver = ReducedDynamics(model=block, q0=block.steady_state(),
                              q_dot0=[0.0, PERTURBATION, 0.0], prefix="long_rigid_ts_")

@@ -62,7 +62,7 @@ say = ff.results.get_logger(comm=comm).info
 # At rest the inertia term $\langle \rho \ddot u, v\rangle$ drops out of the steady form.
 
 # %%
-scene = ff.BlockOnBelt(mu=0.0)
+scene = ff.BlockOnBelt()  # the paper's law, eq. (36), with μ = 0
 model = scene.build(comm=comm, with_friction=True)
 R = model.residual
 say(f"R has {len(R.form.integrals())} integrals; steady form keeps "
@@ -148,3 +148,48 @@ say(f"with p = {p_top} on top: N = {q.normal_force:.2f} (expected {scene.weight 
 tol = resultant_tolerance(report.residual_norm)
 assert abs(q.normal_force - (scene.weight + extra)) <= tol
 assert abs(q.spring_force + q.mu * (scene.weight + extra)) <= (1 + q.mu) * tol
+
+# %% [markdown]
+# ## A friction law of our own
+# The interface law is one object, `ff.InterfaceLaw`, that every model takes. A friction
+# coefficient of our own — falling exponentially with the slip speed $s$ and rising with the
+# normal pressure $p$,
+#
+# $$ \mu(s, p) = \left(\mu_k + (\mu_s - \mu_k) e^{-s/v_s}\right)
+#    \left(1 + \frac{p}{p_{ref}}\right)^{\alpha}, $$
+#
+# — is written once with operations valid on UFL and NumPy (`ff.laws.exp`), wrapped in the law
+# and handed to the scene unchanged; the residual, its Jacobian and the observables follow
+# (see docs/user-law.md). In steady sliding every point of the base slips at the belt speed
+# $U_T$, so the friction resultant is $B_0 \int_{\Gamma_C} \mu(U_T, p)\, p \, ds$, and the
+# spring holds it.
+
+# %%
+MU_S, MU_K, V_S, P_REF, ALPHA = 0.6, 0.4, 0.1, 0.2, 0.3
+
+
+def user_mu(speed, pressure):
+    """μ(s, p): Stribeck-like in the slip speed, a power law in the pressure."""
+    return (MU_K + (MU_S - MU_K) * ff.laws.exp(-speed / V_S)) * (1 + pressure / P_REF) ** ALPHA
+
+
+user_scene = scene.with_law(friction_coefficient=user_mu)
+user_model = user_scene.build(comm=comm)
+user_model.initial_guess()
+user_report = ff.SteadySolver(user_model.residual, prefix="demo_user_",
+                              options=user_model.solver_options()).solve()
+qu = user_model.quantities()
+pressure = user_model.pressure()
+expected = comm.allreduce(fem.assemble_scalar(fem.form(
+    user_scene.B0 * user_mu(user_scene.belt_speed, pressure) * pressure
+    * user_model.ds_contact)), op=MPI.SUM)
+mean_pressure = user_scene.weight / (user_scene.L * user_scene.B0)
+say(f"user law: friction = {qu.friction_force:.3f} (∫ μ(U, p) p: {expected:.3f}), "
+    f"spring = {qu.spring_force:.3f}, apparent μ = {qu.friction_force / qu.normal_force:.4f} "
+    f"(μ at the mean pressure: {user_mu(user_scene.belt_speed, mean_pressure):.4f})")
+
+# %%
+tol = resultant_tolerance(user_report.residual_norm)
+assert abs(qu.normal_force - user_scene.weight) <= tol
+assert abs(qu.spring_force + qu.friction_force) <= 2 * tol
+assert np.isclose(qu.friction_force, expected, rtol=1e-10)

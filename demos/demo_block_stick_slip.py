@@ -92,7 +92,8 @@ interrupted: list[str] = []  # where this rank's runs stopped
 
 def belt_scene(belt_speed):
     """The data of Figs. 13-15 at one belt speed."""
-    return ff.BlockOnBelt(mu=MU, belt_speed=belt_speed, b_n=0.381e10, eps=EPS)
+    return ff.BlockOnBelt(belt_speed=belt_speed, law=ff.InterfaceLaw(mu=MU, b_n=0.381e10,
+                                                                      eps=EPS))
 
 
 # %% [markdown]
@@ -193,7 +194,7 @@ def run_rigid(block: RigidBlock, name: str, stem: str
     with CsvRows(path=out / f"timeseries_{stem}.csv", comm=MPI.COMM_SELF) as table:
         integrate(solver, records, observe=lambda t: rigid_block_observables(
             block, solver.q, solver.q_dot), on_step=on_step)
-    statistics = statistics_of(records, mu=block.mu, eps=block.eps)
+    statistics = statistics_of(records, mu=block.law.mu, eps=block.law.eps)
     about = {"belt_speed": block.belt_speed, "weight": block.weight,
              "unstable_eigenvalue": [growth.real, growth.imag],
              "wall_time_s": sum(r["wall_time_s"] for r in records)}

@@ -121,18 +121,20 @@ assert np.all(np.diff(np.abs(fx)) >= 0)
 # rolling direction at small creepage: `docs/rolling-fe.md`).
 
 # %%
-carter = RollingContact(dim=2, nu=0.0, mu=0.3, p0=0.01, block_size=100.0, cells_per_a=16)
-saturation = carter.mu * carter.a / carter.radius
+carter = RollingContact(dim=2, nu=0.0, p0=0.01, block_size=100.0,
+                        cells_per_a=16).with_law(mu=0.3)
+saturation = carter.law.mu * carter.a / carter.radius
 model = carter.build(comm)
 fractions = (0.1, 0.3, 0.5, 0.7, 0.9)
 results = model.creep_curve([(f * saturation, 0.0, 0.0) for f in fractions])
 P = carter.normal_load
 rows = []
 for f, r in zip(fractions, results, strict=True):
-    exact = closed_forms.carter_force(f * saturation, carter.mu, carter.a, carter.peak_pressure,
+    exact = closed_forms.carter_force(f * saturation, carter.law.mu, carter.a, carter.peak_pressure,
                                       carter.radius)
-    c = closed_forms.carter_stick_half_width(f * saturation, carter.mu, carter.a, carter.radius)
-    rows.append((f, r.Fx / (carter.mu * P), exact / (carter.mu * P), r.adhesion_fraction, c))
+    c = closed_forms.carter_stick_half_width(f * saturation, carter.law.mu, carter.a, carter.radius)
+    rows.append((f, r.Fx / (carter.law.mu * P), exact / (carter.law.mu * P), r.adhesion_fraction,
+                 c))
     say(f"Carter ξ = {f:.1f} ξ_sat: Fx/(μP) = {rows[-1][1]:+.4f} (Carter {rows[-1][2]:+.4f}), "
         f"adhesion {r.adhesion_fraction:.3f} of the contact (c/a = {c / carter.a:.3f}), "
         f"{r.newton_iterations} Newton its over {len(r.eps_records)} ε, {r.wall_time_s:.2f} s")
@@ -141,13 +143,13 @@ if comm.rank == 0:
     middle = results[2]
     grid = np.linspace(-carter.a, carter.a, 401)
     fig, ax = plt.subplots(figsize=(7, 3.8))
-    ax.plot(grid, closed_forms.carter_traction(grid, 0.5 * saturation, carter.mu, carter.a,
+    ax.plot(grid, closed_forms.carter_traction(grid, 0.5 * saturation, carter.law.mu, carter.a,
                                                carter.peak_pressure, carter.radius)
-            / (carter.mu * carter.peak_pressure), "k-", label="Carter (1926)")
-    ax.plot(middle.x[:, 0], middle.traction[:, 0] / (carter.mu * carter.peak_pressure), "o",
+            / (carter.law.mu * carter.peak_pressure), "k-", label="Carter (1926)")
+    ax.plot(middle.x[:, 0], middle.traction[:, 0] / (carter.law.mu * carter.peak_pressure), "o",
             ms=3.5, mfc="none", label=f"finite elements, h = a/{carter.cells_per_a}")
     stick = middle.stick()
-    ax.plot(middle.x[stick, 0], middle.traction[stick, 0] / (carter.mu * carter.peak_pressure),
+    ax.plot(middle.x[stick, 0], middle.traction[stick, 0] / (carter.law.mu * carter.peak_pressure),
             "o", ms=3.5, color="tab:green", label="adhesion")
     ax.set(xlabel="x / a (leading edge on the right)", ylabel="p_x / (μ p0)",
            title="Carter's cylinders at half the saturation creepage")
@@ -177,7 +179,8 @@ for f, force, exact, adhesion, c in rows:
 
 # %%
 ellipse = RollingContact(dim=3, block_size=10.0, growth=1.5, cells_per_a=CELLS_PER_A,
-                         eps=(10.0, 1.0, 0.1, 0.01), **WHEEL)
+                         eps_sequence=(10.0, 1.0, 0.1, 0.01),
+                         **{k: v for k, v in WHEEL.items() if k != "mu"}).with_law(mu=WHEEL["mu"])
 model3 = ellipse.build(comm)
 fe_xi = np.array([1e-6, 5e-4, 1e-3, 2e-3, 1e-2])
 fe = model3.creep_curve([(x, 0.0, 0.0) for x in fe_xi])
@@ -227,12 +230,12 @@ assert fe[1].adhesion_fraction > fe[2].adhesion_fraction > fe[3].adhesion_fracti
 # $s = \Delta u_\tau - \Delta u_\tau^{old} - \Delta\delta$.
 
 # %%
-spheres = RollingContact(dim=3, nu=0.0, mu=0.3, p0=0.01, cells_per_a=6, block_size=10.0,
-                         growth=1.5, eps=(1.0, 0.1, 0.01))
+spheres = RollingContact(dim=3, nu=0.0, p0=0.01, cells_per_a=6, block_size=10.0, growth=1.5,
+                         eps_sequence=(1.0, 0.1, 0.01)).with_law(mu=0.3)
 shifted = spheres.build(comm, kinematics="shift")
 steps = shifted.shift((2e-3 * spheres.a, 0.0), increments=2)
 final = steps[-1]
-q_ratio = final.Fx / (spheres.mu * final.Fn)
+q_ratio = final.Fx / (spheres.law.mu * final.Fn)
 c_exact = closed_forms.mindlin_stick_radius(spheres.a, q_ratio)
 c_fe = np.linalg.norm(final.x[final.stick()], axis=1).max()
 say(f"Cattaneo-Mindlin: Q/(μP) = {q_ratio:.3f}, stick radius {c_fe / spheres.a:.3f} a "

@@ -85,7 +85,7 @@ if comm.rank == 0:
 hertz = Hertz(dim=2)
 a, p0 = hertz.closed_form()
 model = TwoBodyModel(geometry.hertz_2d(comm, h_contact=H_CONTACT), hertz.materials,
-                     hertz.c_n, hertz.m_n, fix_load_face=True)
+                     hertz.law, fix_load_face=True)
 summary, model = hertz.run(comm, model)
 values = model.surface_values()
 x, p = values.x[:, 0], values.pressure
@@ -218,13 +218,13 @@ for dim in (2, 3):
 
 # %%
 cattaneo = Cattaneo(increments=5)
+mu = cattaneo.law.mu
 friction_model = TwoBodyModel(geometry.hertz_2d(comm, h_contact=H_CONTACT),
-                              cattaneo.materials, cattaneo.c_n, cattaneo.m_n, mu=cattaneo.mu,
-                              eps=cattaneo.eps)
+                              cattaneo.materials, cattaneo.law)
 summary_c, friction_model = cattaneo.run(comm, friction_model)
 values_c = friction_model.surface_values()
 xc, q = values_c.x[:, 0], -values_c.traction[:, 0]  # the traction on the cylinder opposes Q
-Q = cattaneo.q_ratio * cattaneo.mu * cattaneo.load
+Q = cattaneo.q_ratio * mu * cattaneo.load
 for row in summary_c["increments"]:
     say(f"Q/μP = {row['q_ratio']:.1f}: stick half-width {row['stick_half_width']:.4f} "
         f"(Cattaneo {row['cattaneo_stick_half_width']:.4f}), "
@@ -237,12 +237,12 @@ say(f"Cattaneo-Mindlin: traction L2 error {summary_c['traction_error_l2']:.2%}; 
 if comm.rank == 0:
     fig, ax = plt.subplots(figsize=(6, 3.5))
     fine = np.linspace(-1.2 * a, 1.2 * a, 481)
-    ax.plot(fine / a, closed_forms.cattaneo_traction(fine, a, p0, cattaneo.mu,
-                                                     cattaneo.q_ratio) / (cattaneo.mu * p0),
+    ax.plot(fine / a, closed_forms.cattaneo_traction(fine, a, p0, mu, cattaneo.q_ratio)
+            / (mu * p0),
             "k-", label="Cattaneo-Mindlin")
     ax.plot(fine / a, closed_forms.hertz_pressure(fine, a, p0) / p0, "k:", lw=1,
             label="μp (slip limit)")
-    ax.plot(xc / a, q / (cattaneo.mu * p0), "o", ms=4, label="node-to-segment")
+    ax.plot(xc / a, q / (mu * p0), "o", ms=4, label="node-to-segment")
     c = closed_forms.cattaneo_stick_half_width(a, cattaneo.q_ratio)
     ax.axvspan(-c / a, c / a, color="0.9", label="stick zone (closed form)")
     ax.set(xlim=(-1.2, 1.2), xlabel="x / a", ylabel="q / μp$_0$",

@@ -28,7 +28,6 @@ import ufl
 from dolfinx import fem
 
 from fenicsfriction import laws
-from fenicsfriction.laws import is_speed_law
 
 __all__ = [
     "NodalSpring",
@@ -38,7 +37,6 @@ __all__ = [
     "elasticity",
     "friction",
     "inertia",
-    "is_speed_law",
     "normal_compliance",
     "normal_damping",
     "normal_part",
@@ -106,42 +104,38 @@ def surface_traction(t: Field, v: Field, ds: ufl.Measure) -> ufl.Form:
 
 
 # --- interface terms on Γ_C (Martins & Oden 1986, eqs. 14-16) ----------------------------------
+# Each takes the interface law (:class:`fenicsfriction.laws.InterfaceLaw`), whose values a model
+# replaces by its ``fem.Constant`` (``law.replace(mu=..., c_n=...)``) to change them without
+# recompiling.
 
-def normal_compliance(u: Field, v: Field, n: Field, c_n: Value, m_n: Value, g: Value,
+def normal_compliance(u: Field, v: Field, n: Field, law: laws.InterfaceLaw,
                       ds: ufl.Measure) -> ufl.Form:
     """:math:`\\langle P(u), v\\rangle = \\int_{\\Gamma_C} c_n (u_n - g)_+^{m_n} v_n`."""
-    d = laws.penetration(normal_part(u, n), g)
-    return laws.normal_pressure(d, c_n, m_n) * normal_part(v, n) * ds
+    d = laws.penetration(normal_part(u, n), law.g)
+    return law.pressure(d) * normal_part(v, n) * ds
 
 
-def normal_damping(u: Field, u_dot: Field, v: Field, n: Field, b_n: Value, l_n: Value,
-                   g: Value, ds: ufl.Measure) -> ufl.Form:
+def normal_damping(u: Field, u_dot: Field, v: Field, n: Field, law: laws.InterfaceLaw,
+                   ds: ufl.Measure) -> ufl.Form:
     """:math:`\\langle D(u,\\dot u), v\\rangle = \\int_{\\Gamma_C} b_n d^{l_n} \\dot u_n v_n`."""
-    d = laws.penetration(normal_part(u, n), g)
-    return laws.normal_damping_pressure(d, normal_part(u_dot, n), b_n, l_n) \
-        * normal_part(v, n) * ds
+    d = laws.penetration(normal_part(u, n), law.g)
+    return law.damping_pressure(d, normal_part(u_dot, n)) * normal_part(v, n) * ds
 
 
-def friction(u: Field, u_dot: Field, v: Field, n: Field, c_T: Value | typing.Callable,
-             m_T: Value, g: Value, U_T: Field, eps: Value, ds: ufl.Measure,
-             regularisation: str = "c1", slip_rule: laws.SlipRule | None = None) -> ufl.Form:
+def friction(u: Field, u_dot: Field, v: Field, n: Field, law: laws.InterfaceLaw, U_T: Field,
+             ds: ufl.Measure) -> ufl.Form:
     """Regularised friction power :math:`\\langle J_\\varepsilon(u,\\dot u), v\\rangle`.
 
     .. math:: \\int_{\\Gamma_C} c_T\\, d^{m_T}\\, \\phi_\\varepsilon'(\\dot u_T - U_T)\\cdot v_T
 
-    that is :math:`-\\int t_T \\cdot v_T` with the traction
-    :func:`fenicsfriction.laws.friction_traction`.
-    ``c_T`` is a number/UFL value (Coulomb: :math:`\\mu c_n`), or a callable of the relative
-    slip speed :math:`|\\dot u_T - U_T|` for a velocity-dependent law, e.g.
-    ``lambda s: c_n * PiecewiseLinearFriction()(s)``; its slope then enters every derivative.
-    ``slip_rule`` (:data:`fenicsfriction.laws.SLIP_RULES`, default isotropic Coulomb) shapes
-    the traction, e.g. orthotropic friction with
-    :class:`~fenicsfriction.laws.EllipticSlipRule` (then ``c_T`` is its ``mu_ref * c_n``).
+    that is :math:`-\\int t_T \\cdot v_T` with the law's traction
+    (:meth:`fenicsfriction.laws.InterfaceLaw.friction_traction`): constant μ, a friction
+    coefficient law μ(speed, pressure) (its slopes then enter every derivative) and the law's
+    slip rule (e.g. orthotropic friction with :class:`~fenicsfriction.laws.EllipticSlipRule`).
     """
-    d = laws.penetration(normal_part(u, n), g)
+    d = laws.penetration(normal_part(u, n), law.g)
     w = tangential_part(u_dot, n) - U_T
-    traction = laws.friction_traction(d, w, c_T, m_T, eps, regularisation, slip_rule)
-    return -ufl.inner(traction, tangential_part(v, n)) * ds
+    return -ufl.inner(law.friction_traction(d, w), tangential_part(v, n)) * ds
 
 
 # --- nodal springs (point loads are not UFL integrals in dolfinx 0.5) ----------------------------

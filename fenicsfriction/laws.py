@@ -12,8 +12,10 @@ reduced models and post-processing) and returns the same kind. Notation (see doc
   Kalker 1986, §7).
 
 The two tractions of the interface on the body are defined here once, :func:`normal_traction`
-and :func:`friction_traction`; the residual's terms (:mod:`fenicsfriction.forms`), the scenes'
-observables and the reduced models all call them.
+and :func:`friction_traction`; :class:`InterfaceLaw` holds the law's parameters, friction
+coefficient law and slip rule, and exposes the tractions and their NumPy derivatives: the
+residual's terms (:mod:`fenicsfriction.forms`), the scenes' observables and the reduced models
+all take a law and call it.
 
 Parameters are validated in one place, :class:`InterfaceLaw`; a bad value raises ``ValueError``
 naming the parameter, its value and what is allowed.
@@ -32,6 +34,7 @@ from ufl.variable import Label
 
 __all__ = [
     "FRICTION_BOUND",
+    "FrictionLaw",
     "ConstantFriction",
     "CoulombSlipRule",
     "EllipticSlipRule",
@@ -48,13 +51,17 @@ __all__ = [
     "abs_smooth_derivative",
     "abs_smooth_second_derivative",
     "check",
+    "exp",
     "friction_bound",
     "friction_traction",
     "is_speed_law",
+    "maximum",
+    "minimum",
     "normal_damping_pressure",
     "normal_pressure",
     "normal_traction",
     "penetration",
+    "sqrt",
 ]
 
 Scalar: typing.TypeAlias = typing.Any  # a float, a NumPy array or a UFL expression
@@ -452,8 +459,8 @@ class ConstantFriction:
     def __post_init__(self) -> None:
         check("mu", self.mu, self.mu >= 0, "the friction coefficient must be >= 0")
 
-    def __call__(self, speed: Scalar) -> Scalar:
-        """μ at relative velocity ``speed``: the constant."""
+    def __call__(self, speed: Scalar, pressure: Scalar = None) -> Scalar:
+        """μ at relative velocity ``speed`` (any ``pressure``): the constant."""
         return self.mu + 0 * abs(speed)
 
     def derivative(self, speed: Scalar) -> np.ndarray:
@@ -481,9 +488,10 @@ class PiecewiseLinearFriction:
         check("slope", self.slope, mu_k >= 0,
               f"mu_s - slope*v_c must be >= 0 (got {mu_k:g}): mu may not turn negative")
 
-    def __call__(self, speed: Scalar) -> Scalar:
-        """μ at relative velocity ``speed`` (its magnitude is used: signed input is fine)."""
-        return self.mu_s - self.slope * _min(abs(speed), self.v_c)
+    def __call__(self, speed: Scalar, pressure: Scalar = None) -> Scalar:
+        """μ at relative velocity ``speed`` (its magnitude is used: signed input is fine; any
+        ``pressure``)."""
+        return self.mu_s - self.slope * minimum(abs(speed), self.v_c)
 
     def derivative(self, speed: Scalar) -> np.ndarray:
         """dμ/dv at the signed relative velocity ``speed`` (NumPy).
@@ -513,10 +521,11 @@ class StribeckFriction:
         check("v_s", self.v_s, self.v_s > 0, "the Stribeck speed must be > 0")
         check("exponent", self.exponent, self.exponent > 0, "the exponent must be > 0")
 
-    def __call__(self, speed: Scalar) -> Scalar:
-        """μ at relative velocity ``speed`` (its magnitude is used: signed input is fine)."""
+    def __call__(self, speed: Scalar, pressure: Scalar = None) -> Scalar:
+        """μ at relative velocity ``speed`` (its magnitude is used: signed input is fine; any
+        ``pressure``)."""
         ratio = abs(speed) / self.v_s
-        return self.mu_k + (self.mu_s - self.mu_k) * _exp(-(ratio**self.exponent))
+        return self.mu_k + (self.mu_s - self.mu_k) * exp(-(ratio**self.exponent))
 
     def derivative(self, speed: Scalar) -> np.ndarray:
         """dμ/dv at the signed relative velocity ``speed`` (NumPy); 0 at v = 0."""
@@ -531,59 +540,218 @@ class StribeckFriction:
 FrictionCoefficient = ConstantFriction | PiecewiseLinearFriction | StribeckFriction
 
 
-# --- the interface law as a validated parameter set ---------------------------------------------
+# --- operations valid on UFL, NumPy and the dual numbers of the derivatives --------------------
 
-@dataclasses.dataclass
+class _Dual:
+    """A forward-mode dual number :math:`a + b\\,\\delta` (:math:`\\delta^2 = 0`) over NumPy
+    arrays: a friction coefficient law evaluated on one carries its derivative along, so that
+    :meth:`InterfaceLaw.friction_traction_derivatives` differentiates a user's μ(speed,
+    pressure) without a derivative written by hand or a finite-difference step."""
+
+    __array_ufunc__ = None  # NumPy defers to the operators below
+
+    def __init__(self, value: typing.Any, slope: typing.Any):
+        self.value, self.slope = np.asarray(value, dtype=float), np.asarray(slope, dtype=float)
+
+    @staticmethod
+    def lift(x: typing.Any) -> _Dual:
+        return x if isinstance(x, _Dual) else _Dual(x, 0.0)
+
+    def __add__(self, other: typing.Any) -> _Dual:
+        o = _Dual.lift(other)
+        return _Dual(self.value + o.value, self.slope + o.slope)
+
+    __radd__ = __add__
+
+    def __neg__(self) -> _Dual:
+        return _Dual(-self.value, -self.slope)
+
+    def __sub__(self, other: typing.Any) -> _Dual:
+        return self + (-_Dual.lift(other))
+
+    def __rsub__(self, other: typing.Any) -> _Dual:
+        return _Dual.lift(other) - self
+
+    def __mul__(self, other: typing.Any) -> _Dual:
+        o = _Dual.lift(other)
+        return _Dual(self.value * o.value, self.slope * o.value + self.value * o.slope)
+
+    __rmul__ = __mul__
+
+    def __truediv__(self, other: typing.Any) -> _Dual:
+        o = _Dual.lift(other)
+        return _Dual(self.value / o.value,
+                     (self.slope * o.value - self.value * o.slope) / o.value**2)
+
+    def __rtruediv__(self, other: typing.Any) -> _Dual:
+        return _Dual.lift(other) / self
+
+    def __pow__(self, exponent: typing.Any) -> _Dual:
+        check("exponent", exponent, not isinstance(exponent, _Dual),
+              "a dual number's exponent must be a number (write exp(b log a))")
+        value = self.value**exponent
+        with np.errstate(divide="ignore", invalid="ignore"):
+            slope = np.where(self.slope == 0, 0.0,
+                             exponent * self.value ** (exponent - 1) * self.slope)
+        return _Dual(value, slope)
+
+    def __rpow__(self, base: typing.Any) -> _Dual:
+        return exp(self * np.log(base))
+
+    def __abs__(self) -> _Dual:
+        return _Dual(np.abs(self.value), np.sign(self.value) * self.slope)
+
+    def exp(self) -> _Dual:
+        e = np.exp(self.value)
+        return _Dual(e, e * self.slope)
+
+    def sqrt(self) -> _Dual:
+        r = np.sqrt(self.value)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return _Dual(r, np.where(self.slope == 0, 0.0, self.slope / (2 * r)))
+
+    def select(self, mask: typing.Any, other: typing.Any) -> _Dual:
+        """``self`` where ``mask``, else ``other``."""
+        o = _Dual.lift(other)
+        return _Dual(np.where(mask, self.value, o.value), np.where(mask, self.slope, o.slope))
+
+
+def _value(x: typing.Any) -> typing.Any:
+    return x.value if isinstance(x, _Dual) else x
+
+
+def exp(x: Scalar) -> Scalar:
+    """:math:`e^x` of a UFL expression, a NumPy value or a dual number (write a user's
+    friction coefficient law with it: :class:`InterfaceLaw`)."""
+    if isinstance(x, _Dual):
+        return x.exp()
+    return _exp(x)
+
+
+def sqrt(x: Scalar) -> Scalar:
+    """:math:`\\sqrt{x}` of a UFL expression, a NumPy value or a dual number."""
+    return x.sqrt() if isinstance(x, _Dual) else _sqrt(x)
+
+
+def maximum(a: Scalar, b: Scalar) -> Scalar:
+    """max(a, b) of UFL expressions, NumPy values or dual numbers."""
+    if isinstance(a, _Dual) or isinstance(b, _Dual):
+        a, b = _Dual.lift(a), _Dual.lift(b)
+        return a.select(a.value >= b.value, b)
+    return _max(a, b)
+
+
+def minimum(a: Scalar, b: Scalar) -> Scalar:
+    """min(a, b) of UFL expressions, NumPy values or dual numbers."""
+    if isinstance(a, _Dual) or isinstance(b, _Dual):
+        a, b = _Dual.lift(a), _Dual.lift(b)
+        return a.select(a.value <= b.value, b)
+    return _min(a, b)
+
+
+# --- the interface law: one object, its tractions and their derivatives --------------------------
+
+FrictionLaw: typing.TypeAlias = typing.Callable[[typing.Any, typing.Any], typing.Any]
+"""A friction coefficient μ(speed, pressure): the built-in laws, or a user's function."""
+
+
+@dataclasses.dataclass(frozen=True)
 class InterfaceLaw:
-    """Normal compliance and regularised Coulomb-type friction on :math:`\\Gamma_C`.
+    """The interface law of Martins & Oden (1986, eqs. 1-2): normal compliance, normal damping
+    and regularised friction on :math:`\\Gamma_C`, the one object every model with an interface
+    takes.
+
+    Tractions on the body at penetration :math:`d` and slip velocity :math:`w`:
+
+    * normal: :math:`p = c_n d^{m_n} + b_n d^{l_n} \\dot d` (:meth:`normal_traction`);
+    * friction: :math:`t = -c_n \\mu(|w|, p_e)\\, d^{m_T} \\phi_\\varepsilon'(w)`, the bound
+      :math:`c_T d^{m_T}` with :math:`c_T = \\mu c_n` (:meth:`friction_traction`), where
+      :math:`p_e = c_n d^{m_n}` is the elastic pressure and μ the constant ``mu`` or the law
+      ``friction_coefficient``; with an :class:`EllipticSlipRule` the bound is
+      :math:`\\mu_{ref} c_n d^{m_T}` and the rule shapes the traction.
+
+    Each method takes UFL (forms) or NumPy (reduced models, post-processing) input and returns
+    the same kind; the NumPy derivatives (:meth:`normal_traction_derivatives`,
+    :meth:`friction_traction_derivatives`) differentiate a friction coefficient law with dual
+    numbers, so a user's law needs no derivative (see docs/user-law.md).
+
+    A finite element model hands the law its ``fem.Constant`` values with :meth:`replace`
+    (``law.replace(mu=mu_constant, c_n=...)``): UFL values are not validated, the others are.
 
     Args:
-        c_n: normal compliance coefficient [force / length^(2+m_n)] (pressure per d^m_n).
+        c_n: normal compliance coefficient [force / length^(2+m_n)] (pressure per d^m_n), > 0
+            (default: the block of Martins & Oden 1986, eq. 36, in 10^3 kg cm^(-1-m_n) s^-2).
         m_n: normal compliance exponent [-], >= 1 (experiments: 2 to 3.33).
-        mu: friction coefficient c_T / c_n [-] (Coulomb when m_T = m_n and b_n = 0).
-        m_T: friction exponent [-]; ``None`` means m_T = m_n (Coulomb).
+        mu: friction coefficient c_T / c_n [-], >= 0 (Coulomb when m_T = m_n and b_n = 0).
+        m_T: friction exponent [-], >= 1; ``None`` means m_T = m_n (Coulomb).
         b_n: normal damping coefficient [force time / length^(3+l_n)], >= 0.
-        l_n: normal damping exponent [-]; ``None`` means l_n = m_n.
+        l_n: normal damping exponent [-], >= 1; ``None`` means l_n = m_n.
         g: initial gap [length], >= 0.
-        eps: regularisation parameter of |u̇_T - U_T| [length / time], > 0.
+        eps: regularisation parameter ε of |u̇_T - U_T| [length / time], > 0.
         regularisation: ``"c1"`` (φ_ε, Pop, eq. 15) or ``"smooth"`` (ψ_ε, Kalker 1986, eq. 40).
-        friction_coefficient: optional velocity-dependent μ(|v|); when given it replaces ``mu``.
+        friction_coefficient: μ(speed, pressure) replacing ``mu``: a law of this module
+            (:class:`ConstantFriction`, :class:`StribeckFriction`,
+            :class:`PiecewiseLinearFriction`) or a user's function of the slip speed |w| and
+            the elastic pressure :math:`c_n d^{m_n}` written with operations valid on UFL and
+            NumPy (``+ - * / **``, :func:`exp`, :func:`sqrt`, :func:`maximum`,
+            :func:`minimum`, ``abs``).
+        slip_rule: the slip surface and rule (:data:`SLIP_RULES`); ``None``: isotropic Coulomb.
     """
 
-    c_n: float
-    m_n: float
-    mu: float = 0.0
+    c_n: Scalar = 1e10
+    m_n: float = 2.5
+    mu: Scalar = 0.0
     m_T: float = None  # type: ignore[assignment]  # None: set by __post_init__
-    b_n: float = 0.0
+    b_n: Scalar = 0.0
     l_n: float = None  # type: ignore[assignment]  # None: set by __post_init__
-    g: float = 0.0
-    eps: float = 1e-3
+    g: Scalar = 0.0
+    eps: Scalar = 1e-3
     regularisation: str = "c1"
-    friction_coefficient: FrictionCoefficient | None = None
+    friction_coefficient: FrictionLaw | None = None
+    slip_rule: SlipRule | None = None
 
     def __post_init__(self) -> None:
         if self.m_T is None:
-            self.m_T = self.m_n
+            object.__setattr__(self, "m_T", self.m_n)
         if self.l_n is None:
-            self.l_n = self.m_n
+            object.__setattr__(self, "l_n", self.m_n)
         self.validate()
 
     def validate(self) -> None:
-        """Check every parameter; raise ``ValueError`` naming the first bad one."""
+        """Check every parameter; raise ``ValueError`` naming the first bad one. UFL values
+        (a model's ``fem.Constant``) are left to the model."""
         for name in ("c_n", "m_n", "mu", "m_T", "b_n", "l_n", "g", "eps"):
             value = getattr(self, name)
-            check(name, value, isinstance(value, (int, float)) and math.isfinite(value),
+            if _is_ufl(value):
+                continue
+            check(name, value, isinstance(value, numbers.Real) and math.isfinite(value),
                   "must be a finite real number")
-        check("c_n", self.c_n, self.c_n > 0, "the normal compliance coefficient must be > 0")
+        numeric = {name: getattr(self, name) for name in ("c_n", "mu", "b_n", "g", "eps")
+                   if not _is_ufl(getattr(self, name))}
+        check("c_n", self.c_n, numeric.get("c_n", 1.0) > 0,
+              "the normal compliance coefficient must be > 0")
         check("m_n", self.m_n, self.m_n >= 1, "the normal exponent must be >= 1")
         check("m_T", self.m_T, self.m_T >= 1, "the friction exponent must be >= 1")
-        check("mu", self.mu, self.mu >= 0, "the friction coefficient must be >= 0")
-        check("b_n", self.b_n, self.b_n >= 0, "the normal damping coefficient must be >= 0")
+        check("mu", self.mu, numeric.get("mu", 0.0) >= 0, "the friction coefficient must be >= 0")
+        check("b_n", self.b_n, numeric.get("b_n", 0.0) >= 0,
+              "the normal damping coefficient must be >= 0")
         check("l_n", self.l_n, self.l_n >= 1, "the damping exponent must be >= 1")
-        check("g", self.g, self.g >= 0, "the initial gap must be >= 0")
-        check("eps", self.eps, self.eps > 0, "the regularisation parameter must be > 0")
+        check("g", self.g, numeric.get("g", 0.0) >= 0, "the initial gap must be >= 0")
+        check("eps", self.eps, numeric.get("eps", 1.0) > 0,
+              "the regularisation parameter must be > 0")
         check("regularisation", self.regularisation, self.regularisation in REGULARISATIONS,
               f"must be one of {sorted(REGULARISATIONS)}")
+        check("friction_coefficient", self.friction_coefficient,
+              self.friction_coefficient is None or callable(self.friction_coefficient),
+              "must be None or a function mu(speed, pressure)")
+        check("slip_rule", self.slip_rule,
+              self.slip_rule is None or isinstance(self.slip_rule, SLIP_RULES),
+              f"must be None or one of {', '.join(r.__name__ for r in SLIP_RULES)}")
+
+    def replace(self, **changes: typing.Any) -> InterfaceLaw:
+        """A copy with ``changes`` (validated; UFL values, e.g. a model's ``fem.Constant``,
+        are taken as they are)."""
+        return dataclasses.replace(self, **changes)
 
     @property
     def coulomb(self) -> bool:
@@ -591,11 +759,123 @@ class InterfaceLaw:
         return self.m_T == self.m_n and self.b_n == 0 and self.friction_coefficient is None
 
     @property
-    def c_T(self) -> float:
-        """Friction coefficient of the bound c_T = μ c_n."""
+    def has_friction(self) -> bool:
+        """True unless μ = 0 with no friction coefficient law or slip rule."""
+        return not (isinstance(self.mu, numbers.Real) and self.mu == 0) \
+            or self.friction_coefficient is not None or self.slip_rule is not None
+
+    @property
+    def c_T(self) -> Scalar:
+        """The constant friction coefficient of the bound :math:`c_T = \\mu c_n`
+        (:math:`\\mu_{ref} c_n` with an :class:`EllipticSlipRule`)."""
+        if isinstance(self.slip_rule, EllipticSlipRule):
+            return self.slip_rule.mu_ref * self.c_n
         return self.mu * self.c_n
 
     def uniform_penetration(self, pressure: float) -> float:
         """Penetration under a uniform pressure p: d = (p / c_n)^(1/m_n) (no damping)."""
         check("pressure", pressure, pressure >= 0, "must be >= 0")
         return (pressure / self.c_n) ** (1.0 / self.m_n)
+
+    # --- tractions (UFL or NumPy) ----------------------------------------------------------------
+    def pressure(self, d: Scalar) -> Scalar:
+        """Elastic normal pressure :math:`c_n d^{m_n}` (:func:`normal_pressure`)."""
+        return normal_pressure(d, self.c_n, self.m_n)
+
+    def damping_pressure(self, d: Scalar, approach_rate: Scalar) -> Scalar:
+        """Normal damping :math:`b_n d^{l_n} \\dot d` (:func:`normal_damping_pressure`)."""
+        return normal_damping_pressure(d, approach_rate, self.b_n, self.l_n)
+
+    def normal_traction(self, d: Scalar, approach_rate: Scalar = 0.0) -> Scalar:
+        """Normal pressure on the body :math:`c_n d^{m_n} + b_n d^{l_n} \\dot d`
+        (:func:`fenicsfriction.laws.normal_traction`)."""
+        return normal_traction(d, self.c_n, self.m_n, approach_rate, self.b_n, self.l_n)
+
+    def coefficient(self, speed: Scalar, pressure: Scalar) -> Scalar:
+        """μ at slip speed ``speed`` and elastic pressure ``pressure``."""
+        if self.friction_coefficient is None:
+            return self.mu + 0 * speed
+        return self.friction_coefficient(speed, pressure)
+
+    def coefficient_slope(self, speed: typing.Any, pressure: typing.Any) -> np.ndarray:
+        """∂μ/∂speed at ``speed`` >= 0 and ``pressure`` (NumPy): a law's own ``derivative``
+        where it has one (the laws of this module), else the law evaluated on dual numbers
+        (a user's function needs no derivative)."""
+        law = self.friction_coefficient
+        if law is None:
+            return 0.0 * np.asarray(speed, dtype=float)
+        derivative = getattr(law, "derivative", None)
+        if derivative is not None:
+            return derivative(speed)
+        return _Dual.lift(law(_Dual(speed, 1.0), pressure)).slope
+
+    def direction(self, w: typing.Any) -> typing.Any:
+        """The regularised direction :math:`\\phi_\\varepsilon'(w)` of the slip ``w`` (UFL
+        vector or NumPy), of the law's regularisation and ε (:data:`REGULARISATIONS`)."""
+        return REGULARISATIONS[self.regularisation][1](w, self.eps)
+
+    def friction_force(self, normal_force: typing.Any, w: typing.Any) -> typing.Any:
+        """The regularised friction force of a point contact pressed with the normal force
+        ``normal_force`` N at slip velocity ``w`` (NumPy, one tangent direction):
+        :math:`-\\mu(|w|, N)\\, N\\, \\phi_\\varepsilon'(w)`, the traction of
+        :meth:`friction_traction` with the bound μN of a mesh-free model (the compliance
+        c_n, m_n is not used: N is the model's own; μ reads N as its pressure)."""
+        return -self.coefficient(abs(w), normal_force) * normal_force * self.direction(w)
+
+    def _c_T(self, d: Scalar) -> typing.Any:
+        """c_T of :func:`fenicsfriction.laws.friction_traction`: μ c_n, or c_n μ(|w|, p_e) as a
+        function of the slip speed."""
+        if self.friction_coefficient is None:
+            return self.c_T
+        law, pressure = self.friction_coefficient, self.pressure(d)
+        return lambda speed: self.c_n * law(speed, pressure)
+
+    def friction_bound(self, d: Scalar, speed: Scalar = 0.0) -> Scalar:
+        """The friction bound :math:`c_T d^{m_T}` at slip speed ``speed``
+        (:func:`fenicsfriction.laws.friction_bound`)."""
+        c_T = self._c_T(d)
+        return friction_bound(d, c_T(speed) if is_speed_law(c_T) else c_T, self.m_T)
+
+    def friction_traction(self, d: Scalar, w: typing.Any) -> typing.Any:
+        """Regularised friction traction on the body at penetration ``d`` and slip velocity
+        ``w`` (UFL vector, or NumPy: one tangent direction), the bound labelled
+        :data:`FRICTION_BOUND` (:func:`fenicsfriction.laws.friction_traction`)."""
+        return friction_traction(d, w, self._c_T(d), self.m_T, self.eps, self.regularisation,
+                                 self.slip_rule)
+
+    def stick_curvature(self) -> Scalar:
+        """:math:`\\phi_\\varepsilon''(0)` of the regularisation (1/ε for both): inside the band
+        the friction traction is the tangential damping
+        :math:`c_T(0) d^{m_T} \\phi_\\varepsilon''(0)` (:meth:`friction_bound` at zero speed)."""
+        return REGULARISATIONS[self.regularisation][2](0.0, self.eps)
+
+    # --- NumPy derivatives (reduced models' linearisations) -------------------------------------
+    def normal_traction_derivatives(self, d: typing.Any, approach_rate: typing.Any = 0.0
+                                    ) -> tuple[np.ndarray, np.ndarray]:
+        """(∂p/∂d, ∂p/∂ḋ) of :meth:`normal_traction` (NumPy, d > 0)."""
+        mn, ln = self.m_n, self.l_n
+        dp_dd = mn * self.c_n * d ** (mn - 1) + ln * self.b_n * d ** (ln - 1) * approach_rate
+        return dp_dd, self.b_n * d**ln
+
+    def friction_traction_derivatives(self, d: typing.Any, w: typing.Any
+                                      ) -> tuple[np.ndarray, np.ndarray]:
+        """(∂t/∂d, ∂t/∂w) of :meth:`friction_traction` for a scalar slip ``w`` (one tangent
+        direction, NumPy, d > 0). A friction coefficient law is differentiated exactly by
+        evaluating it on dual numbers; the slip rule must be Coulomb's."""
+        check("slip_rule", self.slip_rule,
+              self.slip_rule is None or isinstance(self.slip_rule, CoulombSlipRule),
+              "the NumPy derivatives are those of the isotropic (Coulomb) rule")
+        _, first, second = REGULARISATIONS[self.regularisation]
+        dphi, ddphi = first(w, self.eps), second(w, self.eps)
+        mT = self.m_T
+        if self.friction_coefficient is None:
+            c_T = self.c_T
+            return -mT * c_T * d ** (mT - 1) * dphi, -c_T * d**mT * ddphi
+        law, speed, pressure = self.friction_coefficient, np.abs(w), self.pressure(d)
+        mu = _value(law(speed, pressure))
+        dmu_ds = _Dual.lift(law(_Dual(speed, 1.0), pressure)).slope
+        dmu_dp = _Dual.lift(law(speed, _Dual(pressure, 1.0))).slope
+        dp_dd = self.m_n * self.c_n * d ** (self.m_n - 1)
+        dt_dd = -self.c_n * (dmu_dp * dp_dd * d**mT + mu * mT * d ** (mT - 1)) * dphi
+        dt_dw = -self.c_n * d**mT * (dmu_ds * np.sign(w) * dphi + mu * ddphi)
+        return dt_dd, dt_dw

@@ -16,7 +16,7 @@ from fenicsfriction.studies.oscillators.belt import BeltOscillator
 def classic(**kwargs) -> BeltOscillator:
     """c = 0, μ_k = 0.3 < μ_s = 0.5, ω = 1, v_b = 1: T = 6.288, 6 % of it stuck."""
     parameters = {"m": 1.0, "k": 1.0, "c": 0.0, "N": 1.0, "v_belt": 1.0,
-                      "friction": laws.ConstantFriction(0.3), "mu_static": 0.5}
+                  "law": laws.InterfaceLaw(mu=0.3, regularisation="smooth"), "mu_static": 0.5}
     return BeltOscillator(**{**parameters, **kwargs})
 
 
@@ -33,7 +33,7 @@ def test_perturbations_of_steady_sliding_grow_or_decay_at_the_linear_rate(law, s
     N = 10.0
     c_boundary = -N * float(friction.derivative(v_belt))  # c + N μ'(v_b) = 0
     oscillator = BeltOscillator(m=1.0, k=1.0, c=(1 + side) * c_boundary, N=N, v_belt=v_belt,
-                                friction=friction)
+                                law=friction)
     rate = oscillator.linear_eigenvalues().real
     expected = -side * c_boundary / 2  # Re s = -(c + N μ')/(2m)
     assert rate == pytest.approx([expected, expected], rel=1e-12)
@@ -88,7 +88,7 @@ def test_regularised_law_approaches_the_stick_slip_cycle_as_eps_vanishes():
 
 def test_momentum_balance_holds_across_stick_slip_events():
     friction = laws.StribeckFriction(mu_s=0.5, mu_k=0.3, v_s=0.5)
-    oscillator = BeltOscillator(m=2.0, k=1.0, c=0.05, N=1.0, v_belt=0.2, friction=friction)
+    oscillator = BeltOscillator(m=2.0, k=1.0, c=0.05, N=1.0, v_belt=0.2, law=friction)
     h = 2e-3
     result = oscillator.simulate(40.0, x0=0.0, v0=0.0, sample_dt=h)
     sticks = result.stick_intervals

@@ -132,7 +132,7 @@ def test_distributed_steady_state_matches_serial_on_every_rank():
     xa, da = contact_profile(world)
     xb, db = contact_profile(alone)
     assert xa == pytest.approx(xb, abs=1e-12)
-    relative = 10 * bound / (scene.m_n * scene.weight)
+    relative = 10 * bound / (scene.law.m_n * scene.weight)
     assert np.abs(da - db).max() <= relative * db.max() + 1e-15
 
 
@@ -146,7 +146,7 @@ def test_dynamics_grows_at_the_unstable_eigenvalues_rate():
     1.4 % at twice the step). Tolerances 3 % on σ and 0.5 % on ω. The amplitude stays below
     1e-6 cm, 2 % of the penetration, so the motion is linear.
     """
-    scene = ff.BlockOnSlab(**STIFF, mu=0.4)
+    scene = ff.BlockOnSlab(**STIFF, law=ff.InterfaceLaw(mu=0.4))
     model, _, _ = sliding(scene, 0.4, prefix="growth_")
     modes = StabilitySolver(model.residual, prefix="growth_pep_").solve(MAX_MODULUS)
     lam = max(modes, key=lambda m: m.value.real).value

@@ -57,7 +57,7 @@ def test_fastsim_curve_rises_to_saturation_with_one_record_per_point(shared_tmp_
 def test_fe_carter_curve_against_the_closed_form(shared_tmp_path):
     out = shared_tmp_path / "carter"
     G, nu, mu, a, Fn = 1.0, 0.3, 0.3, 1.0, 0.01
-    scene = RollingContact(dim=2, a=a, G=G, nu=nu, mu=mu, Fn=Fn)
+    scene = RollingContact(dim=2, a=a, G=G, nu=nu, Fn=Fn)  # mu acts on neither p0 nor R
     saturation = mu * a / scene.radius
     assert main(["rolling", "curve", "--method", "fe", "--dim", "2", "--a", str(a), "--G", str(G),
                  "--nu", str(nu), "--mu", str(mu), "--Fn", str(Fn), "--cells-per-a", "16",

@@ -18,6 +18,7 @@ from two_blocks import MASTER, SLAVE, UPPER, stacked_blocks
 from fenicsfriction import _compat
 from fenicsfriction.contact import NodeToSegment, solve_with_search
 from fenicsfriction.contact.pairing import point_facet_distance, surface_coordinates
+from fenicsfriction.laws import InterfaceLaw
 
 
 def _contact(dim: int, friction: bool, overlap: float = 0.02, comm=MPI.COMM_WORLD,
@@ -32,10 +33,12 @@ def _contact(dim: int, friction: bool, overlap: float = 0.02, comm=MPI.COMM_WORL
     for f, scale in ((u, 0.01), (u_old, 0.005)):
         f.x.array[:] = (scale * np.sin(x @ k[:dim].T + k[2])).ravel()
         f.x.scatter_forward()
-    law = {"c_n": 100.0, "m_n": 2.0}
+    law = InterfaceLaw(c_n=100.0, m_n=2.0)
+    options = {}
     if friction:
-        law.update(c_T=50.0, velocity=(u - u_old) / 0.1, fields=[u_old], eps=1e-2)
-    contact = NodeToSegment(u, ft, SLAVE, MASTER, frozen=frozen, **law)
+        law = law.replace(mu=0.5, eps=1e-2)
+        options = {"velocity": (u - u_old) / 0.1, "fields": [u_old]}
+    contact = NodeToSegment(u, ft, SLAVE, MASTER, law, frozen=frozen, **options)
     contact.cell_tags = cell_tags
     return contact, u
 
@@ -153,19 +156,20 @@ def test_search_between_solves_reaches_a_fixed_point():
 
 
 def test_perturbed_lagrangian_approaches_the_compliance_law_as_its_penalty_grows():
-    """Cattaneo-Mindlin with Pop's perturbed Lagrangian (normal penalty c_n, tangential ε_T)
+    """Cattaneo-Mindlin with Pop's perturbed Lagrangian (normal penalty c_n, tangential κ_T)
     and with the compliance law (the same linear normal penalty, friction regularised by a
-    small ε): the normal pressures coincide, and the tangential tractions draw together as ε_T
+    small ε): the normal pressures coincide, and the tangential tractions draw together as κ_T
     grows (the stick spring stiffens towards the regularised law's rigid stick)."""
     from fenicsfriction.studies.contact.validation import Cattaneo
 
     common = {"h_contact": 0.01, "increments": 2}
-    _, model = Cattaneo(eps=1e-6, **common).run()
+    _, model = Cattaneo(**common).with_law(eps=1e-6).run()
     reference = model.surface_values()
     scale = np.abs(reference.traction).max()
     distances = []
-    for eps_T in (1e2, 1e3):
-        _, model = Cattaneo(formulation="perturbed-lagrangian", eps_T=eps_T, **common).run()
+    for penalty_T in (1e2, 1e3):
+        _, model = Cattaneo(formulation="perturbed-lagrangian", penalty_T=penalty_T,
+                            **common).run()
         values = model.surface_values()
         # the same normal penalty; the tangential law moves the approach by ~1e-3
         assert np.allclose(values.pressure, reference.pressure,
@@ -185,7 +189,7 @@ def test_hertz_converges_as_the_compliance_stiffens():
 
     widths, peaks = [], []
     for c_n in (1e2, 1e3, 1e4):
-        summary, _ = Hertz(c_n=c_n, h_contact=0.01).run()
+        summary, _ = Hertz(h_contact=0.01).with_law(c_n=c_n).run()
         widths.append(summary["half_width"])
         peaks.append(summary["max_pressure"])
     for values in (widths, peaks):

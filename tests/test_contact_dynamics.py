@@ -25,12 +25,12 @@ def _static_penetration(scene: PressAndDrag) -> float:
     """Hertz's peak pressure over c_n: the static penetration of linear compliance."""
     from fenicsfriction.studies.contact.closed_forms import hertz_line_contact
     _, p0 = hertz_line_contact(scene.load, scene.radius, scene.E_star)
-    return p0 / scene.c_n
+    return p0 / scene.law.c_n
 
 
 @pytest.mark.parametrize("scheme", ["alpha2", "central"])
 def test_pressing_the_cylinder_balances_energy_without_runaway(scheme):
-    scene = PressAndDrag(mu=0.0, t_end=1.8, h_contact=H)
+    scene = PressAndDrag(t_end=1.8, h_contact=H).with_law(mu=0.0)
     # dt = 0.02 resolves the contact springs' period (~0.04 for a few nodes of c_n h): at
     # 0.05 generalized-α damps them and the balance drifts by 20-50 % (docs/contact.md)
     records, summary = scene.run(scheme=scheme, dt=0.02)
@@ -46,8 +46,8 @@ def test_dragging_the_cylinder_with_friction_dissipates_without_runaway():
     12's gmsh mesh but only to 2-3 % on Debian 13's (1278 instead of 1286 unknowns, the same
     sizes) and drifts by O(1) at dt = 0.01; the stiff stick band's discrete energy is an open
     problem (docs/contact.md)."""
-    scene = PressAndDrag(mu=0.3, q_ratio=1.5, drag_start=1.5, drag_end=2.5, t_end=3.0,
-                         h_contact=H)
+    scene = PressAndDrag(q_ratio=1.5, drag_start=1.5, drag_end=2.5, t_end=3.0,
+                         h_contact=H).with_law(mu=0.3)
     records, summary = scene.run(scheme="alpha2", dt=0.02)
     assert records[-1]["time"] == pytest.approx(scene.t_end)
     assert records[-1]["dissipated"] > 0
@@ -59,8 +59,8 @@ def test_stick_transitions_cut_the_step_back_and_the_run_goes_on():
     """A narrow regularisation (ε = 1e-4) and a long step: Newton fails where nodes enter
     stick, the step is cut back and grows again, and the run reaches its end with the balance
     closed (measured 41 cut-backs, 0.1 %)."""
-    scene = PressAndDrag(mu=0.3, q_ratio=1.5, eps=1e-4, drag_start=1.5, drag_end=2.5,
-                         t_end=3.0, h_contact=H)
+    scene = PressAndDrag(q_ratio=1.5, drag_start=1.5, drag_end=2.5, t_end=3.0,
+                         h_contact=H).with_law(mu=0.3, eps=1e-4)
     records, summary = scene.run(scheme="alpha2", dt=0.05)
     assert records[-1]["time"] == pytest.approx(scene.t_end)
     assert summary["rejected_steps"] > 0
@@ -70,7 +70,7 @@ def test_stick_transitions_cut_the_step_back_and_the_run_goes_on():
 
 @pytest.mark.mpi
 def test_two_ranks_integrate_the_serial_motion():
-    scene = PressAndDrag(mu=0.0, t_end=1.0, h_contact=H)
+    scene = PressAndDrag(t_end=1.0, h_contact=H).with_law(mu=0.0)
     here, _ = scene.run(scheme="alpha2", dt=0.02, comm=MPI.COMM_WORLD)
     alone, _ = scene.run(scheme="alpha2", dt=0.02, comm=MPI.COMM_SELF)
     for key in ("kinetic", "elastic", "contact_energy"):

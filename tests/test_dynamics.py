@@ -15,7 +15,7 @@ from fenicsfriction.stability import StabilitySolver
 
 def steady_block(mu: float, comm=MPI.COMM_WORLD, prefix="dyn", **scene):
     """A converged steady sliding state of the block at μ."""
-    model = ff.BlockOnBelt(mu=mu, **scene).build(comm, with_friction=mu > 0)
+    model = ff.BlockOnBelt(**scene, law=ff.InterfaceLaw(mu=mu)).build(comm, with_friction=mu > 0)
     model.initial_guess()
     solver = ff.SteadySolver(model.residual, prefix=f"{prefix}_steady_",
                              options=model.solver_options())

@@ -181,10 +181,18 @@ def test_interface_law_rejects_bad_parameter_by_name(name, value):
     assert_names(error, name, value)
 
 
-@pytest.mark.parametrize(("name", "value"), BAD_LAW + BAD_SCENE)
+@pytest.mark.parametrize(("name", "value"), [*BAD_SCENE, ("law", {"mu": 0.3})])
 def test_block_scene_rejects_bad_parameter_by_name(name, value):
     with pytest.raises(ValueError, match=f"^{name}=") as error:
         ff.BlockOnBelt(**{name: value})
+    assert_names(error, name, value)
+
+
+@pytest.mark.parametrize(("name", "value"), BAD_LAW)
+def test_block_scene_law_rejects_bad_parameter_by_name(name, value):
+    """The scene holds the law, which validates its own fields (one place)."""
+    with pytest.raises(ValueError, match=f"^{name}=") as error:
+        ff.BlockOnBelt().with_law(**{name: value})
     assert_names(error, name, value)
 
 

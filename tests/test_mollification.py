@@ -80,7 +80,8 @@ def test_mollifier_rejects_a_negative_radius():
 
 
 def _block(refine):
-    scene = ff.BlockOnBelt(degree=1, contact_quadrature="nodal", refine=refine, mu=1.2)
+    scene = ff.BlockOnBelt(degree=1, contact_quadrature="nodal", refine=refine,
+                           law=ff.InterfaceLaw(mu=1.2))
     model = scene.build(COMM, with_friction=True)
     return scene, model, scene.L / (4 * refine)
 

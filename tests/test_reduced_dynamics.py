@@ -22,6 +22,7 @@ import pytest
 import scipy.optimize
 from scipy.integrate import trapezoid
 
+from fenicsfriction.laws import InterfaceLaw
 from fenicsfriction.studies.block import RigidBlock, rigid_block_observables
 from fenicsfriction.studies.oscillators import BouncingMass
 from fenicsfriction.timestepping import DynamicsError, ReducedDynamics
@@ -61,7 +62,8 @@ def mean_period(records) -> float:
 
 # --- the bouncing mass: closed forms and quadrature -------------------------------------------
 
-LINEAR = {"mass": 1.0, "weight": 1000.0, "c_n": 1e6, "m_n": 1.0, "area": 1.0}  # ω = 1e3, g = 1e3
+# ω = 1e3, g = 1e3
+LINEAR = {"mass": 1.0, "weight": 1000.0, "law": InterfaceLaw(c_n=1e6, m_n=1.0), "area": 1.0}
 
 
 def linear_period(omega: float, g: float, d0: float, v0: float) -> tuple[float, float]:
@@ -86,7 +88,7 @@ def test_linear_period_closed_form_agrees_with_an_adaptive_ode_solution():
     no flight (a = d0/2). The kink of the force at y = 0 costs the adaptive solver accuracy
     locally; measured agreement 6e-13, tolerance 1e-10."""
     bm = BouncingMass(**LINEAR)
-    omega, g, d0 = np.sqrt(bm.c_n * bm.area / bm.mass), bm.gravity, -bm.equilibrium()
+    omega, g, d0 = np.sqrt(bm.law.c_n * bm.area / bm.mass), bm.gravity, -bm.equilibrium()
     for ratio in (2.0, 0.5):
         v0 = ratio * d0 * omega
         T = linear_period(omega, g, d0, v0)[0]
@@ -129,7 +131,7 @@ def test_period_on_a_linear_foundation_converges_at_second_order(ratio):
     flight; 2.06e-5, equal to the prediction to 2e-5 relative, without).
     """
     bm = BouncingMass(**LINEAR)
-    omega, g, d0 = np.sqrt(bm.c_n * bm.area / bm.mass), bm.gravity, -bm.equilibrium()
+    omega, g, d0 = np.sqrt(bm.law.c_n * bm.area / bm.mass), bm.gravity, -bm.equilibrium()
     v0 = ratio * d0 * omega
     T, contact = linear_period(omega, g, d0, v0)
     errors = []
@@ -154,7 +156,7 @@ def quadrature_period(bm: BouncingMass, v0: float) -> tuple[float, float, float]
 
     def V(y):
         d = max(-y, 0.0)
-        return bm.c_n * bm.area * d ** (bm.m_n + 1) / (bm.m_n + 1) + bm.weight * y
+        return bm.law.c_n * bm.area * d ** (bm.law.m_n + 1) / (bm.law.m_n + 1) + bm.weight * y
 
     E = V(-d0) + 0.5 * bm.mass * v0**2
     y1 = scipy.optimize.brentq(lambda y: V(y) - E, -10 * d0, -d0, xtol=1e-16 * d0, rtol=1e-15)
@@ -181,7 +183,7 @@ def test_error_control_follows_the_tolerance_and_resolves_lift_off_and_landing()
     > 4 apart), and the steps vary along the orbit, small at lift-off and landing where the
     force has its kink, large in flight (measured max/min 65; asserted > 10)."""
     bm = BouncingMass(**LINEAR)
-    omega, g, d0 = np.sqrt(bm.c_n * bm.area / bm.mass), bm.gravity, -bm.equilibrium()
+    omega, g, d0 = np.sqrt(bm.law.c_n * bm.area / bm.mass), bm.gravity, -bm.equilibrium()
     v0 = 1.05 * d0 * omega
     T = linear_period(omega, g, d0, v0)[0]
     steps, errors = [], []
@@ -211,12 +213,12 @@ def test_period_on_the_power_law_foundation_matches_the_energy_quadrature():
     """
     bm = BouncingMass()
     d0 = -bm.equilibrium()
-    v_lift = np.sqrt(2 * bm.m_n / (bm.m_n + 1) * bm.weight * d0 / bm.mass)  # V(0) - V(-d0)
+    v_lift = np.sqrt(2 * bm.law.m_n / (bm.law.m_n + 1) * bm.weight * d0 / bm.mass)  # V(0) - V(-d0)
     T, y1, y2 = quadrature_period(bm, 0.9 * v_lift)
     assert y2 < 0
-    omega0 = np.sqrt(bm.m_n * bm.weight / (d0 * bm.mass))
+    omega0 = np.sqrt(bm.law.m_n * bm.weight / (d0 * bm.mass))
     assert abs(T * omega0 / (2 * np.pi) - 1) > 0.05  # far from the linearised period
-    omega_max = np.sqrt(bm.m_n * bm.c_n * bm.area * (-y1) ** (bm.m_n - 1) / bm.mass)
+    omega_max = np.sqrt(bm.law.m_n * bm.law.c_n * bm.area * (-y1) ** (bm.law.m_n - 1) / bm.mass)
     errors, bounds = [], []
     for n in (200, 400):
         records = trajectory(bm, [-d0], [0.9 * v_lift], 2.2 * T, T / n, f"pow{n}")
@@ -240,8 +242,8 @@ def test_energy_is_conserved_to_second_order_and_exactly_for_a_linear_foundation
     """
     bm = BouncingMass()
     d0 = -bm.equilibrium()
-    v0 = 1.5 * np.sqrt(2 * bm.m_n / (bm.m_n + 1) * bm.weight * d0 / bm.mass)
-    T0 = 2 * np.pi / np.sqrt(bm.m_n * bm.weight / (d0 * bm.mass))
+    v0 = 1.5 * np.sqrt(2 * bm.law.m_n / (bm.law.m_n + 1) * bm.weight * d0 / bm.mass)
+    T0 = 2 * np.pi / np.sqrt(bm.law.m_n * bm.weight / (d0 * bm.mass))
     errors = []
     for n in (100, 200, 400):
         records = trajectory(bm, [-d0], [v0], 3 * T0, T0 / n, f"energy{n}")
@@ -254,7 +256,7 @@ def test_energy_is_conserved_to_second_order_and_exactly_for_a_linear_foundation
 
     linear = BouncingMass(**LINEAR)
     d0 = -linear.equilibrium()
-    v0 = 0.5 * d0 * np.sqrt(linear.c_n * linear.area / linear.mass)
+    v0 = 0.5 * d0 * np.sqrt(linear.law.c_n * linear.area / linear.mass)
     records = trajectory(linear, [-d0], [v0], 0.02, 1e-4, "energy_linear")
     energy = np.array([r["energy"] for r in records])
     assert np.abs(energy - energy[0]).max() < 1e-11 * 0.5 * linear.mass * v0**2
@@ -266,7 +268,7 @@ def test_bouncing_mass_linearisation_is_the_derivative_of_its_residual(y, y_dot,
     """(M, C, K) against central differences of R, in contact with and without damping and
     in flight (all zero but M). Steps 1e-6 of |y| and of |ẏ|: truncation ≈ (1e-6)²,
     round-off ε_mach W/(h K) ≲ 1e-9; tolerance 1e-7 (measured ≤ 8e-11 for K, 1e-9 for C)."""
-    bm = BouncingMass(m_n=m_n, b_n=b_n, c_n=1e10 if m_n > 1 else 1e6)
+    bm = BouncingMass(law=InterfaceLaw(m_n=m_n, b_n=b_n, c_n=1e10 if m_n > 1 else 1e6))
     hy, hv = 1e-6 * abs(y), 1e-6 * abs(y_dot)
     M, C, K = bm.linearisation([y], [y_dot])
     R = lambda y, y_dot: bm.residual([y], [y_dot], [0.0])[0]  # noqa: E731
@@ -296,7 +298,7 @@ def rigid_block(mu: float) -> RigidBlock:
     viscous = tuple(2 * zeta * np.sqrt(k * m)
                     for zeta, k, m in zip((0.005, 0.04, 0.04), np.diag(K), np.diag(M),
                                               strict=True))
-    return RigidBlock(mu=mu, viscous=viscous, **data)
+    return RigidBlock(viscous=viscous, **data, law=InterfaceLaw(mu=mu))
 
 
 def test_modal_damping_gives_the_asked_damping_ratios_at_mu_0():
@@ -314,7 +316,8 @@ def test_modal_damping_gives_the_asked_damping_ratios_at_mu_0():
     # frequencies: tangential (spring) < normal/rotation; the x ratio is the smallest one
     assert measured[np.argmin(abs(lam))] == pytest.approx(ratios[0], rel=1e-9)
     assert sorted(measured) == pytest.approx(sorted(ratios), rel=1e-9)
-    assert RigidBlock.with_modal_damping(ratios, mu=1.0, **data).viscous == pytest.approx(
+    damped = RigidBlock.with_modal_damping(ratios, law=InterfaceLaw(mu=1.0), **data)
+    assert damped.viscous == pytest.approx(
         rigid_block(1.0).viscous, rel=1e-12)
     with pytest.raises(ValueError, match="viscous"):
         RigidBlock(viscous=(1.0, float("nan"), 1.0))
@@ -391,7 +394,7 @@ def test_rigid_block_probe_tractions_integrate_to_the_resultants():
     partly lifted state; friction is μ × pressure while slipping (|w| = U ≫ ε)."""
     rb = rigid_block(0.5)
     q_steady = rb.steady_state()
-    q_tilted = q_steady + np.array([0.0, 0.4 * (q_steady[1] + rb.g), 8e-6])  # lifts the rear
+    q_tilted = q_steady + np.array([0.0, 0.4 * (q_steady[1] + rb.law.g), 8e-6])  # lifts the rear
     for q in (q_steady, q_tilted):
         x = np.linspace(0.0, rb.L, 4001)
         probes = [rigid_block_observables(rb, q, np.zeros(3), probe_x=xi) for xi in x]
@@ -435,11 +438,15 @@ def test_a_petsc_error_inside_the_time_step_is_reported_with_the_last_state_kept
 # --- bad input --------------------------------------------------------------------------------
 
 def test_bad_input_raises_value_errors_naming_the_parameter():
-    for bad, name in (({"mass": 0.0}, "mass"), ({"mass": -1.0}, "mass"), ({"c_n": 0.0}, "c_n"),
-                      ({"c_n": -1e10}, "c_n"), ({"m_n": 0.5}, "m_n"), ({"weight": 0.0}, "weight"),
-                      ({"area": -1.0}, "area"), ({"b_n": -1.0}, "b_n")):
+    for bad, name in (({"mass": 0.0}, "mass"), ({"mass": -1.0}, "mass"),
+                      ({"weight": 0.0}, "weight"), ({"area": -1.0}, "area"),
+                      ({"law": {"c_n": 1e6}}, "law")):
         with pytest.raises(ValueError, match=rf"^{name}=.* is invalid"):
             BouncingMass(**bad)
+    for bad, name in (({"c_n": 0.0}, "c_n"), ({"c_n": -1e10}, "c_n"), ({"m_n": 0.5}, "m_n"),
+                      ({"b_n": -1.0}, "b_n")):  # the law validates its own fields
+        with pytest.raises(ValueError, match=rf"^{name}=.* is invalid"):
+            BouncingMass(law=InterfaceLaw(**bad))
     bm = BouncingMass()
     with pytest.raises(ValueError, match=r"^q_dot0=.* is invalid"):
         ReducedDynamics(bm, [0.0], [0.0, 1.0], prefix=prefix("bad"))

@@ -40,7 +40,7 @@ def central_difference(f, x: np.ndarray, steps: np.ndarray) -> np.ndarray:
 
 # --- the linearisation and the steady state ---------------------------------------------------
 
-DAMPED = {"mu": 0.6, "b_n": 0.381e10, "regularisation": "smooth", "eps": 0.1,
+DAMPED = {"law": ff.InterfaceLaw(mu=0.6, b_n=0.381e10, regularisation="smooth", eps=0.1),
           "viscous": (0.01, 0.2, 3.0)}
 
 
@@ -96,7 +96,7 @@ def test_steady_state_balances_weight_friction_spring_and_moments(mu, spring_hei
     Newton stops at 1e-12 of W (forces) and of W L (moment); quad is asked for 1e-12 of the
     integral or of W (W L); tolerance 1e-9 of W and W L.
     """
-    rb = RigidBlock(mu=mu, spring_height=spring_height)
+    rb = RigidBlock(spring_height=spring_height, law=ff.InterfaceLaw(mu=mu))
     u_x, u_y, theta = rb.steady_state()
 
     def penetration(s):
@@ -109,8 +109,8 @@ def test_steady_state_balances_weight_friction_spring_and_moments(mu, spring_hei
                                             epsabs=1e-12 * scale / rb.B0, epsrel=1e-12,
                                             limit=200)[0]
 
-    normal = integral(lambda s: rb.c_n * penetration(s) ** rb.m_n, rb.weight)
-    moment = integral(lambda s: rb.c_n * penetration(s) ** rb.m_n * s, rb.weight * rb.L)
+    normal = integral(lambda s: rb.law.c_n * penetration(s) ** rb.law.m_n, rb.weight)
+    moment = integral(lambda s: rb.law.c_n * penetration(s) ** rb.law.m_n * s, rb.weight * rb.L)
     friction = mu * normal  # c_T d^{m_T} = μ c_n d^{m_n}, dragging the block along the belt
     spring = -rb.K_x * (u_x - theta * (rb.spring_height - rb.H / 2))
     W = rb.weight
@@ -143,9 +143,9 @@ def test_tangential_pair_does_not_move_with_mu_when_the_spring_acts_through_g():
     """
     omega = np.sqrt(RigidBlock().K_x / RigidBlock().mass)
     for mu in MU_GRID:
-        lam = tangential_eigenvalue(RigidBlock(mu=mu))
+        lam = tangential_eigenvalue(RigidBlock(law=ff.InterfaceLaw(mu=mu)))
         assert abs(lam - 1j * omega) <= 1e-14 * omega, (mu, lam)
-    low, high = (tangential_eigenvalue(RigidBlock(mu=mu, spring_height=10.0))
+    low, high = (tangential_eigenvalue(RigidBlock(spring_height=10.0, law=ff.InterfaceLaw(mu=mu)))
                  for mu in MU_GRID[[0, -1]])
     assert abs(high - low) > 1e-7 * omega
 
@@ -175,7 +175,7 @@ def test_stiff_fe_block_has_the_eigenvalues_of_the_rigid_block(B0, spring_height
     stability = StabilitySolver(model.residual, prefix=prefix("pep"))
     for mu in (0.0, 0.5, 1.2):
         ff.continuation(steady, model.mu, [mu])
-        rb = RigidBlock.from_scene(scene, mu=mu)
+        rb = RigidBlock.from_scene(scene, law=scene.law.replace(mu=mu))
         rigid = rb.eigenvalues(rb.steady_state())
         rigid = rigid[rigid.imag >= 0]
         fe = np.array([m.value for m in stability.solve(max_modulus=1.5 * abs(rigid).max())])
@@ -199,15 +199,14 @@ def test_bad_parameters_raise_value_errors_naming_them():
         solver.solve(max_modulus=-1)
 
 
-def test_rigid_counterpart_carries_the_top_pressure_and_refuses_a_speed_law():
-    """A top pressure p is a resultant p L B0 through G: it joins the weight; a velocity law
-    has no rigid counterpart and must not be silently replaced by a constant μ."""
-    scene = ff.BlockOnBelt(top_pressure=0.3, mu=0.5)
+def test_rigid_counterpart_carries_the_top_pressure_and_the_scene_law():
+    """A top pressure p is a resultant p L B0 through G: it joins the weight; the law is the
+    scene's own object, friction coefficient law included (never replaced by a constant μ)."""
+    scene = ff.BlockOnBelt(top_pressure=0.3, law=ff.InterfaceLaw(mu=0.5))
     block = RigidBlock.from_scene(scene)
     assert block.weight == pytest.approx(scene.weight + 0.3 * scene.L * scene.B0, rel=1e-15)
-    with pytest.raises(ValueError, match="friction_coefficient"):
-        RigidBlock.from_scene(ff.BlockOnBelt(
-            friction_coefficient=ff.laws.StribeckFriction(mu_s=0.8, mu_k=0.5, v_s=0.1)))
+    stribeck = ff.InterfaceLaw(friction_coefficient=ff.laws.StribeckFriction(0.8, 0.5, 0.1))
+    assert RigidBlock.from_scene(ff.BlockOnBelt(law=stribeck)).law is stribeck
 
 
 def test_rigid_loci_bracket_each_onset_between_a_stable_and_a_growing_block():
@@ -218,7 +217,7 @@ def test_rigid_loci_bracket_each_onset_between_a_stable_and_a_growing_block():
     loci = rigid_loci(scene, targets, max_frequency, growth_tol, tol)
 
     def grows(mu):
-        block = RigidBlock.from_scene(scene, mu=mu)
+        block = RigidBlock.from_scene(scene, law=scene.law.replace(mu=mu))
         lam = block.eigenvalues(block.steady_state())
         lam = lam[(lam.imag >= 0) & (np.abs(lam) <= max_frequency)]
         return bool(np.any(lam.real > growth_tol * np.abs(lam)))
@@ -238,14 +237,14 @@ def test_rigid_generalised_forces_integrate_the_pointwise_tractions():
     """The rigid block's generalised forces integrate laws.normal_traction and
     laws.friction_traction: at full contact with θ = 0 and a uniform slip they are B0 L times
     the pointwise tractions (closed form, smooth regularisation, normal damping on)."""
-    block = RigidBlock(mu=0.6, b_n=1e6, regularisation="smooth", eps=1e-2)
+    block = RigidBlock(law=ff.InterfaceLaw(mu=0.6, b_n=1e6, regularisation="smooth", eps=1e-2))
     d, rate, w = 2e-4, 0.03, 0.1
     q = np.array([0.0, -d, 0.0])
     q_dot = np.array([w + block.belt_speed, -rate, 0.0])
     forces = block.generalised_forces(q, q_dot)
     area = block.L * block.B0
-    p = block.c_n * d**block.m_n + block.b_n * d**block.l_n * rate
-    t = -0.6 * block.c_n * d**block.m_n * w / np.sqrt(w**2 + 1e-4)
+    p = block.law.c_n * d**block.law.m_n + block.law.b_n * d**block.law.l_n * rate
+    t = -0.6 * block.law.c_n * d**block.law.m_n * w / np.sqrt(w**2 + 1e-4)
     F_s = block._spring(q)
     arm = block.spring_height - block.H / 2
     assert forces == pytest.approx([area * t + F_s, area * p - block.weight,

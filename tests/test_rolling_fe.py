@@ -9,12 +9,16 @@ from mpi4py import MPI
 import numpy as np
 import pytest
 
+from fenicsfriction.laws import InterfaceLaw
 from fenicsfriction.studies.rolling import closed_forms
 from fenicsfriction.studies.rolling.kalker import creep_coefficients
 from fenicsfriction.studies.rolling.model import RollingContact, write_xdmf
 
+#: μ = 0.3 with Kalker's smooth regularisation (ε set by each scene's sequence); the linear
+#: compliance c_n = 1000 E*/a (E* = G = 1, a = 1) of the normal-compliance pressure
+LAW = InterfaceLaw(c_n=1e3, m_n=1.0, mu=0.3, regularisation="smooth")
 #: Carter's problem: μ p0/G = 3e-3, saturation at ξ = μ a/R = 6e-3 (ν = 0)
-CARTER = {"dim": 2, "nu": 0.0, "mu": 0.3, "p0": 0.01, "block_size": 100.0}
+CARTER = {"dim": 2, "nu": 0.0, "law": LAW, "p0": 0.01, "block_size": 100.0}
 
 
 def _carter(xi: float, **kwargs):
@@ -32,17 +36,17 @@ def test_carter_traction_force_and_leading_stick_zone():
     scene, result = _carter(0.5 * 6e-3, cells_per_a=32)
     R, p0, a = scene.radius, scene.peak_pressure, scene.a
     xi = 0.5 * 6e-3
-    force = closed_forms.carter_force(xi, scene.mu, a, p0, R)
-    assert abs(result.Fx - force) < 0.01 * scene.mu * scene.normal_load
-    c = closed_forms.carter_stick_half_width(xi, scene.mu, a, R)
+    force = closed_forms.carter_force(xi, scene.law.mu, a, p0, R)
+    assert abs(result.Fx - force) < 0.01 * scene.law.mu * scene.normal_load
+    c = closed_forms.carter_stick_half_width(xi, scene.law.mu, a, R)
     stick = result.x[result.stick(), 0]
     h = a / 32
     assert stick.max() >= a - 1.5 * h  # up to the leading edge's last loaded node
     assert abs(stick.min() - (a - 2 * c)) < 2 * h
     assert result.adhesion_fraction == pytest.approx(c / a, abs=2 * h / a)
-    exact = closed_forms.carter_traction(result.x[:, 0], xi, scene.mu, a, p0, R)
+    exact = closed_forms.carter_traction(result.x[:, 0], xi, scene.law.mu, a, p0, R)
     error = result.traction[:, 0] - exact
-    assert np.max(np.abs(error)) < 0.1 * scene.mu * p0
+    assert np.max(np.abs(error)) < 0.1 * scene.law.mu * p0
     assert np.linalg.norm(error) / np.linalg.norm(exact) < 0.02
 
 
@@ -52,8 +56,8 @@ def test_carter_force_converges_at_first_order_in_the_mesh():
     xi = 0.2 * 6e-3
     errors = []
     for n in (8, 16, 32):
-        scene, result = _carter(xi, cells_per_a=n, eps=(10.0, 1.0, 0.1, 0.01))
-        exact = closed_forms.carter_force(xi, scene.mu, scene.a, scene.peak_pressure,
+        scene, result = _carter(xi, cells_per_a=n, eps_sequence=(10.0, 1.0, 0.1, 0.01))
+        exact = closed_forms.carter_force(xi, scene.law.mu, scene.a, scene.peak_pressure,
                                           scene.radius)
         errors.append(abs(result.Fx - exact) / abs(exact))
     rates = np.log2(np.array(errors[:-1]) / errors[1:])
@@ -74,15 +78,15 @@ def test_contact_pressure_gives_carters_force():
     xi = 0.5 * 6e-3
     scene, result = _carter(xi, cells_per_a=16, pressure="contact", zone_margin=1.25)
     assert result.Fn == pytest.approx(scene.normal_load, rel=1e-6)
-    force = closed_forms.carter_force(xi, scene.mu, scene.a, scene.peak_pressure, scene.radius)
-    assert abs(result.Fx - force) < 0.02 * scene.mu * scene.normal_load
+    force = closed_forms.carter_force(xi, scene.law.mu, scene.a, scene.peak_pressure, scene.radius)
+    assert abs(result.Fx - force) < 0.02 * scene.law.mu * scene.normal_load
 
 
 @pytest.fixture(scope="module")
 def circle():
     """The circular contact, ν = 0, h = a/6 on a block of 10 a, cells growing by 1.5."""
-    scene = RollingContact(dim=3, nu=0.0, mu=0.3, p0=0.01, cells_per_a=6, block_size=10.0,
-                           growth=1.5, eps=(10.0, 1.0, 0.1))
+    scene = RollingContact(dim=3, nu=0.0, law=LAW, p0=0.01, cells_per_a=6, block_size=10.0,
+                           growth=1.5, eps_sequence=(10.0, 1.0, 0.1))
     return scene, scene.build()
 
 
@@ -111,33 +115,35 @@ def test_large_creepage_saturates_at_mu_fn_with_adhesion_at_the_leading_edge(cir
     assert stick[:, 0].max() > 0.8 * scene.a and stick[:, 0].min() > -0.8 * scene.a
     result = model.solve((0.05, 0.0, 0.0))
     # the regularised law's ε/|s| ~ 1e-3 below the bound, the nodal rule's Fn exact to 0.1 %
-    assert result.Fx == pytest.approx(-scene.mu * result.Fn, rel=3e-3)
+    assert result.Fx == pytest.approx(-scene.law.mu * result.Fn, rel=3e-3)
     assert result.adhesion_fraction == 0.0
 
 
 def test_cattaneo_mindlin_stick_radius_under_a_shift():
     """ν = 0: the shifted spheres' stick radius c = a (1 - Q/μP)^(1/3) with Q the measured
     force, within an element (h = a/6) of the nodes in stick."""
-    scene = RollingContact(dim=3, nu=0.0, mu=0.3, p0=0.01, cells_per_a=6, block_size=10.0,
-                           growth=1.5, eps=(1.0, 0.1, 0.01))
+    scene = RollingContact(dim=3, nu=0.0, law=LAW, p0=0.01, cells_per_a=6, block_size=10.0,
+                           growth=1.5, eps_sequence=(1.0, 0.1, 0.01))
     model = scene.build(kinematics="shift")
     results = model.shift((2e-3 * scene.a, 0.0), increments=2)
     final = results[-1]
-    q_ratio = final.Fx / (scene.mu * final.Fn)
+    q_ratio = final.Fx / (scene.law.mu * final.Fn)
     assert 0.2 < q_ratio < 0.95
     c = closed_forms.mindlin_stick_radius(scene.a, q_ratio)
     r = np.linalg.norm(final.x[final.stick()], axis=1)
     h = scene.a / 6
     assert abs(r.max() - c) < h
     r_all = np.linalg.norm(final.x, axis=1)
-    exact = closed_forms.mindlin_traction(r_all, scene.a, scene.peak_pressure, scene.mu,
+    exact = closed_forms.mindlin_traction(r_all, scene.a, scene.peak_pressure, scene.law.mu,
                                           q_ratio)
-    assert np.max(np.abs(final.traction[:, 0] - exact)) < 0.25 * scene.mu * scene.peak_pressure
+    assert np.max(np.abs(final.traction[:, 0] - exact)) < 0.25 * scene.law.mu * scene.peak_pressure
 
 
 def test_bad_parameters_are_named():
     with pytest.raises(ValueError, match="mu="):
-        RollingContact(mu=-1.0)
+        RollingContact().with_law(mu=-1.0)
+    with pytest.raises(ValueError, match="law="):
+        RollingContact().with_law(mu=0.0)
     with pytest.raises(ValueError, match="p0="):
         RollingContact(p0=0.01, Fn=1.0)
     with pytest.raises(ValueError, match="pressure="):
@@ -149,7 +155,7 @@ def test_bad_parameters_are_named():
 def test_parallel_solve_matches_the_serial_one():
     """Carter's problem on this communicator and on each rank alone: forces and surface
     values agree to the Newton tolerance (|R| <= 1e-9 against nodal forces of 1e-4)."""
-    scene = RollingContact(**CARTER, cells_per_a=8, eps=(10.0, 1.0, 0.1))
+    scene = RollingContact(**CARTER, cells_per_a=8, eps_sequence=(10.0, 1.0, 0.1))
     here = scene.build(MPI.COMM_WORLD).solve((3e-3, 0.0, 0.0))
     alone = scene.build(MPI.COMM_SELF).solve((3e-3, 0.0, 0.0))
     assert np.allclose(here.x, alone.x)
@@ -159,7 +165,7 @@ def test_parallel_solve_matches_the_serial_one():
 
 
 def test_xdmf_holds_the_displacement_and_the_traction(shared_tmp_path):
-    scene = RollingContact(**CARTER, cells_per_a=4, eps=(10.0, 1.0))
+    scene = RollingContact(**CARTER, cells_per_a=4, eps_sequence=(10.0, 1.0))
     model = scene.build()
     model.solve((3e-3, 0.0, 0.0))
     path = shared_tmp_path / "rolling.xdmf"

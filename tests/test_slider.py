@@ -100,7 +100,7 @@ def test_forced_response_is_the_periodic_motion_of_the_linear_system():
     # its transient (heavily damped here) leaves the forced oscillation Im(Ŷ e^{iωt})
     contact = Contact(mass=0.1, k_t=10.0, c_t=1.0, k_n=1.0, c_n=0.2, normal_load=5.0,
                       roughness=0.1, wavelength=1.0, surface_speed=1.0,
-                      friction=laws.ConstantFriction(0.4))
+                      law=laws.InterfaceLaw(mu=0.4, regularisation="smooth"))
     slider = Slider(1.0, 2.0, 2.0, [contact])
     motion = SliderMotion(slider, linearised=True)
     result = integrate_hybrid(motion, motion.initial_state(), motion.slip_mode(), 40.0,
@@ -141,8 +141,7 @@ def test_bad_slider_parameters_are_named_in_the_error():
     with pytest.raises(ValueError, match="reading='x' is invalid"):
         table2_slider(30.0, reading="x")
     with pytest.raises(ValueError, match="unit=0.0 is invalid"):
-        Contact(0.01, 10, 0.015, 0.1, 0.001, 0.05, 1, 16.67, 80,
-                friction=dataclasses.replace(table2_slider(30.0).contacts[0].friction, unit=0.0))
+        dataclasses.replace(table2_slider(30.0).contacts[0].law.friction_coefficient, unit=0.0)
     assert laws.PiecewiseLinearFriction().derivative(3.0) == pytest.approx(-0.03)
 
 

@@ -207,11 +207,16 @@ def _assemble(form: ufl.Form, fields: tuple) -> tuple[PETSc.Vec, list[PETSc.Mat]
     return b, matrices
 
 
-def _friction_form(u, u_dot, n, ds, c_T, slip_rule, regularisation, U_T=None):
+def _friction_form(u, u_dot, n, ds, law, U_T=None):
     v = ufl.TestFunction(u.function_space)
     U_T = ufl.zero(len(u)) if U_T is None else U_T
-    return forms.friction(u, u_dot, v, n, c_T, 2.0, 0.0, U_T, EPS, ds, regularisation,
-                          slip_rule=slip_rule)
+    return forms.friction(u, u_dot, v, n, law, U_T, ds)
+
+
+def _law(c_n, slip_rule, regularisation, mu=0.0):
+    """m_n = 2, no gap; an elliptic rule's bound is μ_ref c_n."""
+    return laws.InterfaceLaw(c_n=c_n, m_n=2.0, mu=mu, eps=EPS, regularisation=regularisation,
+                             slip_rule=slip_rule)
 
 
 @pytest.mark.parametrize(("dim", "associated", "regularisation"),
@@ -229,7 +234,7 @@ def test_isotropic_rules_reproduce_the_coulomb_term(dim, associated, regularisat
     b_ref, A_ref = _assemble(by_hand, (u, u_dot))
     rule = laws.EllipticSlipRule(mu, mu, associated=associated, frame=frame)
     for slip_rule, tol in ((None, 0.0), (laws.CoulombSlipRule(), 0.0), (rule, 1e-12)):
-        b, A = _assemble(_friction_form(u, u_dot, n, ds, mu * c_n, slip_rule, regularisation),
+        b, A = _assemble(_friction_form(u, u_dot, n, ds, _law(c_n, slip_rule, regularisation, mu)),
                          (u, u_dot))
         # the Coulomb rule is today's expression: the same code, the same bits (tol 0); the
         # isotropic ellipse reaches it through μ w / μ and sqrt(μ²/1): a few ulps per entry
@@ -264,7 +269,7 @@ def _near_rest(x: np.ndarray) -> np.ndarray:
 def test_elliptic_friction_term_passes_the_taylor_test_in_3d(associated, velocity):
     u, u_dot, n, ds, frame = _interface(3, velocity)
     rule = laws.EllipticSlipRule(MU_X, MU_Y, associated=associated, frame=frame)
-    form = _friction_form(u, u_dot, n, ds, rule.mu_ref * 50.0, rule, "c1")
+    form = _friction_form(u, u_dot, n, ds, _law(50.0, rule, "c1"))
     L = _compat.form(form)
     b0, (J_u, J_v) = _assemble(form, (u, u_dot))
     x = u.function_space.tabulate_dof_coordinates()
@@ -300,7 +305,7 @@ def test_friction_jacobian_at_rest_is_finite_and_the_band_stiffness(associated):
     u, u_dot, n, ds, frame = _interface(3, lambda x: np.zeros_like(x))  # w = 0 exactly
     rule = laws.EllipticSlipRule(MU_X, MU_Y, associated=associated, frame=frame)
     c_T = rule.mu_ref * 50.0
-    _, (J,) = _assemble(_friction_form(u, u_dot, n, ds, c_T, rule, "c1"), (u_dot,))
+    _, (J,) = _assemble(_friction_form(u, u_dot, n, ds, _law(50.0, rule, "c1")), (u_dot,))
     values = J.getValuesCSR()[2]  # this rank's rows: a rank may hold no contact facet
     comm = MPI.COMM_WORLD
     assert comm.allreduce(np.all(np.isfinite(values)), op=MPI.LAND)
@@ -345,12 +350,12 @@ def _block_on_oblique_belt(rule: laws.EllipticSlipRule, belt_angle: float, press
     u, u_dot, u_ddot = (fem.Function(V, name=name) for name in ("u", "u_dot", "u_ddot"))
     v = ufl.TestFunction(V)
     c_n, m_n = 1e4, 1.0
+    law = laws.InterfaceLaw(c_n=c_n, m_n=m_n, eps=EPS, slip_rule=rule)
     belt = fem.Constant(msh, np.array([np.cos(belt_angle), 0.0, np.sin(belt_angle)]))
     n = ufl.FacetNormal(msh)
     terms = forms.elasticity(u, v, 1e3, 0.3, ufl.dx(domain=msh)) \
-        + forms.normal_compliance(u, v, n, c_n, m_n, 0.0, ds(1)) \
-        + forms.friction(u, u_dot, v, n, rule.mu_ref * c_n, m_n, 0.0, belt, EPS, ds(1),
-                         slip_rule=rule) \
+        + forms.normal_compliance(u, v, n, law, ds(1)) \
+        + forms.friction(u, u_dot, v, n, law, belt, ds(1)) \
         + forms.surface_traction(ufl.as_vector([0.0, -pressure, 0.0]), v, ds(2))
     held = [fem.locate_dofs_topological(V.sub(i), fdim, top) for i in (0, 2)]
     bcs = [fem.dirichletbc(PETSc.ScalarType(0), dofs, V.sub(i))

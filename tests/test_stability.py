@@ -167,8 +167,8 @@ def test_stiffness_and_damping_are_the_derivatives_of_the_residual():
     the terms independent of u̇ round identically in both evaluations and cancel. Measured:
     3e-10; friction is 38 % of C δu̇, normal damping the rest.
     """
-    model, _ = sliding_block(COMM, 0.6, prefix("fd"), b_n=0.381e10,
-                             regularisation="smooth", eps=0.1)
+    model, _ = sliding_block(COMM, 0.6, prefix("fd"), law=ff.InterfaceLaw(
+        b_n=0.381e10, regularisation="smooth", eps=0.1))
     residual = model.residual
     solver = StabilitySolver(residual, prefix=prefix("fd_pep"))
     solver.assemble()
@@ -247,9 +247,8 @@ def test_stiffness_is_symmetric_but_for_the_friction_coupling():
 
     ff.continuation(steady, model.mu, np.linspace(0.1, 0.5, 5))
     solver.assemble()
-    term = model.thickness * friction(
-        residual.u, residual.u_dot, residual.v, model.normal, model.friction_c_T, model.m_T,
-        model.gap, model.belt_velocity, model.eps, model.ds_contact, model.scene.regularisation)
+    term = model.thickness * friction(residual.u, residual.u_dot, residual.v, model.normal,
+                                      model.law, model.belt_velocity, model.ds_contact)
     a = _compat.form(residual.at_rest(residual.derivative(term, residual.u)))
     F = dolfinx.fem.petsc.assemble_matrix(a)
     F.assemble()

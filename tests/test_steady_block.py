@@ -56,7 +56,7 @@ def test_frictionless_block_under_top_pressure_penetrates_uniformly(refine, degr
     p = 0.3
     scene = ff.BlockOnBelt(weight=0.0, top_pressure=p, refine=refine, degree=degree)
     model = scene.build(COMM)  # μ = 0: no friction term
-    d = (p / scene.c_n) ** (1 / scene.m_n)
+    d = (p / scene.law.c_n) ** (1 / scene.law.m_n)
     # start tilted and too deep, so that Newton has to find the answer
     model.residual.u.interpolate(
         lambda x: np.vstack([np.zeros(x.shape[1]), -d * (1.5 + 0.5 * x[0] / scene.L)]))
@@ -70,7 +70,7 @@ def test_frictionless_block_under_top_pressure_penetrates_uniformly(refine, degr
     assert q.normal_force == pytest.approx(load, abs=force_error)
     # d ∝ N^(1/m_n): a force error δN moves the penetration by δd/d = δN / (m_n N); the
     # factor 10 allows for the error not being spread uniformly over the contact nodes
-    tolerance = 10 * force_error / (scene.m_n * load)
+    tolerance = 10 * force_error / (scene.law.m_n * load)
     assert q.min_penetration == pytest.approx(d, rel=tolerance)
     assert q.max_penetration == pytest.approx(d, rel=tolerance)
 
@@ -100,7 +100,7 @@ def test_spring_holds_mu_times_the_weight_at_every_mu(mu_path):
     N = W; the spring, read off its node's displacement, balances it. Its error is the
     horizontal balance's slack plus μ times the vertical one's."""
     scene, records, n = mu_path
-    assert scene.eps < scene.belt_speed
+    assert scene.law.eps < scene.belt_speed
     for r in records:
         expected = scene.belt_direction * r["mu"] * scene.weight
         assert abs(-r["spring_force"] - expected) <= (1 + r["mu"]) * slack(
@@ -188,8 +188,8 @@ BELT_SPEED, MU = 0.08, 0.6
 
 
 def epsilon_path(regularisation: str, eps_values, prefix: str):
-    scene = ff.BlockOnBelt(regularisation=regularisation, belt_speed=BELT_SPEED,
-                           eps=eps_values[0])
+    scene = ff.BlockOnBelt(belt_speed=BELT_SPEED,
+                           law=ff.InterfaceLaw(regularisation=regularisation, eps=eps_values[0]))
     model, solver, _ = solve_block(scene, prefix, [MU / 2, MU])
     records = ff.epsilon_sequence(solver, model.eps, eps_values, observe=model.quantities)
     return scene, records
@@ -350,8 +350,8 @@ def test_solvers_sharing_a_prefix_each_get_their_own_defaults():
 
 
 def test_failed_epsilon_step_restores_eps_with_the_state():
-    model = ff.BlockOnBelt(mu=0.6, regularisation="smooth", belt_speed=0.08,
-                           eps=0.08).build(MPI.COMM_WORLD)
+    law = ff.InterfaceLaw(mu=0.6, regularisation="smooth", eps=0.08)
+    model = ff.BlockOnBelt(belt_speed=0.08, law=law).build(MPI.COMM_WORLD)
     model.initial_guess()
     solver = ff.SteadySolver(model.residual, prefix="eps_restore_",
                              options=model.solver_options())

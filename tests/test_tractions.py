@@ -42,7 +42,7 @@ def test_normal_traction_is_elastic_plus_damping_part():
 def stribeck_block():
     """A block with a Stribeck law pressed into the belt, its nodes moving at v_x = 0.05."""
     law = laws.StribeckFriction(mu_s=0.8, mu_k=0.5, v_s=0.1)
-    scene = BlockOnBelt(friction_coefficient=law, eps=1e-2)
+    scene = BlockOnBelt(law=ff.InterfaceLaw(friction_coefficient=law, eps=1e-2))
     model = scene.build(COMM)
     model.initial_guess()
     bs = model.V.dofmap.index_map_bs
@@ -55,13 +55,13 @@ def test_probe_friction_follows_a_velocity_dependent_law(stribeck_block):
     be evaluated with the constant μ, zero for this scene)."""
     scene, model = stribeck_block
     values = model.probe(scene.L / 2)
-    d = max(-values.u_y - scene.g, 0.0)
-    assert d > 0 and abs(values.slip) > scene.eps
+    d = max(-values.u_y - scene.law.g, 0.0)
+    assert d > 0 and abs(values.slip) > scene.law.eps
     assert values.slip == pytest.approx(0.05 - scene.belt_speed, rel=1e-14)
-    mu = scene.friction_coefficient(abs(values.slip))
-    expected = -scene.c_n * mu * d**scene.m_n * np.sign(values.slip)
+    mu = scene.law.friction_coefficient(abs(values.slip))
+    expected = -scene.law.c_n * mu * d**scene.law.m_n * np.sign(values.slip)
     assert values.friction == pytest.approx(expected, rel=1e-12)
-    assert values.pressure == pytest.approx(scene.c_n * d**scene.m_n, rel=1e-12)
+    assert values.pressure == pytest.approx(scene.law.c_n * d**scene.law.m_n, rel=1e-12)
 
 
 def test_friction_force_of_a_velocity_dependent_law_is_mu_of_the_slip_times_normal_force(
@@ -71,7 +71,7 @@ def test_friction_force_of_a_velocity_dependent_law_is_mu_of_the_slip_times_norm
     q = model.quantities()
     slip = 0.05 - scene.belt_speed
     assert q.friction_force == pytest.approx(
-        -scene.friction_coefficient(abs(slip)) * q.normal_force_elastic * np.sign(slip),
+        -scene.law.friction_coefficient(abs(slip)) * q.normal_force_elastic * np.sign(slip),
         rel=1e-12)
 
 
@@ -86,12 +86,12 @@ def _assembled(form) -> np.ndarray:
 @pytest.mark.parametrize("regularisation", sorted(laws.REGULARISATIONS))
 def test_band_damping_is_the_closed_form_row_sum(regularisation):
     """Row sums of the tangential damping in the band: ∫ B0 c_T d^{m_T}/ε v_x on Γ_C."""
-    scene = BlockOnBelt(mu=0.4, eps=2e-3, regularisation=regularisation)
+    scene = BlockOnBelt(law=ff.InterfaceLaw(mu=0.4, eps=2e-3, regularisation=regularisation))
     model = scene.build(COMM)
     model.initial_guess()
     v = model.residual.v
     d = ufl.max_value(-model.residual.u[1], 0.0)
-    closed = scene.B0 * 0.4 * scene.c_n * d**scene.m_n / 2e-3 * v[0] * model.ds_contact
+    closed = scene.B0 * 0.4 * scene.law.c_n * d**scene.law.m_n / 2e-3 * v[0] * model.ds_contact
     expected = _assembled(closed)
     assert np.max(np.abs(expected)) > 0
     assert _assembled(model.band_damping()) == pytest.approx(
@@ -118,7 +118,7 @@ def test_stepping_mu_on_a_model_with_a_speed_law_is_refused(stribeck_block):
 
 
 def test_slide_to_ramps_mu_from_zero_and_holds_mu_w_in_the_spring():
-    scene = BlockOnBelt(mu=0.3)
+    scene = BlockOnBelt(law=ff.InterfaceLaw(mu=0.3))
     model = scene.build(COMM)
     model.initial_guess()
     solver = ff.SteadySolver(model.residual, prefix="slide_", options=model.solver_options())

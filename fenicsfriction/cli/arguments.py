@@ -293,7 +293,7 @@ def add_contact_parsers(commands: typing.Any) -> None:
                           help="the contact law: normal compliance with regularised friction, "
                                "or Pop's perturbed Lagrangian (penalties c_n and --eps-T) "
                                "(compliance)")
-    cattaneo.add_argument("--eps-T", dest="eps_T", type=float,
+    cattaneo.add_argument("--eps-T", dest="penalty_T", type=float,
                           help="tangential penalty of the perturbed Lagrangian "
                                "[force/length^3] (1e4)")
 

@@ -148,7 +148,7 @@ def _hertz_outputs(scene: typing.Any, summary: dict, model: TwoBodyModel, out: p
         columns = {"r": r, **columns, "traction_x": on_block[:, 0], "traction_y": on_block[:, 1]}
     cattaneo = summary["scene"] == "cattaneo"
     if cattaneo:
-        columns["cattaneo_traction"] = closed_forms.cattaneo_traction(r, a, p0, scene.mu,
+        columns["cattaneo_traction"] = closed_forms.cattaneo_traction(r, a, p0, scene.law.mu,
                                                                       scene.q_ratio)
     write_rows(out / "surface.csv", _surface_rows(values, columns, dim), comm)
     width = "half_width" if dim == 2 else "contact_radius"
@@ -165,11 +165,11 @@ def _hertz_outputs(scene: typing.Any, summary: dict, model: TwoBodyModel, out: p
         if cattaneo:
             c = closed_forms.cattaneo_stick_half_width(a, scene.q_ratio)
             plotting.plot_contact_traction(
-                values.x[:, 0], tractions, scene.mu * values.pressure, grid,
-                closed_forms.cattaneo_traction(grid, a, p0, scene.mu, scene.q_ratio),
-                scene.mu * closed_forms.hertz_pressure(grid, a, p0), a, c,
+                values.x[:, 0], tractions, scene.law.mu * values.pressure, grid,
+                closed_forms.cattaneo_traction(grid, a, p0, scene.law.mu, scene.q_ratio),
+                scene.law.mu * closed_forms.hertz_pressure(grid, a, p0), a, c,
                 out / "traction.png",
-                f"Q = {scene.q_ratio:g} μP, μ = {scene.mu:g}: stick half-width "
+                f"Q = {scene.q_ratio:g} μP, μ = {scene.law.mu:g}: stick half-width "
                 f"{summary['stick_half_width']:.4g} (Cattaneo-Mindlin {c:.4g})")
     _deformed(model, out / "deformed.png", a if dim == 2 else None,
               f"{summary['scene']}: the contact region, displacements at true scale",
@@ -220,13 +220,14 @@ def _run_cattaneo(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm)
     a, _ = scene.closed_form()
     model = scene.build(comm)
     log.info(f"cattaneo: {model.dofs} dofs on {comm.size} rank(s), load {scene.load:.6g} per "
-             f"unit length, μ = {scene.mu:g}, Q to {scene.q_ratio:g} μP in {scene.increments} "
-             f"increments, ε = {sequence if sequence else scene.eps}; Hertz half-width {a:.6g}")
+             f"unit length, μ = {scene.law.mu:g}, Q to {scene.q_ratio:g} μP in "
+             f"{scene.increments} increments, ε = {sequence if sequence else scene.law.eps}; "
+             f"Hertz half-width {a:.6g}")
     tractions: list[tuple[np.ndarray, str]] = []
     counts: dict[float, int] = {}
 
     def on_increment(row: dict) -> None:
-        eps = row.get("eps", scene.eps)
+        eps = row.get("eps", scene.law.eps)
         k = counts[eps] = counts.get(eps, 0) + 1
         log.info(f"ε = {eps:.3g}  increment {k}/{scene.increments}  Q/(μP) = "
                  f"{row['q_ratio']:.4g}  stick half-width {row['stick_half_width']:.5g} "

@@ -84,7 +84,7 @@ def _cylinders(p: dict) -> tuple[float, float]:
     """Hertz's peak pressure p0 and the relative radius R of Carter's cylinders (2D)."""
     from fenicsfriction.studies.rolling import RollingContact
 
-    scene = RollingContact(dim=2, a=p["a"], G=p["G"], nu=p["nu"], mu=p["mu"], Fn=p["Fn"])
+    scene = RollingContact(dim=2, a=p["a"], G=p["G"], nu=p["nu"], Fn=p["Fn"])
     return scene.peak_pressure, scene.radius
 
 
@@ -92,10 +92,10 @@ def _fe_model(p: dict, comm: MPI.Comm) -> typing.Any:
     """The finite element model of the parameters ``p`` (built once, re-solved per creepage)."""
     from fenicsfriction.studies.rolling import RollingContact
 
-    renamed = {"normal": "pressure", "eps_sequence": "eps"}
+    renamed = {"normal": "pressure"}
     fields: dict[str, typing.Any] = {renamed.get(k, k): (tuple(v) if k == "eps_sequence" else v)
-                                     for k, v in p.items()}
-    scene = RollingContact(**fields)
+                                     for k, v in p.items() if k != "mu"}
+    scene = RollingContact(**fields).with_law(mu=p["mu"])
     return scene.build(comm)
 
 

@@ -54,7 +54,7 @@ __all__ = ["FORMULATIONS", "ContactOperator", "NodalValues", "NodeToSegment",
 
 #: the contact laws: ``"compliance"`` (normal compliance, friction regularised on the slip
 #: rate: Martins & Oden 1986) and ``"perturbed-lagrangian"`` (Pop, eq. 27: normal and
-#: tangential penalties ε_N = c_n, ε_T with their multipliers eliminated node by node)
+#: tangential penalties ε_N = c_n, κ_T with their multipliers eliminated node by node)
 FORMULATIONS = ("compliance", "perturbed-lagrangian")
 
 Value = typing.Any
@@ -69,10 +69,9 @@ class NodeToSegment:
         u: the displacement (degree-1 Lagrange vectors on the mesh holding both bodies).
         facet_tags: the mesh's facet tags.
         slave, master: the tags of the slave and master surfaces.
-        c_n, m_n, c_T, m_T, b_n, l_n, eps, regularisation: the interface law
-            (:class:`fenicsfriction.laws.InterfaceLaw`'s parameters: numbers or
-            ``fem.Constant``), ``c_T = 0`` (default) for frictionless contact, whose residual
-            then has no friction term.
+        law: the interface law (:class:`fenicsfriction.laws.InterfaceLaw`, its values numbers
+            or ``fem.Constant`` through ``law.replace``); a law without friction
+            (``law.has_friction`` false: μ = 0, no coefficient law) has no friction term.
         velocity: the slave velocity, a UFL vector of Functions of ``V`` (``u_dot`` in
             dynamics, ``(u - u_old) / dt`` in a quasi-static increment); ``None``: no velocity
             (frictionless statics).
@@ -84,9 +83,9 @@ class NodeToSegment:
         formulation: one of :data:`FORMULATIONS`. The perturbed Lagrangian's multipliers
             are nodal and enter their own equations quadratically, so they are eliminated at
             each slave node: λ_N = ε_N (-g)_+ (linear compliance, ``c_n`` = ε_N, m_n = 1) and
-            λ_T = ε_T times the slip increment from the last committed λ_T (:meth:`commit`),
-            returned to μλ_N in slide. ``eps`` is then unused.
-        eps_T: the tangential penalty ε_T [force/length³] (perturbed Lagrangian).
+            λ_T = κ_T times the slip increment from the last committed λ_T (:meth:`commit`),
+            returned to μλ_N in slide. The law's ε is then unused.
+        penalty_T: the tangential penalty κ_T [force/length³] (perturbed Lagrangian).
         time_step: the increment's duration, slip increment = velocity × time_step
             (perturbed Lagrangian; 1 with a quasi-static velocity (u - u_old)/1).
         search: when the pairing is searched again: ``"solve"`` (default) once at the start
@@ -110,12 +109,10 @@ class NodeToSegment:
     """
 
     def __init__(self, u: fem.Function, facet_tags: mesh.MeshTags, slave: int, master: int,
-                 c_n: Value, m_n: Value, c_T: Value = 0.0, m_T: Value | None = None,
-                 b_n: Value = 0.0, l_n: Value | None = None, eps: Value = 1e-3,
-                 regularisation: str = "c1", velocity: typing.Any = None,
+                 law: laws.InterfaceLaw, velocity: typing.Any = None,
                  fields: typing.Sequence[fem.Function] = (), transport: typing.Any = None,
                  weight: float = 1.0, frozen: bool = False, search: str = "solve",
-                 formulation: str = "compliance", eps_T: Value | None = None,
+                 formulation: str = "compliance", penalty_T: Value | None = None,
                  time_step: Value = 1.0):
         V = u.function_space
         msh = V.mesh
@@ -125,15 +122,14 @@ class NodeToSegment:
         for name, tag in (("slave", slave), ("master", master)):
             count = msh.comm.allreduce(int(np.count_nonzero(facet_tags.values == tag)))
             laws.check(name, tag, count > 0, "a facet tag present in facet_tags")
-        laws.check("regularisation", regularisation, regularisation in laws.REGULARISATIONS,
-                   f"one of {sorted(laws.REGULARISATIONS)}")
         laws.check("search", search, search in ("solve", "residual"), "'solve' or 'residual'")
         laws.check("formulation", formulation, formulation in FORMULATIONS,
                    f"one of {', '.join(FORMULATIONS)}")
         if formulation == "perturbed-lagrangian":
-            laws.check("m_n", m_n, m_n == 1, "the perturbed Lagrangian's normal penalty is "
-                       "linear: m_n = 1 (c_n is the penalty eps_N)")
-            laws.check("eps_T", eps_T, eps_T is not None, "the tangential penalty (> 0)")
+            laws.check("m_n", law.m_n, law.m_n == 1, "the perturbed Lagrangian's normal "
+                       "penalty is linear: m_n = 1 (c_n is the penalty eps_N)")
+            laws.check("penalty_T", penalty_T, penalty_T is not None,
+                       "the tangential penalty (> 0)")
         self.formulation = formulation
         #: the tangential multiplier of the last committed increment (perturbed Lagrangian)
         self.traction_old = fem.Function(V, name="tangential_multiplier")
@@ -141,7 +137,7 @@ class NodeToSegment:
         self.dim = dim
         self.frozen = frozen
         self.search_every_residual = search == "residual"
-        self.c_n, self.m_n, self.weight = c_n, m_n, weight
+        self.law, self.c_n, self.m_n, self.weight = law, law.c_n, law.m_n, weight
         self.search_pending = True
         self.W = _compat.lagrange_vector_space(msh, 1, dim * dim)
         slave_nodes = np.unique(facet_nodes(V, facet_tags, slave, outward=False))
@@ -170,21 +166,17 @@ class NodeToSegment:
                 w = w - ufl.as_vector(transport)
         self.relative_velocity = w
         approach = -ufl.dot(w, n) if w is not None else 0.0
-        self.pressure = laws.normal_traction(d, c_n, m_n, approach, b_n,
-                                             m_n if l_n is None else l_n)
+        self.pressure = law.normal_traction(d, approach)
         force = self.pressure * n
         self.traction = None
-        if not (isinstance(c_T, (int, float)) and c_T == 0):
+        if law.has_friction:
             laws.check("velocity", velocity, w is not None,
-                       "friction (c_T != 0) needs the slave velocity")
+                       "friction (mu != 0) needs the slave velocity")
             w_T = w - ufl.dot(w, n) * n
             if formulation == "compliance":
-                self.traction = laws.friction_traction(d, w_T, c_T,
-                                                       m_n if m_T is None else m_T, eps,
-                                                       regularisation)
+                self.traction = law.friction_traction(d, w_T)
             else:
-                self.traction = self._stick_penalty(d, w_T * time_step, n, c_T,
-                                                    m_n if m_T is None else m_T, eps_T)
+                self.traction = self._stick_penalty(d, w_T * time_step, n, penalty_T)
             force = force + self.traction
         v, omega = ufl.TestFunction(V), ufl.TestFunction(self.W)
         master_test = self.projection.interpolate([self._node(omega, a) for a in range(dim)])
@@ -192,10 +184,10 @@ class NodeToSegment:
         self.G = weight * ufl.inner(force, master_test) * self.ds
         # energy bookkeeping: the compliance's stored energy and the power the interface
         # dissipates (friction, normal damping), both >= 0
-        self.potential = weight * c_n * d ** (m_n + 1) / (m_n + 1) * self.ds
+        self.potential = weight * law.c_n * d ** (law.m_n + 1) / (law.m_n + 1) * self.ds
         dissipated = 0.0 * d
         if w is not None:
-            damping = self.pressure - laws.normal_pressure(d, c_n, m_n)
+            damping = self.pressure - law.pressure(d)
             dissipated = damping * approach
             if self.traction is not None:
                 dissipated = dissipated - ufl.dot(self.traction, w)
@@ -235,16 +227,16 @@ class NodeToSegment:
         from mpi4py import MPI
         return 2 * comm.allreduce(stiffness, op=MPI.MAX) / comm.allreduce(lightest, op=MPI.MIN)
 
-    def _stick_penalty(self, d: typing.Any, slip: typing.Any, n: typing.Any, c_T: Value,
-                       m_T: Value, eps_T: Value) -> typing.Any:
+    def _stick_penalty(self, d: typing.Any, slip: typing.Any, n: typing.Any,
+                       penalty_T: Value) -> typing.Any:
         """The tangential multiplier of the perturbed Lagrangian (Pop, eq. 27), eliminated
-        node by node: a stick spring of stiffness ε_T on the slip increment from the last
+        node by node: a stick spring of stiffness κ_T on the slip increment from the last
         committed multiplier, returned to the Coulomb bound c_T d^{m_T} when it would exceed
         it (slide)."""
         old = self.traction_old - ufl.dot(self.traction_old, n) * n
-        trial = old - eps_T * slip
+        trial = old - penalty_T * slip
         size = ufl.sqrt(ufl.dot(trial, trial))
-        bound = laws.friction_bound(d, c_T, m_T)
+        bound = self.law.friction_bound(d)
         return ufl.conditional(ufl.le(size, bound), trial, bound * trial / size)
 
     def commit(self) -> None:

@@ -93,13 +93,10 @@ class BlockData:
         B0: breadth out of the plane, the plane-strain thickness [cm].
         mass: total mass M [10^3 kg].
         weight: total weight W, applied as a body force [10^3 kg cm s^-2].
-        c_n, m_n: normal compliance c_n [10^3 kg cm^(-1-m_n) s^-2] and exponent [-].
-        mu: friction coefficient μ = c_T / c_n [-].
-        m_T: friction exponent [-] (None: m_n, Coulomb).
-        b_n, l_n: normal damping [10^3 kg cm^(-2-l_n) s^-1] and exponent [-] (None: m_n).
-        g: initial gap [cm].
-        eps: regularisation of |u̇_T - U_T| [cm/s].
-        regularisation: "c1" or "smooth".
+        law: the interface law (:class:`~fenicsfriction.laws.InterfaceLaw`, in the units
+            above: c_n [10^3 kg cm^(-1-m_n) s^-2], b_n [10^3 kg cm^(-2-l_n) s^-1], g [cm],
+            ε [cm/s]); default the paper's, eq. (36), with μ = 0. Change it with
+            ``dataclasses.replace(scene, law=scene.law.replace(mu=0.3))``.
         belt_speed: |U_T| [cm/s], > 0.
         belt_direction: +1 (belt moves along +x) or -1.
         K_x: total stiffness of the driver spring [10^3 kg s^-2].
@@ -111,15 +108,7 @@ class BlockData:
     B0: float = 30.5
     mass: float = 0.45
     weight: float = 450.0
-    c_n: float = 1e10
-    m_n: float = 2.5
-    mu: float = 0.0
-    m_T: float = None  # type: ignore[assignment]  # None: set by __post_init__
-    b_n: float = 0.0
-    l_n: float = None  # type: ignore[assignment]  # None: set by __post_init__
-    g: float = 0.0
-    eps: float = 1e-3
-    regularisation: str = "c1"
+    law: laws.InterfaceLaw = dataclasses.field(default_factory=laws.InterfaceLaw)
     belt_speed: float = 0.287
     belt_direction: int = 1
     K_x: float = 11.1
@@ -140,16 +129,12 @@ class BlockData:
               "must be +1 or -1")
         check("spring_height", self.spring_height, 0 <= self.spring_height <= self.H,
               f"must lie in [0, H] = [0, {self.H}]")
-        laws.InterfaceLaw(**self._law_parameters())  # validates the interface parameters
+        check("law", self.law, isinstance(self.law, laws.InterfaceLaw),
+              "must be a fenicsfriction.laws.InterfaceLaw (it validates its own parameters)")
 
-    def _law_parameters(self) -> dict:
-        names = ("c_n", "m_n", "mu", "m_T", "b_n", "l_n", "g", "eps", "regularisation")
-        return {name: getattr(self, name) for name in names}
-
-    @property
-    def law(self) -> laws.InterfaceLaw:
-        """The interface law of the scene (validated)."""
-        return laws.InterfaceLaw(**self._law_parameters())
+    def with_law(self, **changes: typing.Any) -> typing.Self:
+        """The scene with its law changed, e.g. ``scene.with_law(mu=0.3)``."""
+        return dataclasses.replace(self, law=self.law.replace(**changes))
 
     @property
     def tipping_limit(self) -> float:
@@ -165,7 +150,6 @@ class BlockOnBelt(BlockData):
         E: Young's modulus [10^3 kg cm^-1 s^-2].
         nu: Poisson's ratio [-].
         top_pressure: uniform pressure on the top face [10^3 kg cm^-1 s^-2] (0 in the paper).
-        friction_coefficient: velocity-dependent μ(|v|) replacing ``mu`` (see laws).
         refine: mesh refinement factor; the mesh has 4·refine × 3·refine cells.
         degree: polynomial degree of the Lagrange quadrilaterals (2: nine-node Q2).
         contact_quadrature: "gauss", "gll" (Gauss-Lobatto, includes the corners) or "nodal"
@@ -178,7 +162,6 @@ class BlockOnBelt(BlockData):
     E: float = 1.4e6
     nu: float = 0.25
     top_pressure: float = 0.0
-    friction_coefficient: laws.FrictionCoefficient | None = None
     refine: int = 1
     degree: int = 2
     contact_quadrature: str = "gauss"
@@ -204,9 +187,6 @@ class BlockOnBelt(BlockData):
               self.contact_quadrature != "nodal" or (self.degree == 1 and self.dim == 2),
               "the nodal rule is for degree 1 in 2D (trapezoidal on the facets' vertices)")
 
-    def _law_parameters(self) -> dict:
-        return {**super()._law_parameters(), "friction_coefficient": self.friction_coefficient}
-
     @property
     def contact_pressure(self) -> float:
         """Mean contact pressure (W + p_top L B0) / (L B0) at equilibrium."""
@@ -227,9 +207,9 @@ class BlockOnBelt(BlockData):
 
         Args:
             comm: communicator the mesh is distributed over (default ``MPI.COMM_WORLD``).
-            with_friction: include the friction term; default only when μ > 0 or a
-                velocity-dependent law is given (a frictionless scene assembles no friction,
-                and its μ cannot be stepped away from 0 afterwards).
+            with_friction: include the friction term; default only when the law has friction
+                (μ > 0, a friction coefficient law or a slip rule): a frictionless scene
+                assembles no friction, and its μ cannot be stepped away from 0 afterwards.
 
         Returns:
             The built :class:`~fenicsfriction.studies.block.model.BlockModel`.

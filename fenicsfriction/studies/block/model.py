@@ -29,7 +29,7 @@ from fenicsfriction.forms import (
     surface_traction,
     tangential_part,
 )
-from fenicsfriction.laws import check, is_speed_law
+from fenicsfriction.laws import check
 from fenicsfriction.studies.block import observables
 from fenicsfriction.studies.block.data import CONTACT, LEFT, QUADRATURE, RIGHT, TOP, BlockOnBelt
 
@@ -89,6 +89,8 @@ class BlockModel:
         mu, eps, thickness: ``fem.Constant`` — change ``mu.value`` / ``eps.value`` and re-solve
             (μ only when the friction term is there with a constant μ; otherwise a new value
             raises ``ValueError``).
+        law: the scene's interface law holding the model's ``fem.Constant`` (μ, c_n, g, ε):
+            the one law of the residual's terms and of the tractions read off a state.
         ds_contact: measure on Γ_C with the fixed quadrature degree used everywhere.
         spring: the driver's :class:`~fenicsfriction.forms.NodalSpring`.
     """
@@ -101,12 +103,12 @@ class BlockModel:
         Args:
             scene: the parameters.
             comm: communicator the mesh is distributed over.
-            with_friction: include the friction term (None: when μ > 0 or a law is given).
+            with_friction: include the friction term (None: when the law has friction).
         """
         self.scene = s = scene
         law = s.law
         if with_friction is None:
-            with_friction = s.mu > 0 or s.friction_coefficient is not None
+            with_friction = law.has_friction
         self.with_friction = with_friction
         msh, self.facet_tags, self.cell_tags = self._mesh(comm)
         self.msh = msh
@@ -123,22 +125,24 @@ class BlockModel:
 
         # 2D integrals are per unit breadth: times B0 makes every force a total
         thickness = s.B0 if s.dim == 2 else 1.0
-        self.eps, self.thickness = constant(s.eps), constant(thickness)
+        self.eps, self.thickness = constant(law.eps), constant(thickness)
         if not with_friction:
-            self.mu = _FixedParameter(msh, s.mu, "mu", "the model was built without friction "
+            self.mu = _FixedParameter(msh, law.mu, "mu", "the model was built without friction "
                                       "(with_friction=False, or mu = 0 and no friction law): "
                                       "build it with_friction=True to step mu")
-        elif s.friction_coefficient is not None:
-            self.mu = _FixedParameter(msh, s.mu, "mu", "the friction coefficient is the "
-                                      f"velocity-dependent law {s.friction_coefficient!r}, "
-                                      "not mu")
+        elif law.friction_coefficient is not None:
+            self.mu = _FixedParameter(msh, law.mu, "mu", "the friction coefficient is the "
+                                      f"velocity-dependent (or pressure-dependent) law "
+                                      f"{law.friction_coefficient!r}, not mu")
         else:
-            self.mu = constant(s.mu)
+            self.mu = constant(law.mu)
         e_x, e_y = np.eye(s.dim)[0], np.eye(s.dim)[1]
         self.c_n = constant(law.c_n)
         # exponents stay Python floats: UFL differentiates d**Constant very slowly
         self.m_n, self.m_T = float(law.m_n), float(law.m_T)
         self.gap = constant(law.g)
+        self.law = law.replace(c_n=self.c_n, m_n=self.m_n, mu=self.mu, m_T=self.m_T,
+                               g=self.gap, eps=self.eps)
         self.belt_velocity = fem.Constant(msh, s.belt_direction * s.belt_speed * e_x)
         volume = s.L * s.H * s.B0
         self.rho = constant(s.mass / volume)
@@ -211,14 +215,12 @@ class BlockModel:
                    v: ufl.Argument) -> tuple[ufl.Form | None, list]:
         """(UFL terms per unit breadth, couplings) of the contact and of any other body: here
         normal compliance, normal damping and friction against the rigid belt on Γ_C."""
-        s, law = self.scene, self.scene.law
-        n, ds_c = self.normal, self.ds_contact
-        terms = normal_compliance(u, v, n, self.c_n, self.m_n, self.gap, ds_c)
+        law, n, ds_c = self.law, self.normal, self.ds_contact
+        terms = normal_compliance(u, v, n, law, ds_c)
         if law.b_n > 0:
-            terms += normal_damping(u, u_dot, v, n, law.b_n, law.l_n, self.gap, ds_c)
+            terms += normal_damping(u, u_dot, v, n, law, ds_c)
         if self.with_friction:
-            terms += friction(u, u_dot, v, n, self.friction_c_T, self.m_T, self.gap,
-                              self.belt_velocity, self.eps, ds_c, s.regularisation)
+            terms += friction(u, u_dot, v, n, law, self.belt_velocity, ds_c)
         return terms, []
 
     def _supports(self) -> list[fem.DirichletBC]:
@@ -239,15 +241,14 @@ class BlockModel:
         s = self.scene
         u, v = self.residual.u.x.array, self.residual.u_dot.x.array
         y = self._contact_y
-        d = np.maximum(-u[y] - s.g, 0.0)
+        d = np.maximum(-u[y] - s.law.g, 0.0)
         slip = v[y - 1] - s.belt_direction * s.belt_speed
         return d, slip, np.where(d > 0, -v[y], 0.0)
 
     def damping_pressure(self) -> typing.Any:
         """UFL normal damping pressure b_n d^{l_n} ḋ on Γ_C (zero at rest)."""
-        law = self.scene.law
-        return laws.normal_damping_pressure(
-            self.penetration(), normal_part(self.residual.u_dot, self.normal), law.b_n, law.l_n)
+        return self.law.damping_pressure(self.penetration(),
+                                         normal_part(self.residual.u_dot, self.normal))
 
     def energy_forms(self) -> dict[str, ufl.Form]:
         """Kinetic and strain energies per unit breadth (UFL) of every body of the model."""
@@ -258,24 +259,14 @@ class BlockModel:
     def interface_power_forms(self) -> dict[str, ufl.Form]:
         """Power per unit breadth (UFL) of the friction and normal-damping tractions on the
         bodies: the residual's own terms with the velocity as test function, sign reversed."""
-        R, n, law = self.residual, self.normal, self.scene.law
+        R, n, law = self.residual, self.normal, self.law
         forms = {}
         if self.with_friction:
-            forms["friction"] = -friction(R.u, R.u_dot, R.u_dot, n, self.friction_c_T, self.m_T,
-                                          self.gap, self.belt_velocity, self.eps,
-                                          self.ds_contact, law.regularisation)
+            forms["friction"] = -friction(R.u, R.u_dot, R.u_dot, n, law, self.belt_velocity,
+                                          self.ds_contact)
         if law.b_n > 0:
-            forms["damping"] = -normal_damping(R.u, R.u_dot, R.u_dot, n, law.b_n, law.l_n,
-                                               self.gap, self.ds_contact)
+            forms["damping"] = -normal_damping(R.u, R.u_dot, R.u_dot, n, law, self.ds_contact)
         return forms
-
-    @property
-    def friction_c_T(self) -> typing.Any:
-        """c_T as used by the friction term: μ c_n, or c_n μ(|v|) for a velocity law."""
-        law = self.scene.friction_coefficient
-        if law is None:
-            return self.mu * self.c_n
-        return lambda speed: self.c_n * law(speed)
 
     # --- the tractions on Γ_C (UFL), those of the residual -----------------------------------
     def penetration(self, n: typing.Any = None) -> typing.Any:
@@ -285,17 +276,17 @@ class BlockModel:
 
     def pressure(self, n: typing.Any = None) -> typing.Any:
         """UFL normal contact pressure c_n d^{m_n} (elastic part)."""
-        return laws.normal_pressure(self.penetration(n), self.c_n, self.m_n)
+        return self.law.pressure(self.penetration(n))
 
     def friction_traction(self, n: typing.Any = None) -> typing.Any:
         """UFL friction traction on the body at the current velocity ``u_dot`` (zero in steady
-        sliding), a vector tangent to Γ_C: :func:`fenicsfriction.laws.friction_traction`."""
+        sliding), a vector tangent to Γ_C: the law's
+        (:meth:`fenicsfriction.laws.InterfaceLaw.friction_traction`)."""
         if not self.with_friction:
             return ufl.zero(self.scene.dim)
         n = self.normal if n is None else n
         w = tangential_part(self.residual.u_dot, n) - self.belt_velocity
-        return laws.friction_traction(self.penetration(n), w, self.friction_c_T, self.m_T,
-                                      self.eps, self.scene.regularisation)
+        return self.law.friction_traction(self.penetration(n), w)
 
     def contact_traction(self) -> typing.Any:
         """UFL traction of the foundation on the body, valid in cells (for output fields).
@@ -321,14 +312,10 @@ class BlockModel:
         """
         if not self.with_friction:
             return None
-        c_T = self.friction_c_T
-        if is_speed_law(c_T):
-            c_T = c_T(0.0)
-        curvature = laws.REGULARISATIONS[self.scene.regularisation][2](0.0, self.eps)
         v = self.residual.v
         tangential = sum(v[i] for i in range(self.scene.dim) if i != 1)
-        return self.thickness * laws.friction_bound(self.penetration(), c_T, self.m_T) \
-            * curvature * tangential * self.ds_contact
+        return self.thickness * self.law.friction_bound(self.penetration()) \
+            * self.law.stick_curvature() * tangential * self.ds_contact
 
     # --- preparing a state -----------------------------------------------------------------------
     @property
@@ -346,7 +333,7 @@ class BlockModel:
         s = self.scene
         d0 = s.law.uniform_penetration(s.contact_pressure)
         ux = s.belt_direction * float(self.mu.value) * s.contact_pressure * s.L * s.B0 / s.K_x
-        value = np.array([ux, -(d0 + s.g), 0.0][:s.dim])
+        value = np.array([ux, -(d0 + s.law.g), 0.0][:s.dim])
         self.residual.u.interpolate(lambda x: np.tile(value[:, None], (1, x.shape[1])))
 
     def slide_to(self, mu: float, solver: SteadySolver, step: float = 0.05

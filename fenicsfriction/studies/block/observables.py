@@ -115,7 +115,7 @@ class ProbeValues(Record):
         u_y, v_x, v_y: its displacement and velocity [cm, cm/s].
         slip: v_x - U_T [cm/s].
         pressure: normal traction c_n d^{m_n} + b_n d^{l_n} ḋ [force / cm²].
-        friction: x-traction of the belt on the body, -c_T(|slip|) d^{m_T} φ'_ε(slip).
+        friction: x-traction of the belt on the body, -c_T(|slip|, p) d^{m_T} φ'_ε(slip).
     """
 
     x: float
@@ -238,7 +238,7 @@ def powers(model: BlockModel) -> Powers:
     terms (:func:`~fenicsfriction.forms.friction`, :func:`~fenicsfriction.forms.normal_damping`)
     with the velocity u̇ as test function, sign reversed."""
     values = {"friction": 0.0, "damping": 0.0}
-    if model.with_friction or model.scene.b_n > 0:
+    if model.with_friction or model.scene.law.b_n > 0:
         values.update(_evaluate(model, "power", _power_forms))
     return Powers(**values)
 
@@ -273,15 +273,13 @@ def centre_of_mass(model: BlockModel) -> CentreOfMass:
     return _centre(model, _evaluate(model, "centre", _centre_forms))
 
 
-def _nodal_c_T(model: BlockModel, law: laws.InterfaceLaw) -> typing.Any:
-    """c_T of the friction term as a NumPy value or a NumPy function of the slip speed."""
-    s = model.scene
+def _nodal_law(model: BlockModel) -> laws.InterfaceLaw:
+    """The scene's law with the model's current μ and ε, as NumPy numbers (μ = 0 without a
+    friction term)."""
+    law = model.scene.law.replace(mu=float(model.mu.value), eps=float(model.eps.value))
     if not model.with_friction:
-        return 0.0
-    if s.friction_coefficient is not None:
-        coefficient = s.friction_coefficient
-        return lambda speed: law.c_n * coefficient(speed)
-    return float(model.mu.value) * law.c_n
+        law = law.replace(mu=0.0, friction_coefficient=None, slip_rule=None)
+    return law
 
 
 def _probe_node(model: BlockModel, x: float) -> tuple[int, int, float]:
@@ -304,13 +302,11 @@ def _probe_values(model: BlockModel, dof: int, node_x: float, law: laws.Interfac
                   nodal: tuple) -> ProbeValues:
     """The probe's values, on the rank that owns its node (``nodal``: this rank's
     :meth:`~fenicsfriction.studies.block.model.BlockModel.nodal_contact`)."""
-    s = model.scene
     u, v = model.residual.u.x.array, model.residual.u_dot.x.array
     k = int(np.flatnonzero(model._contact_y == dof)[0])
     d, slip, rate = (float(a[k]) for a in nodal)
-    pressure = laws.normal_traction(d, law.c_n, law.m_n, rate, law.b_n, law.l_n)
-    traction = laws.friction_traction(d, np.array([slip]), _nodal_c_T(model, law), law.m_T,
-                                      float(model.eps.value), s.regularisation)[0]
+    pressure = law.normal_traction(d, rate)
+    traction = law.friction_traction(d, np.array([slip]))[0]
     return ProbeValues(x=node_x, u_y=float(u[dof]), v_x=float(v[dof - 1]), v_y=float(v[dof]),
                        slip=float(slip), pressure=float(pressure), friction=float(traction))
 
@@ -319,12 +315,12 @@ def probe(model: BlockModel, x: float) -> ProbeValues:
     """Nodal values at the contact node nearest to abscissa ``x`` (same on every rank).
 
     The tractions are those of :mod:`fenicsfriction.laws` at the node's penetration and slip,
-    with the model's friction coefficient (velocity-dependent μ(|slip|) included).
+    with the model's μ and ε (a friction coefficient law μ(|slip|, p) included).
     """
     owner, dof, node_x = _probe_node(model, x)
     comm = model.msh.comm
     nodal = model.nodal_contact()  # collective
-    values = (_probe_values(model, dof, node_x, model.scene.law, nodal)
+    values = (_probe_values(model, dof, node_x, _nodal_law(model), nodal)
               if comm.rank == owner else None)
     return comm.bcast(values, root=owner)
 
@@ -388,7 +384,6 @@ def dynamics_observer(model: BlockModel, probe_x: float | None = None
               "p": _power_forms(model), "c": _centre_forms(model)}
     functionals = Functionals(model.msh, {f"{g}.{k}": f for g, forms in groups.items()
                                           for k, f in forms.items()})
-    law = model.scene.law
     owner, dof, node_x = _probe_node(model, x)
     comm = model.msh.comm
     probe_fields = [f.name for f in dataclasses.fields(ProbeValues)]
@@ -401,7 +396,8 @@ def dynamics_observer(model: BlockModel, probe_x: float | None = None
         nodal = model.nodal_contact()  # collective: before the integrals, which use its search
         node = np.zeros(len(probe_fields))
         if comm.rank == owner:
-            node[:] = dataclasses.astuple(_probe_values(model, dof, node_x, law, nodal))
+            node[:] = dataclasses.astuple(_probe_values(model, dof, node_x, _nodal_law(model),
+                                                        nodal))
         total = np.concatenate([functionals.local(), [_local_spring_force(model)],
                                 _contact_counts(model, nodal), node])
         extremes = _penetration_extremes(model, nodal)

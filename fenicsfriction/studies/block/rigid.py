@@ -32,7 +32,6 @@ import typing
 
 import numpy as np
 
-from fenicsfriction import laws
 from fenicsfriction.laws import check
 from fenicsfriction.numerics import bisect, dense_eigenvalues
 from fenicsfriction.results import Record
@@ -60,7 +59,6 @@ class RigidBlock(BlockData):
         if self.inertia is None:
             self.inertia = self.mass * (self.L**2 + self.H**2) / 12
         super().__post_init__()
-        self.m_T, self.l_n = self.law.m_T, self.law.l_n
 
     def validate(self) -> None:
         super().validate()
@@ -76,14 +74,9 @@ class RigidBlock(BlockData):
         """The rigid counterpart of a scene (its :class:`BlockData` fields), with ``changes``.
 
         A uniform top pressure p of the FE scene is a vertical resultant p L B0 through G, so
-        it joins the weight; a velocity-dependent friction law has no rigid counterpart here
-        and is refused rather than silently replaced by ``mu``.
+        it joins the weight; the law is the scene's, friction coefficient law included.
         """
         shared = {f.name: getattr(scene, f.name) for f in dataclasses.fields(BlockData)}
-        law = getattr(scene, "friction_coefficient", None)
-        if law is not None:
-            raise ValueError(f"friction_coefficient={law!r} is invalid: "
-                             "the rigid block supports a constant mu only")
         shared["weight"] += getattr(scene, "top_pressure", 0.0) * scene.L * scene.B0
         return cls(**{**shared, **changes})
 
@@ -98,7 +91,8 @@ class RigidBlock(BlockData):
         check("ratios", ratios, len(ratios) == 3 and all(np.isfinite(z) and z >= 0
                                                          for z in ratios),
               "must be three finite ratios >= 0")
-        frictionless = cls(**{**data, "mu": 0.0})
+        law = data.get("law", BlockData().law)
+        frictionless = cls(**{**data, "law": law.replace(mu=0.0, friction_coefficient=None)})
         M, _, K = frictionless.linearisation(frictionless.steady_state())
         viscous = tuple(float(2 * z * np.sqrt(k * m))
                         for z, k, m in zip(ratios, np.diag(K), np.diag(M), strict=True))
@@ -112,7 +106,7 @@ class RigidBlock(BlockData):
     def _contact_interval(self, q: np.ndarray) -> tuple[float, float, bool] | None:
         """Contact part [lo, hi] of the base and whether d vanishes at ``lo`` (else at ``hi``
         or nowhere: full contact)."""
-        a, theta = -q[1] - self.g, q[2]
+        a, theta = -q[1] - self.law.g, q[2]
         lo, hi = -self.L / 2, self.L / 2
         if theta == 0.0:
             return (lo, hi, False) if a > 0 else None
@@ -135,7 +129,7 @@ class RigidBlock(BlockData):
         if interval is None:
             return np.zeros(size)
         lo, hi, at_lo = interval
-        a, theta = -q[1] - self.g, q[2]
+        a, theta = -q[1] - self.law.g, q[2]
         t, weights = _GAUSS
         lift_off = theta != 0.0 and (at_lo or hi < self.L / 2)
         if lift_off:
@@ -157,12 +151,11 @@ class RigidBlock(BlockData):
         """Q(q, q̇): interface, spring and weight forces on (u_xG, u_yG, θ)."""
         U = self.belt_direction * self.belt_speed
         w = q_dot[0] + q_dot[2] * self.H / 2 - U
-        c_T = self.mu * self.c_n
+        law = self.law
 
         def integrand(s: np.ndarray, d: np.ndarray) -> np.ndarray:
-            p = laws.normal_traction(d, self.c_n, self.m_n, -(q_dot[1] + q_dot[2] * s),
-                                     self.b_n, self.l_n)
-            t = laws.friction_traction(d, w, c_T, self.m_T, self.eps, self.regularisation)
+            p = law.normal_traction(d, -(q_dot[1] + q_dot[2] * s))
+            t = law.friction_traction(d, w)
             return np.array([t, p, p * s + t * self.H / 2])  # arrays over s
 
         Q = self._integrate(q, integrand, 3)
@@ -176,25 +169,24 @@ class RigidBlock(BlockData):
 
     def linearisation(self, q: np.ndarray, q_dot: np.ndarray | None = None
                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(M, C, K̄) = (∂R/∂q̈, ∂R/∂q̇, ∂R/∂q) at (q, q̇), derived by hand from the laws."""
+        """(M, C, K̄) = (∂R/∂q̈, ∂R/∂q̇, ∂R/∂q) at (q, q̇): the kinematics differentiated by
+        hand, the tractions by the law's NumPy derivatives
+        (:meth:`~fenicsfriction.laws.InterfaceLaw.friction_traction_derivatives`)."""
         q = np.asarray(q, float)
         q_dot = np.zeros(3) if q_dot is None else np.asarray(q_dot, float)
         U = self.belt_direction * self.belt_speed
         w = q_dot[0] + q_dot[2] * self.H / 2 - U
-        _, first, second = laws.REGULARISATIONS[self.regularisation]
-        dphi, ddphi = first(w, self.eps), second(w, self.eps)
-        c_T, h2 = self.mu * self.c_n, self.H / 2
-        mn, mT, ln = self.m_n, self.m_T, self.l_n
+        law, h2 = self.law, self.H / 2
 
         def integrand(s, d):
             vn = -(q_dot[1] + q_dot[2] * s)  # normal velocity into the belt
-            dp_dd = mn * self.c_n * d ** (mn - 1) + ln * self.b_n * d ** (ln - 1) * vn
-            dt_dd = -mT * c_T * d ** (mT - 1) * dphi
+            dp_dd, dp_dvn = law.normal_traction_derivatives(d, vn)
+            dt_dd, dt_dw = law.friction_traction_derivatives(d, w)
             zero, one = np.zeros_like(s), np.ones_like(s)
             dd = np.array([zero, -one, -s])  # ∂d/∂q, one column per point
             dp_dq, dt_dq = dp_dd * dd, dt_dd * dd
-            dp_dqdot = self.b_n * d**ln * np.array([zero, -one, -s])
-            dt_dqdot = -c_T * d**mT * ddphi * np.array([one, zero, h2 * one])
+            dp_dqdot = dp_dvn * np.array([zero, -one, -s])
+            dt_dqdot = dt_dw * np.array([one, zero, h2 * one])
             rows = lambda dp, dt: np.array([dt, dp, dp * s + dt * h2])  # noqa: E731
             return np.concatenate([rows(dp_dq, dt_dq), rows(dp_dqdot, dt_dqdot)])
 
@@ -207,8 +199,9 @@ class RigidBlock(BlockData):
 
     # --- solutions -------------------------------------------------------------------------------
     def initial_guess(self) -> np.ndarray:
-        d0 = (self.weight / (self.L * self.B0 * self.c_n)) ** (1 / self.m_n)
-        return np.array([self.belt_direction * self.mu * self.weight / self.K_x, -d0 - self.g,
+        law = self.law
+        d0 = (self.weight / (self.L * self.B0 * law.c_n)) ** (1 / law.m_n)
+        return np.array([self.belt_direction * law.mu * self.weight / self.K_x, -d0 - law.g,
                          0.0])
 
     def steady_state(self, q0: np.ndarray | None = None, tol: float = 1e-12,
@@ -234,7 +227,7 @@ class RigidBlock(BlockData):
                     break
                 alpha /= 2
             q, r = trial, r_trial
-        raise RuntimeError(f"rigid block: Newton did not converge at mu={self.mu} "
+        raise RuntimeError(f"rigid block: Newton did not converge at mu={self.law.mu} "
                            f"(scaled residual {np.max(np.abs(r) / scale):.3e})")
 
     def eigenvalues(self, q: np.ndarray) -> np.ndarray:
@@ -281,7 +274,7 @@ def rigid_loci(scene: BlockData, targets: typing.Sequence[float] | np.ndarray,
 
     def values(mu: float) -> np.ndarray:
         nonlocal q
-        block = RigidBlock.from_scene(scene, mu=mu)
+        block = RigidBlock.from_scene(scene, law=scene.law.replace(mu=mu))
         q = block.steady_state(q)
         lam = block.eigenvalues(q)
         return lam[(lam.imag >= 0) & (np.abs(lam) <= max_frequency)]
@@ -328,19 +321,19 @@ def rigid_block_observables(block: RigidBlock, q: typing.Any, q_dot: typing.Any,
     q, q_dot = np.asarray(q, float), np.asarray(q_dot, float)
     check("probe_x", probe_x, probe_x is None or 0 <= probe_x <= block.L,
           f"must lie on the base, in [0, L = {block.L}]")
+    law = block.law
     Q = block.generalised_forces(q, q_dot)  # interface integrals + (F_s, -W, -F_s arm)
     spring = block._spring(q)
     w = q_dot[0] + q_dot[2] * block.H / 2 - block.belt_direction * block.belt_speed
     if block._contact_interval(q) is None:
         contact = "open"
     else:
-        contact = "stick" if abs(w) < block.eps else "slip"
-    elastic = block._integrate(q, lambda s, d: block.c_n * d**block.m_n, 1)[0]
+        contact = "stick" if abs(w) < law.eps else "slip"
+    elastic = block._integrate(q, lambda s, d: law.pressure(d), 1)[0]
     x = 0.5 * block.L if probe_x is None else float(probe_x)
     s = x - 0.5 * block.L  # from G's vertical
-    d = max(-q[1] - block.g - q[2] * s, 0.0)
-    friction = laws.friction_traction(d, w, block.mu * block.c_n, block.m_T, block.eps,
-                                      block.regularisation)
+    d = max(-q[1] - law.g - q[2] * s, 0.0)
+    friction = law.friction_traction(d, w)
     return {"normal_force": float(Q[1] + block.weight), "normal_force_elastic": float(elastic),
             "friction_force": float(Q[0] - spring), "spring_force": float(spring),
             "spring_elongation": float(-spring / block.K_x),
@@ -349,5 +342,5 @@ def rigid_block_observables(block: RigidBlock, q: typing.Any, q_dot: typing.Any,
             "probe_x": x, "probe_u_y": float(q[1] + q[2] * s),
             "probe_v_x": float(q_dot[0] + q_dot[2] * block.H / 2),
             "probe_v_y": float(q_dot[1] + q_dot[2] * s), "probe_slip": float(w),
-            "probe_pressure": float(laws.normal_pressure(d, block.c_n, block.m_n)),
+            "probe_pressure": float(law.pressure(d)),
             "probe_friction": float(friction)}

@@ -89,7 +89,7 @@ class SlabModel(BlockModel):
     scene: BlockOnSlab
 
     def __init__(self, scene: BlockOnSlab, comm: MPI.Comm, with_friction: bool | None):
-        laws.check("g", scene.g, scene.g == 0,
+        laws.check("g", scene.law.g, scene.law.g == 0,
                    "must be 0: the slab scene starts with the block on the slab")
         super().__init__(scene, comm, with_friction)
 
@@ -135,14 +135,14 @@ class SlabModel(BlockModel):
                    v: ufl.Argument) -> tuple[ufl.Form, list]:
         """The slab's inertia and elasticity, and the block-slab contact (a coupling whose
         forms are per unit breadth times B0, like the residual's)."""
-        s, law = self.scene, self.scene.law
+        s = self.scene
+        law = self.law if self.with_friction else \
+            self.law.replace(mu=0.0, friction_coefficient=None, slip_rule=None)
         self.rho_slab = fem.Constant(self.msh, np.float64(s.slab_density))
         slab = inertia(self.rho_slab, u_ddot, v, self.dx_slab) \
             + elasticity(u, v, s.slab_E, s.slab_nu, self.dx_slab)
         self.contact = NodeToSegment(
-            u, self.facet_tags, slave=CONTACT, master=SLAB_TOP, c_n=self.c_n, m_n=self.m_n,
-            c_T=self.friction_c_T if self.with_friction else 0.0, m_T=self.m_T, b_n=law.b_n,
-            l_n=law.l_n, eps=self.eps, regularisation=law.regularisation, velocity=u_dot,
+            u, self.facet_tags, slave=CONTACT, master=SLAB_TOP, law=law, velocity=u_dot,
             fields=[u_dot], transport=self.belt_velocity, weight=float(self.thickness.value))
         self.ds_contact = self.contact.ds
         return slab, [self.contact]

@@ -23,7 +23,7 @@ from mpi4py import MPI
 import numpy as np
 import ufl
 
-from fenicsfriction import _compat
+from fenicsfriction import _compat, laws
 from fenicsfriction.dynamics import CentralDifference, DynamicsSolver
 from fenicsfriction.laws import check
 from fenicsfriction.studies.contact import closed_forms, geometry
@@ -44,12 +44,13 @@ class PressAndDrag(_Bodies):
         load: P [force/length]; ``None``: the load of a Hertz half-width R/10.
         radius: R [length].
         density: both bodies' mass density [mass/length³].
-        mu: friction coefficient (0: frictionless, no drag).
-        eps: regularisation of the slip rate [length/time]. Against the contact's speeds
-            (~1e-3 at the drag): with ε = 1e-4 and dt = 0.02 the stick dashpots
-            (c_T d/ε per node, far stiffer than 1/dt²) make Newton fail at most stick
-            transitions and the energy balance drifts (docs/contact.md).
-        b_n: normal damping coefficient (exponent m_n).
+        law: the interface law: compliance c_n d^m_n, normal damping b_n, friction
+            coefficient ``mu`` (0: frictionless, no drag) and the regularisation ``eps`` of the
+            slip rate [length/time]; default c_n = 1e3, m_n = 1, μ = 0.3, ε = 1e-3, b_n = 0.
+            Against the contact's speeds (~1e-3 at the drag): with ε = 1e-4 and dt = 0.02 the
+            stick dashpots (c_T d/ε per node, far stiffer than 1/dt²) make Newton fail at most
+            stick transitions and the energy balance drifts (docs/contact.md). The drag is
+            ``q_ratio`` times the law's constant ``mu``.
         q_ratio: the drag Q/(μP) between ``drag_start`` and ``drag_end``.
         drag_start, drag_end, t_end: times [time].
         h_contact: the mesh size at the contact [length].
@@ -61,10 +62,8 @@ class PressAndDrag(_Bodies):
     load: float | None = None
     radius: float = 1.0
     density: float = 1.0
-    c_n: float = 1e3
-    mu: float = 0.3
-    eps: float = 1e-3
-    b_n: float = 0.0
+    law: laws.InterfaceLaw = dataclasses.field(
+        default_factory=lambda: laws.InterfaceLaw(c_n=1e3, m_n=1.0, mu=0.3, eps=1e-3))
     q_ratio: float = 1.5
     drag_start: float = 10.0
     drag_end: float = 20.0
@@ -78,24 +77,21 @@ class PressAndDrag(_Bodies):
             self.load = closed_forms.hertz_load(self.radius / 10, self.radius, self.E_star)
         check("load", self.load, self.load > 0, "the load must be > 0")
         check("density", self.density, self.density > 0, "must be > 0")
-        check("mu", self.mu, self.mu >= 0, "must be >= 0")
-        check("eps", self.eps, self.eps > 0, "must be > 0")
         check("drag_start", self.drag_start, 0 <= self.drag_start <= self.drag_end,
               "0 <= drag_start <= drag_end")
         check("t_end", self.t_end, self.t_end > 0, "must be > 0")
 
     def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
         mesh = geometry.hertz_2d(comm, R=self.radius, h_contact=self.h_contact)
-        return TwoBodyModel(mesh, self.materials, self.c_n, self.m_n, mu=self.mu,
-                            eps=self.eps, passes=self.passes, density=self.density,
-                            b_n=self.b_n)
+        return TwoBodyModel(mesh, self.materials, self.law, passes=self.passes,
+                            density=self.density)
 
     def traction(self, t: float) -> np.ndarray:
         """The traction on the cylinder's top at time t: −P/(2R) normal, the drag between
         ``drag_start`` and ``drag_end``."""
         assert self.load is not None
         p = self.load / (2 * self.radius)
-        drag = self.q_ratio * self.mu * p if self.drag_start <= t < self.drag_end else 0.0
+        drag = self.q_ratio * self.law.mu * p if self.drag_start <= t < self.drag_end else 0.0
         return np.array([drag, -p])
 
     def run(self, scheme: str = "alpha2", dt: float = 0.05, comm: MPI.Comm = MPI.COMM_WORLD,

@@ -26,7 +26,7 @@ import numpy as np
 import ufl
 from dolfinx import fem, mesh
 
-from fenicsfriction import _compat, forms
+from fenicsfriction import _compat, forms, laws
 from fenicsfriction.contact import NodeToSegment, facet_nodes, solve_with_search
 from fenicsfriction.contact.node_to_segment import NodalValues
 from fenicsfriction.laws import check
@@ -87,9 +87,9 @@ class TwoBodyModel:
     Args:
         geometry: the mesh and its tags.
         materials: body 1's and body 2's :class:`Material`.
-        c_n, m_n: normal compliance (pressure c_n d^m_n) [force/length^(2+m_n)], [-].
-        mu: friction coefficient (0: frictionless, no friction term).
-        eps: regularisation of the slip increment [length per pseudo-time].
+        law: the interface law (:class:`~fenicsfriction.laws.InterfaceLaw`): c_n, m_n, μ (0:
+            frictionless, no friction term), ε (regularisation of the slip increment [length
+            per pseudo-time]), the regularisation and b_n (dynamic models).
         passes: 1 (body 1's surface is the slave) or 2 (each surface in turn).
         clamp: body 2's :data:`FIXED` face clamped (True) or on rollers (normal component
             fixed only: a patch test's free lateral expansion).
@@ -97,9 +97,9 @@ class TwoBodyModel:
             friction on the slip rate u̇, normal damping ``b_n``, the LOAD face under the
             traction ``shear`` in every direction: no platen, inertia carries body 1); ``None``
             (default): quasi-static.
-        b_n: normal damping coefficient (dynamic models), exponent ``m_n``.
-        formulation, eps_T: the contact law (``"compliance"`` or ``"perturbed-lagrangian"``
-            with the tangential penalty ``eps_T``; :class:`~fenicsfriction.contact.NodeToSegment`).
+        formulation, penalty_T: the contact formulation (``"compliance"`` or
+            ``"perturbed-lagrangian"`` with the tangential penalty κ_T;
+            :class:`~fenicsfriction.contact.NodeToSegment`).
         fix_load_face: also fix the tangential displacement of the :data:`LOAD` face
             (removes the sliding mode of a frictionless body 1 in a full model); else the
             face carries the tangential traction ``shear``.
@@ -119,16 +119,10 @@ class TwoBodyModel:
     """
 
     def __init__(self, geometry: TwoBodyMesh, materials: tuple[Material, Material],
-                 c_n: float, m_n: float = 1.0, mu: float = 0.0, eps: float = 1e-6,
-                 passes: int = 1, fix_load_face: bool = False,
-                 regularisation: str = "c1", clamp: bool = True,
-                 density: float | None = None, b_n: float = 0.0,
-                 formulation: str = "compliance", eps_T: float | None = None):
+                 law: laws.InterfaceLaw, passes: int = 1, fix_load_face: bool = False,
+                 clamp: bool = True, density: float | None = None,
+                 formulation: str = "compliance", penalty_T: float | None = None):
         check("passes", passes, passes in (1, 2), "1 or 2")
-        check("c_n", c_n, c_n > 0, "the normal compliance coefficient must be > 0")
-        check("m_n", m_n, m_n >= 1, "the normal exponent must be >= 1")
-        check("mu", mu, mu >= 0, "the friction coefficient must be >= 0")
-        check("eps", eps, eps > 0, "the regularisation parameter must be > 0")
         self.geometry = geometry
         msh, cell_tags, facet_tags = geometry.mesh, geometry.cell_tags, geometry.facet_tags
         self.comm: MPI.Comm = msh.comm
@@ -152,23 +146,24 @@ class TwoBodyModel:
             check("density", density, density > 0, "the mass density must be > 0")
             form += forms.inertia(density, u_ddot, v, dx)
         self.density = density
-        self.mu = fem.Constant(msh, float(mu))
-        self.eps = fem.Constant(msh, float(eps))
+        self.law = law
+        self.mu = fem.Constant(msh, float(law.mu))
+        self.eps = fem.Constant(msh, float(law.eps))
         self.dt = fem.Constant(msh, 1.0)
-        law: dict = {"b_n": b_n}
+        options: dict = {}
         if self.dynamic:
-            law.update(velocity=u_dot, fields=[u_dot])
-        if mu > 0:
-            law.update({"c_T": self.mu * c_n, "m_T": m_n, "eps": self.eps,
-                        "regularisation": regularisation})
+            options.update(velocity=u_dot, fields=[u_dot])
+        if law.has_friction:
+            law = law.replace(mu=self.mu, eps=self.eps)
             if not self.dynamic:
-                law.update({"velocity": (self.u - self.u_old) / self.dt,
-                            "fields": [self.u_old], "time_step": self.dt})
-            self.eps_T = fem.Constant(msh, float(eps_T if eps_T is not None else 0.0))
-            law.update({"formulation": formulation, "eps_T": self.eps_T})
+                options.update({"velocity": (self.u - self.u_old) / self.dt,
+                                "fields": [self.u_old], "time_step": self.dt})
+            self.penalty_T = fem.Constant(msh, float(penalty_T if penalty_T is not None
+                                                     else 0.0))
+            options.update({"formulation": formulation, "penalty_T": self.penalty_T})
         pairs = [(SLAVE, MASTER), (MASTER, SLAVE)][:passes]
-        self.contacts = [NodeToSegment(self.u, facet_tags, slave, master, c_n=c_n, m_n=m_n,
-                                       weight=1.0 / passes, **law)
+        self.contacts = [NodeToSegment(self.u, facet_tags, slave, master, law,
+                                       weight=1.0 / passes, **options)
                          for slave, master in pairs]
         self.residual = forms.Residual(form, self.u, u_dot, u_ddot, v,
                                        bcs=self._bcs(fix_load_face, clamp),

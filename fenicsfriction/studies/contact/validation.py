@@ -24,6 +24,7 @@ from mpi4py import MPI
 
 import numpy as np
 
+from fenicsfriction import laws
 from fenicsfriction.laws import check
 from fenicsfriction.studies.contact import closed_forms, geometry
 from fenicsfriction.studies.contact.model import Material, SurfaceValues, TwoBodyModel
@@ -42,8 +43,9 @@ class _Bodies:
         E1, nu1: body 1's (cylinder, sphere, upper block) Young's modulus [force/length²] and
             Poisson's ratio.
         E2, nu2: body 2's (the block below).
-        c_n: normal compliance coefficient [force/length^(2+m_n)]; pressure c_n d^m_n.
-        m_n: normal compliance exponent (1: a linear penalty).
+        law: the interface law (:class:`~fenicsfriction.laws.InterfaceLaw`): normal compliance
+            c_n d^m_n [force/length^(2+m_n)], friction, regularisation; default frictionless,
+            c_n = 1e4, m_n = 1 (a linear penalty). Change it with ``scene.with_law(c_n=...)``.
         passes: 1 (body 1's surface is the slave) or 2 (each surface slave in turn).
     """
 
@@ -51,15 +53,19 @@ class _Bodies:
     nu1: float = 0.3
     E2: float = 1.0
     nu2: float = 0.3
-    c_n: float = 1e4
-    m_n: float = 1.0
+    law: laws.InterfaceLaw = dataclasses.field(
+        default_factory=lambda: laws.InterfaceLaw(c_n=1e4, m_n=1.0))
     passes: int = 1
 
     def __post_init__(self) -> None:
         self.E_star  # noqa: B018  (validates E1, nu1, E2, nu2, naming each)
-        check("c_n", self.c_n, self.c_n > 0, "the normal compliance coefficient must be > 0")
-        check("m_n", self.m_n, self.m_n >= 1, "the normal exponent must be >= 1")
+        check("law", self.law, isinstance(self.law, laws.InterfaceLaw),
+              "must be a fenicsfriction.laws.InterfaceLaw (it validates its own parameters)")
         check("passes", self.passes, self.passes in (1, 2), "1 or 2")
+
+    def with_law(self, **changes: typing.Any) -> typing.Self:
+        """The scene with its law changed, e.g. ``scene.with_law(c_n=1e5)``."""
+        return dataclasses.replace(self, law=self.law.replace(**changes))
 
     @property
     def materials(self) -> tuple[Material, Material]:
@@ -113,7 +119,7 @@ class Hertz(_Bodies):
             comm, R=self.radius, refine=self.refine, h_contact=self.h_contact)
         # the 2D cylinder's sliding is stopped at its loaded face; the quarter sphere's by the
         # symmetry planes
-        return TwoBodyModel(mesh, self.materials, self.c_n, self.m_n, passes=self.passes,
+        return TwoBodyModel(mesh, self.materials, self.law, passes=self.passes,
                             fix_load_face=self.dim == 2)
 
     def run(self, comm: MPI.Comm = MPI.COMM_WORLD, model: TwoBodyModel | None = None
@@ -134,8 +140,8 @@ class Hertz(_Bodies):
         summary = {
             "scene": "hertz", "dim": self.dim, "load": solved["load"] / share,
             "parameters": {"radius": self.radius, "E1": self.E1, "nu1": self.nu1,
-                           "E2": self.E2, "nu2": self.nu2, "c_n": self.c_n, "m_n": self.m_n,
-                           "refine": self.refine, "passes": self.passes,
+                           "E2": self.E2, "nu2": self.nu2, "c_n": self.law.c_n,
+                           "m_n": self.law.m_n, "refine": self.refine, "passes": self.passes,
                            "h_contact": model.geometry.parameters["h_contact"]},
             "dofs": model.dofs, "ranks": comm.size,
             width: measured, f"hertz_{width}": a,
@@ -175,8 +181,7 @@ class Patch(_Bodies):
     def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
         mesh = (geometry.patch_2d if self.dim == 2 else geometry.patch_3d)(
             comm, n_upper=self.n_upper, n_lower=self.n_lower)
-        model = TwoBodyModel(mesh, self.materials, self.c_n, self.m_n, passes=self.passes,
-                             clamp=False)
+        model = TwoBodyModel(mesh, self.materials, self.law, passes=self.passes, clamp=False)
         model.rollers(range(self.dim - 1))
         return model
 
@@ -185,14 +190,14 @@ class Patch(_Bodies):
         length/area) and its largest deviation from the pressure applied."""
         t0 = time.perf_counter()
         model = self.build(comm)
-        guess = (self.pressure / self.c_n) ** (1 / self.m_n) + self.pressure / self.E1
+        guess = self.law.uniform_penetration(self.pressure) + self.pressure / self.E1
         solved = model.solve_for_load(self.pressure, guess=guess, rtol=1e-10)
         values = model.surface_values()
         transmitted = values.force[:, -1]
         summary = {
             "scene": "patch", "dim": self.dim, "load": self.pressure,
             "parameters": {"E1": self.E1, "nu1": self.nu1, "E2": self.E2, "nu2": self.nu2,
-                           "c_n": self.c_n, "m_n": self.m_n, "passes": self.passes,
+                           "c_n": self.law.c_n, "m_n": self.law.m_n, "passes": self.passes,
                            "n_upper": self.n_upper, "n_lower": self.n_lower},
             "dofs": model.dofs, "ranks": comm.size,
             "pressure_deviation": float(np.max(np.abs(transmitted / self.pressure - 1))),
@@ -207,44 +212,47 @@ class Cattaneo(Hertz):
     """The 2D Hertz cylinder with friction, then a tangential force Q rising to ``q_ratio`` μP.
 
     Args:
-        mu: friction coefficient.
+        law: the interface law, Coulomb's with a constant μ > 0 (Cattaneo-Mindlin's closed
+            form): compliance c_n, m_n, friction coefficient ``mu`` and the regularisation
+            ``eps`` of the slip increment [length] (c1: Pop, eq. 15; a sequence ε_k → 0 is
+            Kalker's sequential process, :meth:`run_sequence`); default c_n = 1e4, m_n = 1,
+            μ = 0.3, ε = 1e-6.
         q_ratio: Q / (μ P), in [0, 1).
         increments: load increments of Q (the quasi-static path; the stick zone only shrinks).
-        eps: the regularisation of the slip increment [length] (c1: Pop, eq. 15); a
-            sequence ε_k → 0 is Kalker's sequential process.
         formulation: ``"compliance"`` (the regularised law) or ``"perturbed-lagrangian"``
-            (Pop, eq. 27: penalties ε_N = ``c_n`` and ε_T = ``eps_T`` [force/length³]).
+            (Pop, eq. 27: penalties ε_N = the law's ``c_n`` and κ_T = ``penalty_T``
+            [force/length³]).
     """
 
-    mu: float = 0.3
+    law: laws.InterfaceLaw = dataclasses.field(
+        default_factory=lambda: laws.InterfaceLaw(c_n=1e4, m_n=1.0, mu=0.3, eps=1e-6))
     q_ratio: float = 0.5
     increments: int = 10
-    eps: float = 1e-6
     formulation: str = "compliance"
-    eps_T: float = 1e4
+    penalty_T: float = 1e4
 
     def __post_init__(self) -> None:
         super().__post_init__()
         check("dim", self.dim, self.dim == 2, "Cattaneo-Mindlin is built in 2D")
-        check("mu", self.mu, self.mu > 0, "the friction coefficient must be > 0")
+        check("mu", self.law.mu, self.law.mu > 0 and self.law.friction_coefficient is None
+              and self.law.slip_rule is None,
+              "Cattaneo-Mindlin needs a constant friction coefficient > 0 (isotropic Coulomb)")
         check("q_ratio", self.q_ratio, 0 <= self.q_ratio < 1, "Q/(mu P) in [0, 1)")
         check("increments", self.increments,
               isinstance(self.increments, int) and self.increments >= 1, "an integer >= 1")
-        check("eps", self.eps, self.eps > 0, "the regularisation must be > 0")
 
     def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
         mesh = geometry.hertz_2d(comm, R=self.radius, refine=self.refine,
                                  h_contact=self.h_contact)
-        return TwoBodyModel(mesh, self.materials, self.c_n, self.m_n, mu=self.mu,
-                            eps=self.eps, passes=self.passes, formulation=self.formulation,
-                            eps_T=self.eps_T)
+        return TwoBodyModel(mesh, self.materials, self.law, passes=self.passes,
+                            formulation=self.formulation, penalty_T=self.penalty_T)
 
     def stick_zone(self, values: SurfaceValues, tol: float = 1e-3) -> tuple[float, float]:
         """(stick half-width, slip half-width): the extent of the contact nodes whose traction
         is below the friction bound by more than ``tol`` (stick) and of all contact nodes."""
         contact = values.pressure > 0
-        utilisation = np.linalg.norm(values.traction, axis=1) / np.where(
-            contact, self.mu * values.pressure, 1.0)
+        bound = self.law.coefficient(0.0, values.pressure) * values.pressure  # μ p_n
+        utilisation = np.linalg.norm(values.traction, axis=1) / np.where(contact, bound, 1.0)
         stick = contact & (utilisation < 1 - tol)
         x = values.x[:, 0]
         return (float(np.ptp(x[stick]) / 2) if stick.any() else 0.0,
@@ -259,31 +267,32 @@ class Cattaneo(Hertz):
         model = model or self.build(comm)
         a, _ = self.closed_form()
         model.eps.value = NORMAL_LOADING_EPS * a
-        model.eps_T.value = self.E_star / self.radius  # the perturbed Lagrangian's: a soft spring
+        # the perturbed Lagrangian's: a soft spring
+        model.penalty_T.value = self.E_star / self.radius
         return Hertz.run(self, comm, model)
 
     def load_tangential(self, model: TwoBodyModel, eps: float | None = None,
                         on_increment: typing.Callable[[dict], None] | None = None) -> dict:
         """Q from 0 to ``q_ratio`` μP in :attr:`increments` steps under the regularisation
-        ``eps`` (default :attr:`eps`), from the model's current (normally loaded) state.
+        ``eps`` (default the law's ε), from the model's current (normally loaded) state.
 
         Returns ``eps``, ``stick_half_width`` (and Cattaneo's), ``traction_error_l2`` (the
         relative L2 error of the final tangential traction against Cattaneo-Mindlin's),
         ``newton_iterations`` (all increments) and ``increments`` (one row per increment).
         """
-        eps = self.eps if eps is None else eps
+        eps = self.law.eps if eps is None else eps
         check("eps", eps, eps > 0, "the regularisation must be > 0")
         assert self.load is not None
         a, p0 = self.closed_form()
         model.eps.value = eps
-        model.eps_T.value = self.eps_T
+        model.penalty_T.value = self.penalty_T
         rows = []
         for k in range(1, self.increments + 1):
             for contact in model.contacts:
                 contact.commit()
             model.u_old.x.array[:] = model.u.x.array
             q = self.q_ratio * k / self.increments
-            model.shear.value = np.array([q * self.mu * self.load / (2 * self.radius), 0.0])
+            model.shear.value = np.array([q * self.law.mu * self.load / (2 * self.radius), 0.0])
             report = model.solve_at(float(model.approach.value))
             values = model.surface_values()
             stick, _ = self.stick_zone(values)
@@ -294,7 +303,7 @@ class Cattaneo(Hertz):
             if on_increment is not None:
                 on_increment(row)
         values = model.surface_values()
-        exact = closed_forms.cattaneo_traction(values.x[:, 0], a, p0, self.mu, self.q_ratio)
+        exact = closed_forms.cattaneo_traction(values.x[:, 0], a, p0, self.law.mu, self.q_ratio)
         # the traction on the cylinder opposes Q: its x component is -q(x)
         error = float(np.sqrt(np.sum(values.weight * (-values.traction[:, 0] - exact) ** 2)
                               / np.sum(values.weight * exact**2)))
@@ -307,7 +316,7 @@ class Cattaneo(Hertz):
     def _summary(self, normal: dict, tangential: dict, t0: float) -> dict:
         summary = dict(normal)
         summary.update({
-            "scene": "cattaneo", "q_ratio": self.q_ratio, "mu": self.mu,
+            "scene": "cattaneo", "q_ratio": self.q_ratio, "mu": self.law.mu,
             "formulation": self.formulation, "eps": tangential["eps"],
             "stick_half_width": tangential["stick_half_width"],
             "cattaneo_stick_half_width": tangential["cattaneo_stick_half_width"],
@@ -315,9 +324,9 @@ class Cattaneo(Hertz):
             "increments": tangential["increments"],
             "newton_iterations": normal["newton_iterations"] + tangential["newton_iterations"],
             "wall_time_s": time.perf_counter() - t0})
-        summary["parameters"] = {**normal["parameters"], "mu": self.mu, "eps": self.eps,
+        summary["parameters"] = {**normal["parameters"], "mu": self.law.mu, "eps": self.law.eps,
                                  "increments": self.increments,
-                                 "formulation": self.formulation, "eps_T": self.eps_T}
+                                 "formulation": self.formulation, "penalty_T": self.penalty_T}
         return summary
 
     def run(self, comm: MPI.Comm = MPI.COMM_WORLD, model: TwoBodyModel | None = None,

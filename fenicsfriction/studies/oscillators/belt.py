@@ -6,8 +6,9 @@ a normal force N:
 .. math::
     m\ddot x + c\dot x + k x = F, \qquad v_r = v_b - \dot x \ \text{(relative velocity)},
 
-with the friction force F of a coefficient law μ(v) of :mod:`fenicsfriction.laws` and a static
-coefficient :math:`\mu_s` (default μ(0)):
+with the friction force F of the interface law's coefficient μ(v) (:class:`InterfaceLaw
+<fenicsfriction.laws.InterfaceLaw>`, read at the normal force N) and a static coefficient
+:math:`\mu_s` (default μ(0)):
 
 * **slip** (:math:`v_r \ne 0`): :math:`F = \mu(v_r) N \operatorname{sgn}(v_r)`; modes
   ``"slip+"`` (:math:`v_r > 0`, the belt drags the mass forward) and ``"slip-"``;
@@ -90,10 +91,13 @@ class BeltOscillator:
         c: viscous damping, >= 0.
         N: normal force, > 0.
         v_belt: belt speed v_b, > 0.
-        friction: coefficient law μ(v) (:class:`~fenicsfriction.laws.ConstantFriction`,
-            :class:`~fenicsfriction.laws.PiecewiseLinearFriction`,
-            :class:`~fenicsfriction.laws.StribeckFriction`): ``friction(v)`` and
-            ``friction.derivative(v)``.
+        law: the interface law (:class:`~fenicsfriction.laws.InterfaceLaw`), of which a point
+            model uses the friction part: the coefficient μ(speed, N) (``mu`` or a law such as
+            :class:`~fenicsfriction.laws.StribeckFriction` or a user's function; the normal
+            force N is its pressure) and, for ``method="regularised"``, the regularisation.
+            The normal compliance (c_n, m_n, b_n, g) is not used: N is given. A bare
+            coefficient law μ(speed, pressure) is taken as
+            ``InterfaceLaw(friction_coefficient=μ, regularisation="smooth")``.
         mu_static: static coefficient μ_s >= μ(0); None: μ(0).
 
     Any consistent units; the tests use dimensionless ones.
@@ -104,7 +108,7 @@ class BeltOscillator:
     c: float
     N: float
     v_belt: float
-    friction: laws.FrictionCoefficient
+    law: laws.InterfaceLaw | laws.FrictionLaw
     mu_static: float | None = None
 
     size: typing.ClassVar[int] = 2
@@ -115,10 +119,11 @@ class BeltOscillator:
         check_positive("c", self.c, strict=False)
         check_positive("N", self.N)
         check_positive("v_belt", self.v_belt)
-        check("friction", self.friction,
-              callable(self.friction) and hasattr(self.friction, "derivative"),
-              "must be a friction coefficient law of fenicsfriction.laws")
-        mu_0 = float(self.friction(0.0))
+        if not isinstance(self.law, laws.InterfaceLaw):
+            check("law", self.law, callable(self.law),
+                  "must be an InterfaceLaw or a friction coefficient law mu(speed, pressure)")
+            self.law = laws.InterfaceLaw(friction_coefficient=self.law, regularisation="smooth")
+        mu_0 = self.mu(0.0)
         if self.mu_static is None:
             self.mu_static = mu_0
         check_positive("mu_static", self.mu_static, strict=False)
@@ -128,7 +133,16 @@ class BeltOscillator:
     @property
     def static_coefficient(self) -> float:
         """μ_s: ``mu_static`` (μ(0) when not given)."""
-        return float(self.friction(0.0)) if self.mu_static is None else self.mu_static
+        return self.mu(0.0) if self.mu_static is None else self.mu_static
+
+    @property
+    def _law(self) -> laws.InterfaceLaw:
+        assert isinstance(self.law, laws.InterfaceLaw)  # made one by __post_init__
+        return self.law
+
+    def mu(self, v_r: float) -> float:
+        """The law's coefficient μ(|v_r|, N) at the relative velocity v_r."""
+        return float(self._law.coefficient(abs(v_r), self.N))
 
     # --- the hybrid system ----------------------------------------------------------------------
 
@@ -140,7 +154,7 @@ class BeltOscillator:
         """F in ``mode`` at the state y = (x, ẋ)."""
         if mode == STICK:
             return float(self.required_force(y[0]))
-        return _SLIP_SIGN[mode] * float(self.friction(self.v_belt - y[1])) * self.N
+        return _SLIP_SIGN[mode] * self.mu(self.v_belt - y[1]) * self.N
 
     def rhs(self, t: float, y: np.ndarray, mode: str) -> np.ndarray:
         """(ẋ, ẍ): (v_b, 0) in stick, (ẋ, (F - c ẋ - k x)/m) in slip."""
@@ -178,11 +192,11 @@ class BeltOscillator:
 
     def steady_sliding(self) -> float:
         """Position of steady sliding (ẋ = 0, slip velocity v_b): x0 = μ(v_b) N / k."""
-        return float(self.friction(self.v_belt)) * self.N / self.k
+        return self.mu(self.v_belt) * self.N / self.k
 
     def effective_damping(self) -> float:
         """c + N dμ/dv(v_b): the damping of small oscillations about steady sliding."""
-        return self.c + self.N * float(self.friction.derivative(self.v_belt))
+        return self.c + self.N * float(self._law.coefficient_slope(self.v_belt, self.N))
 
     def linear_eigenvalues(self) -> np.ndarray:
         """Roots s of m s² + (c + N μ'(v_b)) s + k = 0 (complex, conjugate pair first by
@@ -222,12 +236,14 @@ class BeltOscillator:
         stick starts at (x_s, v_b): the cycle is reached after one slip from any stick.
 
         Raises:
-            ValueError: c > 0, a law other than ConstantFriction, or μ_s <= μ_k.
+            ValueError: c > 0, a coefficient law other than a constant, or μ_s <= μ_k.
         """
         check("c", self.c, self.c == 0, "the closed form needs c = 0")
-        check("friction", self.friction, isinstance(self.friction, laws.ConstantFriction),
-              "the closed form needs a ConstantFriction kinetic coefficient")
-        mu_k = typing.cast(laws.ConstantFriction, self.friction).mu
+        coefficient = self._law.friction_coefficient
+        check("law", self.law,
+              coefficient is None or isinstance(coefficient, laws.ConstantFriction),
+              "the closed form needs a constant kinetic coefficient")
+        mu_k = self.mu(0.0)
         check("mu_static", self.mu_static, self.static_coefficient > mu_k,
               f"the closed form needs mu_static > mu_k = {mu_k:g} (else no stick-slip)")
         omega = math.sqrt(self.k / self.m)
@@ -242,9 +258,11 @@ class BeltOscillator:
 
     # --- time integration ---------------------------------------------------------------------
 
-    def regularised_force(self, v_r: typing.Any, eps: float) -> typing.Any:
-        r"""The smooth friction law :math:`F_\varepsilon = \mu_\varepsilon(v_r) N
-        v_r/\sqrt{v_r^2 + \varepsilon^2}` (:func:`~fenicsfriction.laws.abs_smooth_derivative`).
+    def regularised_law(self, eps: float) -> laws.InterfaceLaw:
+        r"""The law of ``method="regularised"``: the interface law with ε = ``eps`` and the
+        coefficient :math:`\mu_\varepsilon` below (its friction force, on the mass,
+        :math:`F_\varepsilon = \mu_\varepsilon(v_r) N \phi_\varepsilon'(v_r)`: with the smooth
+        regularisation :math:`\mu_\varepsilon(v_r) N v_r/\sqrt{v_r^2 + \varepsilon^2}`).
 
         :math:`\mu_\varepsilon = \mu` when μ_s = μ(0). A static coefficient above μ(0) (the
         classic jump μ_s > μ_k) cannot be carried by the direction regularisation alone
@@ -254,11 +272,19 @@ class BeltOscillator:
         that both :math:`\varepsilon/v_\varepsilon` and :math:`v_\varepsilon/v_b` vanish as
         ε → 0 and the breakaway force :math:`\max F_\varepsilon` tends to μ_s N.
         """
-        mu = self.friction(v_r)
-        jump = self.static_coefficient - float(self.friction(0.0))
-        if jump > 0:
-            mu = mu + jump * np.exp(-np.abs(v_r) / math.sqrt(eps * self.v_belt))
-        return mu * self.N * laws.abs_smooth_derivative(v_r, eps)
+        jump = self.static_coefficient - self.mu(0.0)
+        if jump <= 0:
+            return self._law.replace(eps=eps)
+        kinetic, v_layer = self._law.coefficient, math.sqrt(eps * self.v_belt)
+
+        def layered(speed: typing.Any, pressure: typing.Any) -> typing.Any:
+            return kinetic(speed, pressure) + jump * np.exp(-speed / v_layer)
+        return self._law.replace(eps=eps, friction_coefficient=layered)
+
+    def regularised_force(self, v_r: typing.Any, eps: float) -> typing.Any:
+        """The friction force on the mass of :meth:`regularised_law` at the relative
+        velocity v_r (the mass slips at -v_r on the belt)."""
+        return self.regularised_law(eps).friction_force(self.N, -np.asarray(v_r, dtype=float))
 
     def simulate(self, t_end: float, x0: float | None = None,
                  v0: float | None = None, method: str = "events",
@@ -273,8 +299,8 @@ class BeltOscillator:
                 (:meth:`steady_sliding`, 0).
             method: ``"events"`` (stick and slip, events located by
                 :func:`~fenicsfriction.events.integrate_hybrid`) or ``"regularised"``
-                (the smooth law :meth:`regularised_force` by the same TS, no events).
-            eps: regularisation speed of ``"regularised"``; None: 1e-3 v_b.
+                (the regularised law :meth:`regularised_law` by the same TS, no events).
+            eps: the law's regularisation speed ε for ``"regularised"``; None: 1e-3 v_b.
             rtol, atol, sample_dt, max_step, observe, prefix: see
                 :func:`~fenicsfriction.events.integrate_hybrid`.
 
@@ -291,9 +317,10 @@ class BeltOscillator:
         if method == "regularised":
             eps = 1e-3 * self.v_belt if eps is None else eps
             check_positive("eps", eps)
-            hybrid = integrate_hybrid(_Regularised(self, eps), [x0, v0], "smooth", t_end,
+            law = self.regularised_law(eps)
+            hybrid = integrate_hybrid(_Regularised(self, law), [x0, v0], "smooth", t_end,
                                       **kwargs)
-            force = self.regularised_force(self.v_belt - hybrid.y[:, 1], eps)
+            force = law.friction_force(self.N, -(self.v_belt - hybrid.y[:, 1]))
             stick = []
         else:
             if v0 == self.v_belt:
@@ -311,17 +338,19 @@ class BeltOscillator:
 
 
 class _Regularised:
-    """The belt oscillator with the smooth law: one mode, no events."""
+    """The belt oscillator with a regularised law (:meth:`BeltOscillator.regularised_law`):
+    one mode, no events."""
 
     size = 2
 
-    def __init__(self, oscillator: BeltOscillator, eps: float) -> None:
-        self.oscillator, self.eps = oscillator, eps
+    def __init__(self, oscillator: BeltOscillator, law: laws.InterfaceLaw) -> None:
+        self.oscillator, self.law = oscillator, law
 
     def rhs(self, t: float, y: np.ndarray, mode: str) -> np.ndarray:
         """(ẋ, ẍ) with the regularised friction force."""
         o = self.oscillator
-        force = o.regularised_force(o.v_belt - y[1], self.eps) - o.c * y[1] - o.k * y[0]
+        friction = self.law.friction_force(o.N, -(o.v_belt - y[1]))
+        force = friction - o.c * y[1] - o.k * y[0]
         return np.array([y[1], force / o.m])
 
     def events(self, t: float, y: np.ndarray, mode: str) -> np.ndarray:

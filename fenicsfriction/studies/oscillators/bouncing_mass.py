@@ -34,29 +34,25 @@ class BouncingMass:
     Args:
         mass: m [10^3 kg], > 0.
         weight: W = m g [10^3 kg cm s^-2], > 0.
-        c_n, m_n: foundation pressure c_n d^{m_n} [10^3 kg cm^(-1-m_n) s^-2], exponent >= 1.
         area: contact area A [cm^2], > 0.
-        b_n, l_n: normal damping b_n d^{l_n} (-ẏ), >= 0, exponent >= 1 (None: m_n).
+        law: the interface law (:class:`~fenicsfriction.laws.InterfaceLaw`): its normal
+            compliance c_n d^{m_n} [10^3 kg cm^(-1-m_n) s^-2] and damping b_n d^{l_n} (-ẏ).
 
     Defaults: the block of Martins & Oden 1986 (M = 0.45, W = 450, c_n = 1e10, m_n = 2.5, A = L B0).
     """
 
     mass: float = 0.45
     weight: float = 450.0
-    c_n: float = 1e10
-    m_n: float = 2.5
     area: float = 48.8 * 30.5
-    b_n: float = 0.0
-    l_n: float = None  # type: ignore[assignment]  # None: set by __post_init__
+    law: laws.InterfaceLaw = dataclasses.field(default_factory=laws.InterfaceLaw)
 
     def __post_init__(self):
-        if self.l_n is None:
-            self.l_n = self.m_n
+        check("law", self.law, isinstance(self.law, laws.InterfaceLaw),
+              "must be a fenicsfriction.laws.InterfaceLaw")
         for name in ("mass", "weight", "area"):
             value = getattr(self, name)
             check(name, value, isinstance(value, (int, float)) and np.isfinite(value)
                   and value > 0, "must be a finite number > 0")
-        laws.InterfaceLaw(c_n=self.c_n, m_n=self.m_n, b_n=self.b_n, l_n=self.l_n)  # validates
 
     @property
     def gravity(self) -> float:
@@ -65,14 +61,13 @@ class BouncingMass:
 
     def equilibrium(self) -> float:
         """Rest position y0 = -d0 with d0 = (W / (c_n A))^(1/m_n)."""
-        return -(self.weight / (self.c_n * self.area)) ** (1.0 / self.m_n)
+        return -(self.weight / (self.law.c_n * self.area)) ** (1.0 / self.law.m_n)
 
     def foundation_force(self, q: ArrayLike, q_dot: ArrayLike) -> np.ndarray:
         """Upward force of the foundation A (c_n d^{m_n} + b_n d^{l_n} (-ẏ))."""
         y, y_dot = np.asarray(q, float), np.asarray(q_dot, float)
         d = laws.penetration(-y)
-        return self.area * (laws.normal_pressure(d, self.c_n, self.m_n)
-                            + laws.normal_damping_pressure(d, -y_dot, self.b_n, self.l_n))
+        return self.area * self.law.normal_traction(d, -y_dot)
 
     def residual(self, q: ArrayLike, q_dot: ArrayLike, q_ddot: ArrayLike) -> np.ndarray:
         """R = m ÿ + W - foundation force."""
@@ -88,9 +83,8 @@ class BouncingMass:
         if y >= 0:
             return np.array([[self.mass]]), np.zeros((1, 1)), np.zeros((1, 1))
         d = -y
-        stiffness = self.m_n * self.c_n * d ** (self.m_n - 1) \
-            + self.l_n * self.b_n * d ** (self.l_n - 1) * (-y_dot)
-        return (np.array([[self.mass]]), np.array([[self.area * self.b_n * d**self.l_n]]),
+        stiffness, damping = self.law.normal_traction_derivatives(d, -y_dot)
+        return (np.array([[self.mass]]), np.array([[self.area * damping]]),
                 np.array([[self.area * stiffness]]))
 
     def energy(self, q: ArrayLike, q_dot: ArrayLike) -> np.ndarray:
@@ -98,4 +92,5 @@ class BouncingMass:
         y, y_dot = np.asarray(q, float), np.asarray(q_dot, float)
         d = laws.penetration(-y)
         return 0.5 * self.mass * y_dot**2 \
-            + self.c_n * self.area * d ** (self.m_n + 1) / (self.m_n + 1) + self.weight * y
+            + self.law.c_n * self.area * d ** (self.law.m_n + 1) / (self.law.m_n + 1) \
+            + self.weight * y

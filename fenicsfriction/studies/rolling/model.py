@@ -21,8 +21,9 @@ for all v vanishing on the far faces, with the slip s (per unit rolling distance
   :math:`s = \Delta u_\tau - \Delta u_\tau^{old} - \Delta\delta` with
   :math:`\Delta u_\tau = 2u_\tau`, the tractions of the increment committed before the next.
 
-:math:`p_\tau` is :func:`fenicsfriction.laws.friction_traction` with :math:`d = p_n`,
-:math:`c_T = \mu`, :math:`m_T = 1` (the package's one interface law and its regularisations);
+:math:`p_\tau` is the friction traction of the package's one interface law
+(:class:`fenicsfriction.laws.InterfaceLaw`, its regularisations) with unit linear compliance read
+on the pressure: :math:`c_n = 1`, :math:`m_n = m_T = 1`, :math:`d = p_n`;
 ε → 0 by Kalker's sequential process (Kalker 1986, section 6,
 :func:`fenicsfriction.steady.epsilon_sequence`). The residual is one UFL form
 (:func:`fenicsfriction.forms.elasticity` and :func:`fenicsfriction.forms.surface_traction`)
@@ -90,21 +91,26 @@ class RollingContact:
         b: the semi-axis across it [length] (3D; ``None``: a circle; ignored in 2D).
         G: shear modulus of both bodies [force/length²].
         nu: Poisson's ratio of both bodies.
-        mu: friction coefficient.
+        law: the interface law (:class:`~fenicsfriction.laws.InterfaceLaw`): its friction
+            coefficient ``mu`` (or law μ(speed, pressure), read at the pressure p_n) and
+            ``regularisation`` (``"smooth"``, Kalker 1986, eq. 40, or ``"c1"``,
+            :data:`fenicsfriction.laws.REGULARISATIONS`; Newton stalls with ``"c1"`` on Carter's
+            problem below ε ≈ 0.1 ξ, line search failures, docs/rolling-fe.md) make the
+            tangential traction; its normal compliance c_n d^m_n [force/length^(2+m_n)] is
+            that of ``pressure="contact"``. Its ε is not used: ``eps_sequence`` sets it.
+            Default μ = 0.3, the smooth regularisation, c_n = 1000, m_n = 1 (1000 E*/a at the
+            default G, ν and a: a compliance stiff against the block's; scale it with E*/a).
         p0: Hertz's peak pressure [force/length²]; or give ``Fn`` (neither: 0.01 G).
         Fn: the normal force [force] (2D: per unit length), instead of ``p0``.
         creepage: (ξ, η, φ): longitudinal and lateral creepage, spin [1/length] (2D: ξ only).
-        eps: Kalker's sequence ε_k → 0 of the regularisation of the slip, relative to each
-            solve's slip scale (:meth:`RollingModel.slip_scale`: the rigid slip's size, or
+        eps_sequence: Kalker's sequence ε_k → 0 of the regularisation of the slip, relative to
+            each solve's slip scale (:meth:`RollingModel.slip_scale`: the rigid slip's size, or
             μ p0/G if smaller) (``None``: :data:`EPS_RELATIVE`). Relative, because the
             linear theory's full adhesion (|ξ| ≪ μ p0/G) needs ε ≪ |ξ|.
-        regularisation: ``"smooth"`` (Kalker 1986, eq. 40) or ``"c1"``
-            (:data:`fenicsfriction.laws.REGULARISATIONS`); Newton stalls with ``"c1"`` on
-            Carter's problem below ε ≈ 0.1 ξ (line search failures, docs/rolling-fe.md).
         pressure: ``"hertz"`` (Hertz's p0 sqrt(1 - x²/a² - y²/b²)) or ``"contact"`` (2D: a
             frictionless normal-compliance contact of the block against a rigid parabola of
-            radius 2R, R the cylinders' relative radius of Hertz's a and p0).
-        c_n: the compliance of ``pressure="contact"`` [force/length³] (``None``: 1000 E*/a).
+            radius 2R, R the cylinders' relative radius of Hertz's a and p0, with the law's
+            normal compliance).
         cells_per_a: cells over the semi-axis a (the contact zone's cell size a / it).
         growth: size ratio of consecutive cells outside the contact zone.
         block_size: the block's half-width and depth over a.
@@ -117,14 +123,13 @@ class RollingContact:
     b: float | None = None
     G: float = 1.0
     nu: float = 0.0
-    mu: float = 0.3
+    law: laws.InterfaceLaw = dataclasses.field(default_factory=lambda: laws.InterfaceLaw(
+        c_n=1e3, m_n=1.0, mu=0.3, regularisation="smooth"))
     p0: float | None = None
     Fn: float | None = None
     creepage: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    eps: tuple[float, ...] | None = None
-    regularisation: str = "smooth"
+    eps_sequence: tuple[float, ...] | None = None
     pressure: str = "hertz"
-    c_n: float | None = None
     cells_per_a: int = 8
     growth: float = 1.3
     block_size: float = 20.0
@@ -132,8 +137,10 @@ class RollingContact:
 
     def __post_init__(self) -> None:
         check("dim", self.dim, self.dim in (2, 3), "2 or 3")
-        for name in ("a", "G", "mu", "growth", "block_size"):
+        for name in ("a", "G", "growth", "block_size"):
             check_positive(name, getattr(self, name))
+        check("law", self.law, isinstance(self.law, laws.InterfaceLaw) and self.law.has_friction,
+              "must be a fenicsfriction.laws.InterfaceLaw with friction (mu > 0 or a law)")
         if self.dim == 3 and self.b is not None:
             check_positive("b", self.b)
         # ν = 1/2 is refused: the displacement formulation locks for incompressible bodies
@@ -145,24 +152,24 @@ class RollingContact:
             check_positive("p0", self.p0)
         check("creepage", self.creepage, len(self.creepage) == 3
               and all(math.isfinite(c) for c in self.creepage), "three finite numbers (ξ, η, φ)")
-        if self.eps is not None:
-            check("eps", self.eps, len(self.eps) >= 1 and all(e > 0 for e in self.eps),
+        if self.eps_sequence is not None:
+            check("eps_sequence", self.eps_sequence, len(self.eps_sequence) >= 1
+                  and all(e > 0 for e in self.eps_sequence),
                   "a non-empty sequence of values > 0 (relative to the slip scale)")
-        check("regularisation", self.regularisation,
-              self.regularisation in laws.REGULARISATIONS,
-              f"one of {', '.join(laws.REGULARISATIONS)}")
         check("pressure", self.pressure, self.pressure in PRESSURES,
               f"one of {', '.join(PRESSURES)}")
         check("pressure", self.pressure, self.pressure == "hertz" or self.dim == 2,
               "'contact' is built in 2D only")
-        if self.c_n is not None:
-            check_positive("c_n", self.c_n)
         check("cells_per_a", self.cells_per_a,
               isinstance(self.cells_per_a, int) and self.cells_per_a >= 1, "an integer >= 1")
         check("growth", self.growth, self.growth >= 1, "must be >= 1")
         check("block_size", self.block_size, self.block_size >= 2 * self.zone_margin,
               f"must be >= 2 zone_margin = {2 * self.zone_margin}")
         check("zone_margin", self.zone_margin, self.zone_margin >= 1, "must be >= 1")
+
+    def with_law(self, **changes: typing.Any) -> typing.Self:
+        """The scene with its law changed, e.g. ``scene.with_law(mu=0.5)``."""
+        return dataclasses.replace(self, law=self.law.replace(**changes))
 
     @property
     def semi_axis_b(self) -> float | None:
@@ -194,12 +201,12 @@ class RollingContact:
     @property
     def creepage_scale(self) -> float:
         """μ p0 / G, the order of the creepage at which the contact saturates."""
-        return self.mu * self.peak_pressure / self.G
+        return self.law.coefficient(0.0, self.peak_pressure) * self.peak_pressure / self.G
 
     @property
     def eps_relative(self) -> tuple[float, ...]:
         """The ε sequence in use, relative to the slip scale."""
-        return EPS_RELATIVE if self.eps is None else tuple(self.eps)
+        return EPS_RELATIVE if self.eps_sequence is None else tuple(self.eps_sequence)
 
     def build(self, comm: MPI.Comm = MPI.COMM_WORLD, kinematics: str = "rolling"
               ) -> RollingModel:
@@ -314,7 +321,7 @@ class RollingModel:
         self.creepage = fem.Constant(self.msh, np.asarray(scene.creepage, dtype=float))
         self.increment = fem.Constant(self.msh, np.zeros(dim - 1))
         self.eps = fem.Constant(self.msh, 1.0)
-        self.mu = fem.Constant(self.msh, float(scene.mu))
+        self.mu = fem.Constant(self.msh, float(scene.law.mu))
         E = 2 * scene.G * (1 + scene.nu)
         self.E = E
         self.p_n = self._hertz_pressure() if scene.pressure == "hertz" else \
@@ -325,8 +332,10 @@ class RollingModel:
             self.slip = rolling_slip(self.u, w, dim)
         else:
             self.slip = shift_slip(self.u, self.u_old, self.increment, dim)
-        self.traction = laws.friction_traction(self.p_n, self.slip, self.mu, 1, self.eps,
-                                               scene.regularisation)
+        #: the scene's law read on the pressure (c_n = 1, m_n = m_T = 1, d = p_n: its bound is
+        #: μ p_n, a friction coefficient law gets p_n), μ and ε the model's constants
+        self.law = scene.law.replace(c_n=1.0, m_n=1.0, m_T=1.0, mu=self.mu, eps=self.eps)
+        self.traction = self.law.friction_traction(self.p_n, self.slip)
         self.weight = self._upwind_weight() if kinematics == "rolling" else 1.0
         form = forms.elasticity(self.u, v, E, scene.nu, self.dx) \
             + forms.surface_traction(self.weight * self.contact_traction(), v, self.ds(CONTACT))
@@ -358,14 +367,14 @@ class RollingModel:
         v = ufl.TestFunction(self.V)
         n = ufl.FacetNormal(self.msh)
         self.approach = fem.Constant(self.msh, 0.0)
-        c_n = s.c_n if s.c_n is not None else 1e3 * s.E_star / s.a
         gap = self.x[0] ** 2 / (4 * s.radius) - self.approach / 2
+        law = s.law.replace(g=gap)
         form = forms.elasticity(u_n, v, self.E, s.nu, self.dx) \
-            + forms.normal_compliance(u_n, v, n, c_n, 1, gap, self.ds(CONTACT))
+            + forms.normal_compliance(u_n, v, n, law, self.ds(CONTACT))
         zero = fem.Function(self.V)
         residual = forms.Residual(form, u_n, zero, zero, v, bcs=[self._clamp()])
         solver = SteadySolver(residual, prefix="rolling_normal_")
-        pressure = laws.normal_traction(laws.penetration(forms.normal_part(u_n, n), gap), c_n, 1)
+        pressure = law.normal_traction(laws.penetration(forms.normal_part(u_n, n), gap))
         load = _compat.form(pressure * self.ds(CONTACT))
         # the secant on log(force) against log(approach), from the rigid indentation's approach
         # a²/(2R): the force grows about linearly with it

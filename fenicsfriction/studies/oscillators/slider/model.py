@@ -55,10 +55,10 @@ __all__ = ["Contact", "FrictionLaw", "ScaledFriction", "Slider"]
 
 
 class FrictionLaw(typing.Protocol):
-    """A friction coefficient μ(v) with its derivative (the laws of :mod:`fenicsfriction.laws`
-    and :class:`ScaledFriction`)."""
+    """A friction coefficient μ(speed, pressure) with its derivative in the speed (the laws of
+    :mod:`fenicsfriction.laws` and :class:`ScaledFriction`)."""
 
-    def __call__(self, speed: typing.Any) -> typing.Any:
+    def __call__(self, speed: typing.Any, pressure: typing.Any = None) -> typing.Any:
         """μ at ``speed`` (a float or an array)."""
 
     def derivative(self, speed: typing.Any) -> typing.Any:
@@ -84,9 +84,9 @@ class ScaledFriction:
         check("unit", self.unit, self.unit > 0 and math.isfinite(self.unit),
               "the velocity unit must be a positive number")
 
-    def __call__(self, speed: typing.Any) -> typing.Any:
-        """μ(v) = μ_0(v/U)."""
-        return self.law(np.asarray(speed, dtype=float) / self.unit)
+    def __call__(self, speed: typing.Any, pressure: typing.Any = None) -> typing.Any:
+        """μ(v) = μ_0(v/U) (at any ``pressure``, passed on to μ_0)."""
+        return self.law(np.asarray(speed, dtype=float) / self.unit, pressure)
 
     def derivative(self, speed: typing.Any) -> typing.Any:
         """dμ/dv = μ_0'(v/U) / U."""
@@ -106,7 +106,13 @@ class Contact:
         roughness: asperity height h_i >= 0 (0: smooth surface, constant N).
         wavelength: λ_i > 0 of the sinusoidal surface.
         surface_speed: V_ref,i > 0, the speed of the surface under this contact.
-        friction: μ(v) with ``__call__`` and ``derivative`` (:mod:`fenicsfriction.laws`).
+        law: the interface law (:class:`~fenicsfriction.laws.InterfaceLaw`), of which this
+            point contact uses the friction part: the coefficient μ(speed, N) (N, the contact's
+            normal force, is its pressure) and the regularisation of
+            :class:`~fenicsfriction.studies.oscillators.slider.motion.SliderMotion`'s ``eps``;
+            its normal compliance is not used (the normal force comes from the contact's
+            spring and dashpot). Default: eq. 59's
+            :class:`~fenicsfriction.laws.PiecewiseLinearFriction`, the smooth regularisation.
         mu_static: static coefficient bounding stick; None: μ(0).
         normal_force_factor: f_N in N = N_o + f_N m ẍ (1: the dimensional model).
     """
@@ -120,7 +126,8 @@ class Contact:
     roughness: float
     wavelength: float
     surface_speed: float
-    friction: FrictionLaw = dataclasses.field(default_factory=laws.PiecewiseLinearFriction)
+    law: laws.InterfaceLaw = dataclasses.field(default_factory=lambda: laws.InterfaceLaw(
+        friction_coefficient=laws.PiecewiseLinearFriction(), regularisation="smooth"))
     mu_static: float | None = None
     normal_force_factor: float = 1.0
 
@@ -131,6 +138,8 @@ class Contact:
             check_positive(name, getattr(self, name), strict=False)
         if self.mu_static is not None:
             check_positive("mu_static", self.mu_static, strict=False)
+        check("law", self.law, isinstance(self.law, laws.InterfaceLaw),
+              "must be a fenicsfriction.laws.InterfaceLaw (it validates its own parameters)")
 
     @property
     def omega(self) -> float:
@@ -140,7 +149,11 @@ class Contact:
     @property
     def static_coefficient(self) -> float:
         """μ_s bounding stick: ``mu_static``, or μ(0) without one."""
-        return float(self.friction(0.0)) if self.mu_static is None else self.mu_static
+        return self.mu(0.0) if self.mu_static is None else self.mu_static
+
+    def mu(self, speed: typing.Any) -> float:
+        """The law's coefficient μ(|V|, N_o) at the relative velocity V."""
+        return float(self.law.coefficient(abs(speed), self.normal_load))
 
     def normal_amplitude(self) -> complex:
         """Complex amplitude X̂ of the steady normal response x = Im(X̂ e^{iωt}) (eqs. 17-19)."""
@@ -163,11 +176,11 @@ class Contact:
 
     def mu_star(self) -> float:
         """μ*_i = μ(V_ref,i), the coefficient of steady sliding (eq. 23)."""
-        return float(self.friction(self.surface_speed))
+        return self.mu(self.surface_speed)
 
     def slope(self) -> float:
         """S_i = dμ/dv at v = V_ref,i (eq. 24)."""
-        return float(self.friction.derivative(self.surface_speed))
+        return float(self.law.coefficient_slope(self.surface_speed, self.normal_load))
 
 
 class Slider:

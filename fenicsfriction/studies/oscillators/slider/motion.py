@@ -49,8 +49,10 @@ class SliderMotion:
         coupled: the surface input reads :math:`X_i = V_{ref,i} t - y_i` (the contact's own
             motion shifts the roughness under it, §2 of the paper) instead of eq. 14's
             :math:`X_i = V_{ref,i} t`.
-        eps: None: true stick by events; > 0: no stick, the regularised law
-            :math:`F = \mu(V) N\,V/\sqrt{V^2+\varepsilon^2}` (one mode, no events).
+        eps: None: true stick by events; > 0: no stick, each contact's law regularised with
+            ε = ``eps`` (:meth:`fenicsfriction.laws.InterfaceLaw.friction_force`; the smooth
+            regularisation: :math:`F = \mu(V) N\,V/\sqrt{V^2+\varepsilon^2}`), one mode, no
+            events.
         linearised: friction linearised about steady sliding (eq. 25),
             :math:`F_i = (\mu^*_i - S_i \dot y_i) N_i(t)` with the signed N, no stick, no
             events: the linear periodic system of :meth:`Slider.averaged` and
@@ -80,6 +82,7 @@ class SliderMotion:
         self._k_n, self._c_n, self._N0 = get("k_n"), get("c_n"), get("normal_load")
         self._h, self._lam, self._V = get("roughness"), get("wavelength"), get("surface_speed")
         self._f = get("normal_force_factor")
+        self._laws = [c.law if eps is None else c.law.replace(eps=eps) for c in slider.contacts]
         self._mu_s = np.array([c.static_coefficient for c in slider.contacts])
         self._mu_star = np.array([c.mu_star() for c in slider.contacts])
         self._force_scale = np.maximum(self._mu_s, 1e-3) * np.array(
@@ -126,9 +129,11 @@ class SliderMotion:
         _, _, N, V_rel, F_req, _ = state
         if self.linearised:  # μ(V_rel) ≈ μ* + S (V_rel − V_ref) = μ* − S ẏ_i
             return (self._mu_star - self.slider.slopes * (self._V - V_rel)) * N
-        mu = np.array([c.friction(V) for c, V in zip(self.slider.contacts, V_rel, strict=True)])
-        if self.eps is not None:
-            return mu * N * V_rel / np.sqrt(V_rel * V_rel + self.eps * self.eps)
+        if self.eps is not None:  # the contact slips at -V_rel on the surface
+            return np.array([law.friction_force(n, -V)
+                             for law, n, V in zip(self._laws, N, V_rel, strict=True)])
+        mu = np.array([law.coefficient(abs(V), n)
+                       for law, n, V in zip(self._laws, N, V_rel, strict=True)])
         sign = np.array(mode, dtype=float)
         return np.where(sign == 0, F_req, mu * N * sign)
 

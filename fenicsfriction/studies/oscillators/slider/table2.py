@@ -75,6 +75,7 @@ def table2_slider(omega: float, reading: str = "paper") -> Slider:
     m, zeta_1, zeta_n, lam = 0.01, 0.015, 0.1, 16.67
     contact = Contact(mass=m, k_t=10.0, c_t=1.0 * zeta_1, k_n=m * 10.0, c_n=m * zeta_n,
                       normal_load=0.05, roughness=1.0, wavelength=lam,
-                      surface_speed=omega * lam / (2 * math.pi), friction=law,
+                      surface_speed=omega * lam / (2 * math.pi),
+                      law=laws.InterfaceLaw(friction_coefficient=law, regularisation="smooth"),
                       normal_force_factor=factor)
     return Slider(mass=1.0, stiffness=1.0, damping=zeta_1, contacts=[contact])
