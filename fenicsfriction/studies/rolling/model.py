@@ -98,8 +98,8 @@ class RollingContact:
             problem below ε ≈ 0.1 ξ, line search failures, docs/rolling-fe.md) make the
             tangential traction; its normal compliance c_n d^m_n [force/length^(2+m_n)] is
             that of ``pressure="contact"``. Its ε is not used: ``eps_sequence`` sets it.
-            Default μ = 0.3, the smooth regularisation, c_n = 1000, m_n = 1 (1000 E*/a at the
-            default G, ν and a: a compliance stiff against the block's; scale it with E*/a).
+            ``None``: μ = 0.3, the smooth regularisation, c_n = 1000 E*/a, m_n = 1 (a
+            compliance stiff against the block's, whatever the units).
         p0: Hertz's peak pressure [force/length²]; or give ``Fn`` (neither: 0.01 G).
         Fn: the normal force [force] (2D: per unit length), instead of ``p0``.
         creepage: (ξ, η, φ): longitudinal and lateral creepage, spin [1/length] (2D: ξ only).
@@ -123,8 +123,7 @@ class RollingContact:
     b: float | None = None
     G: float = 1.0
     nu: float = 0.0
-    law: laws.InterfaceLaw = dataclasses.field(default_factory=lambda: laws.InterfaceLaw(
-        c_n=1e3, m_n=1.0, mu=0.3, regularisation="smooth"))
+    law: laws.InterfaceLaw = None  # type: ignore[assignment]  # None: set by __post_init__
     p0: float | None = None
     Fn: float | None = None
     creepage: tuple[float, float, float] = (0.0, 0.0, 0.0)
@@ -139,12 +138,15 @@ class RollingContact:
         check("dim", self.dim, self.dim in (2, 3), "2 or 3")
         for name in ("a", "G", "growth", "block_size"):
             check_positive(name, getattr(self, name))
+        # ν = 1/2 is refused: the displacement formulation locks for incompressible bodies
+        check("nu", self.nu, -1 < self.nu < 0.5, "Poisson's ratio must be in (-1, 0.5)")
+        if self.law is None:
+            self.law = laws.InterfaceLaw(c_n=1e3 * self.E_star / self.a, m_n=1.0, mu=0.3,
+                                         regularisation="smooth")
         check("law", self.law, isinstance(self.law, laws.InterfaceLaw) and self.law.has_friction,
               "must be a fenicsfriction.laws.InterfaceLaw with friction (mu > 0 or a law)")
         if self.dim == 3 and self.b is not None:
             check_positive("b", self.b)
-        # ν = 1/2 is refused: the displacement formulation locks for incompressible bodies
-        check("nu", self.nu, -1 < self.nu < 0.5, "Poisson's ratio must be in (-1, 0.5)")
         check("p0", self.p0, self.p0 is None or self.Fn is None, "give p0 or Fn, not both")
         if self.Fn is not None:
             check_positive("Fn", self.Fn)
