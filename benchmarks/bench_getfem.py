@@ -47,6 +47,7 @@ def getfem_worker(refine: int, repeats: int) -> dict:
     """The continuation in GetFEM (run in its own process)."""
     import getfem as gf
 
+    from fenicsfriction.elasticity import lame
     from fenicsfriction.studies.block import BlockOnBelt
 
     gf.util_trace_level(0)
@@ -63,8 +64,7 @@ def getfem_worker(refine: int, repeats: int) -> dict:
     mim_contact = gf.MeshIm(m, gf.Integ("IM_GAUSS_PARALLELEPIPED(2,8)"))
     md = gf.Model("real")
     md.add_fem_variable("u", mf)
-    lmbda = s.E * s.nu / ((1 + s.nu) * (1 - 2 * s.nu))
-    shear = s.E / (2 * (1 + s.nu))
+    lmbda, shear = lame(s.E, s.nu)
     data = {"B0": s.B0, "lam": lmbda, "G": shear, "c_n": s.law.c_n, "m_n": s.law.m_n, "g": s.law.g,
             "eps": s.law.eps, "mu": 0.0}
     for name, value in data.items():

@@ -80,10 +80,3 @@ class Coupling(typing.Protocol):
         """An upper bound of the coupling's contribution to ω² on the lumped mass, whatever
         the state (:class:`~fenicsfriction.dynamics.CentralDifference`, when it is built, for
         springs that close after the initial state)."""
-
-
-if typing.TYPE_CHECKING:  # mypy checks that the node-to-segment contact fits, structurally
-    from fenicsfriction.contact.node_to_segment import NodeToSegment
-
-    def _node_to_segment_is_a_coupling(contact: NodeToSegment) -> Coupling:
-        return contact

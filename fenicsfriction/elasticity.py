@@ -1,21 +1,37 @@
 r"""Closed forms of linear elasticity that more than one family of studies checks against
 (NumPy only: the mesh-free models import it too).
 
-Two elastic bodies of moduli :math:`E_i` and Poisson ratios :math:`\nu_i` pressed together act
-as one body of effective modulus :math:`E^*` against a rigid one (plane strain in 2D; Johnson
-1985, *Contact Mechanics*, section 4.2), and Hertz's pressure is an ellipsoid over the contact.
+Lamé's parameters from Young's modulus and Poisson's ratio (:func:`lame`; numbers or UFL
+values: the finite element forms take them too). Two elastic bodies of moduli :math:`E_i` and
+Poisson ratios :math:`\nu_i` pressed together act as one body of effective modulus :math:`E^*`
+against a rigid one (plane strain in 2D; Johnson 1985, *Contact Mechanics*, section 4.2), and
+Hertz's pressure is an ellipsoid over the contact.
 """
 
 from __future__ import annotations
 
 import math
+import typing
 
 import numpy as np
 import numpy.typing as npt
 
 from fenicsfriction.laws import check, check_positive
 
-__all__ = ["check_poisson_ratio", "effective_modulus", "hertz_pressure"]
+__all__ = ["check_poisson_ratio", "effective_modulus", "hertz_pressure", "lame"]
+
+Value = typing.Any  # a number or a UFL expression
+
+
+def lame(E: Value, nu: Value, plane_stress: bool = False) -> tuple[Value, Value]:
+    """Lamé's parameters :math:`(\\lambda, \\mu)`, :math:`\\mu = E/(2(1+\\nu))`,
+    :math:`\\lambda = E\\nu/((1+\\nu)(1-2\\nu))`; with ``plane_stress`` the 2D plane-stress
+    :math:`\\lambda^* = 2\\mu\\lambda/(\\lambda + 2\\mu)` (numbers or UFL values)."""
+    mu = E / (2 * (1 + nu))
+    lmbda = E * nu / ((1 + nu) * (1 - 2 * nu))
+    if plane_stress:
+        lmbda = 2 * mu * lmbda / (lmbda + 2 * mu)
+    return lmbda, mu
 
 
 def check_poisson_ratio(name: str, nu: float) -> None:

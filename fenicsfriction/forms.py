@@ -28,6 +28,7 @@ import ufl
 from dolfinx import fem
 
 from fenicsfriction import laws
+from fenicsfriction.elasticity import lame
 
 __all__ = [
     "NodalSpring",
@@ -67,14 +68,6 @@ def inertia(rho: Value, u_ddot: Field, v: Field, dx: ufl.Measure) -> ufl.Form:
     return rho * ufl.inner(u_ddot, v) * dx
 
 
-def _lame(E: Value, nu: Value, plane_stress: bool) -> tuple[Value, Value]:
-    mu = E / (2 * (1 + nu))
-    lmbda = E * nu / ((1 + nu) * (1 - 2 * nu))
-    if plane_stress:
-        lmbda = 2 * mu * lmbda / (lmbda + 2 * mu)
-    return lmbda, mu
-
-
 def elasticity(u: Field, v: Field, E: Value, nu: Value, dx: ufl.Measure,
                plane_stress: bool = False) -> ufl.Form:
     """:math:`a_0(u, v) = \\int_\\Omega \\sigma(u):\\varepsilon(v)`, isotropic Hooke's law.
@@ -82,7 +75,7 @@ def elasticity(u: Field, v: Field, E: Value, nu: Value, dx: ufl.Measure,
     In 2D the default is plane strain (the block of Martins & Oden 1986);
     ``plane_stress=True`` switches.
     """
-    lmbda, mu = _lame(E, nu, plane_stress)
+    lmbda, mu = lame(E, nu, plane_stress)
     eps_u, eps_v = ufl.sym(ufl.grad(u)), ufl.sym(ufl.grad(v))
     sigma = 2 * mu * eps_u + lmbda * ufl.tr(eps_u) * ufl.Identity(len(u))
     return ufl.inner(sigma, eps_v) * dx

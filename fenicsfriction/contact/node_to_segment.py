@@ -481,3 +481,10 @@ def solve_with_search(solver: typing.Any, contacts: typing.Sequence[NodeToSegmen
             return report
     raise RuntimeError(f"contact search: the pairing still changed after {max_rounds} "
                        "Newton solves (max_rounds); the state of the last solve is kept")
+
+
+if typing.TYPE_CHECKING:  # mypy checks that the node-to-segment contact is a Coupling
+    from fenicsfriction.coupling import Coupling
+
+    def _node_to_segment_is_a_coupling(contact: NodeToSegment) -> Coupling:
+        return contact

@@ -25,6 +25,7 @@ import ufl
 
 from fenicsfriction import _compat, laws
 from fenicsfriction.dynamics import CentralDifference, DynamicsSolver
+from fenicsfriction.elasticity import lame
 from fenicsfriction.laws import check
 from fenicsfriction.studies.contact import closed_forms, geometry
 from fenicsfriction.studies.contact.geometry import LOAD
@@ -144,8 +145,7 @@ class _EnergyBalance:
         forms = {"kinetic": 0.5 * model.density * ufl.inner(u_dot, u_dot) * dx}
         elastic = 0.0
         for tag, material in zip((1, 2), model.materials, strict=True):
-            mu = material.E / (2 * (1 + material.nu))
-            lmbda = material.E * material.nu / ((1 + material.nu) * (1 - 2 * material.nu))
+            lmbda, mu = lame(material.E, material.nu)
             elastic = elastic + (mu * ufl.inner(eps, eps) + 0.5 * lmbda * ufl.tr(eps) ** 2) \
                 * dx(tag)
         forms["elastic"] = elastic
