@@ -216,3 +216,17 @@ def test_friction_coefficient_derivative_is_its_central_difference(law):
     h = 1e-6
     fd = (law(v + h) - law(v - h)) / (2 * h)
     assert np.allclose(law.derivative(v), fd, rtol=1e-7, atol=1e-9)
+
+
+def test_power_law_secant_lands_on_the_load_of_an_exact_power_law():
+    # F = C δ^k: one secant step through two exact points reaches the target to round-off
+    from fenicsfriction.numerics import power_law_secant
+    C, k = 3.0, 1.5
+    x0, x1 = np.log(1e-3), np.log(2e-3)
+    y0, y1 = np.log(C) + k * x0, np.log(C) + k * x1
+    target = np.log(7.0)
+    x = power_law_secant(x0, y0, x1, y1, target)
+    assert C * np.exp(x) ** k == pytest.approx(7.0, rel=1e-12)
+    # the safeguard bounds the exponent from below (a force that barely grows)
+    flat = power_law_secant(x0, y0, x1, y0 + 1e-3 * (x1 - x0), target, min_slope=0.3)
+    assert flat == pytest.approx(x1 + (target - (y0 + 1e-3 * (x1 - x0))) / 0.3)

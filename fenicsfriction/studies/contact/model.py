@@ -30,6 +30,7 @@ from fenicsfriction import _compat, forms, laws
 from fenicsfriction.contact import NodeToSegment, facet_nodes, solve_with_search
 from fenicsfriction.contact.node_to_segment import NodalValues
 from fenicsfriction.laws import check
+from fenicsfriction.numerics import power_law_secant
 from fenicsfriction.steady import SteadySolver
 from fenicsfriction.studies.contact.geometry import (
     BODY1,
@@ -259,8 +260,7 @@ class TwoBodyModel:
                 delta *= 2.0 if force <= 0 else (load / force) ** 0.7
                 continue
             (x0, y0), (x1, y1) = history[-2], history[-1]
-            slope = (y1 - y0) / (x1 - x0) if x1 != x0 else 1.0
-            delta = float(np.exp(x1 + (np.log(load) - y1) / max(slope, 0.3)))
+            delta = float(np.exp(power_law_secant(x0, y0, x1, y1, np.log(load), min_slope=0.3)))
         raise RuntimeError(f"solve_for_load: the contact force {force:.6g} did not reach the "
                            f"load {load:.6g} within {max_solves} solves (max_solves)")
 

@@ -51,6 +51,7 @@ from fenicsfriction import _compat, forms, laws
 from fenicsfriction.assembly import assemble_owned
 from fenicsfriction.io import FieldWriter
 from fenicsfriction.laws import check, check_positive
+from fenicsfriction.numerics import power_law_secant
 from fenicsfriction.steady import SteadySolver, epsilon_sequence
 from fenicsfriction.studies.rolling import closed_forms
 from fenicsfriction.studies.rolling.geometry import CLAMPED, CONTACT, half_space
@@ -393,7 +394,7 @@ class RollingModel:
                 approach *= target / force
                 continue
             (x0, y0), (x1, y1) = history[-2:]
-            approach = math.exp(x1 + (math.log(target) - y1) * (x1 - x0) / (y1 - y0))
+            approach = math.exp(power_law_secant(x0, y0, x1, y1, math.log(target)))
         else:
             raise RuntimeError(f"the normal force {force:.6g} did not reach {target:.6g}")
         self.normal_solver = solver
