@@ -5,6 +5,8 @@ the finite element block, the rigid block and the law's own derivatives.
 with the pressure p; it uses only operations valid on UFL, NumPy and the law's dual numbers.
 """
 
+import dataclasses
+
 from mpi4py import MPI
 from petsc4py import PETSc
 
@@ -12,12 +14,14 @@ import dolfinx.fem.petsc
 import numpy as np
 import pytest
 import scipy.integrate
+import scipy.optimize
 from dolfinx import fem
 
 import fenicsfriction as ff
 from fenicsfriction import _compat, laws
 from fenicsfriction.contact import solve_with_search
 from fenicsfriction.studies.block import RigidBlock, rigid_block_observables
+from fenicsfriction.studies.block.data import CONTACT
 from fenicsfriction.studies.oscillators import BeltOscillator
 
 MU_S, MU_K, V_S, P_REF, ALPHA = 0.6, 0.4, 0.1, 0.2, 0.3
@@ -29,6 +33,13 @@ def user_mu(speed, pressure):
 
 
 LAW = ff.InterfaceLaw(friction_coefficient=user_mu, eps=1e-3)
+BELT_SPEED = ff.BlockOnBelt().belt_speed  # [cm/s], the scenes' default U
+
+
+def user_mu_at_belt_speed(speed, pressure):
+    """The user's μ with the speed frozen at the belt's: the same μ(U, p) in steady sliding
+    (every point slips at U), but no slope in the speed."""
+    return user_mu(BELT_SPEED, pressure)
 
 
 @pytest.mark.parametrize("w", [-0.3, -2e-4, 5e-4, 0.05])
@@ -224,3 +235,128 @@ def test_point_contact_force_and_slope_of_the_user_law():
     assert law.coefficient_slope(s, N) == pytest.approx(central, rel=1e-7)
     belt = BeltOscillator(m=1.0, k=1.0, c=0.1, N=N, v_belt=0.05, law=law)
     assert belt.effective_damping() == pytest.approx(0.1 + N * central[1], rel=1e-7)
+
+
+# --- stability of steady sliding --------------------------------------------------------------
+
+def _sliding(scene: ff.BlockOnBelt, name: str) -> ff.BlockModel:
+    """The FE block of ``scene`` in steady sliding, from the model's initial guess."""
+    model = scene.build(MPI.COMM_WORLD, with_friction=True)
+    model.initial_guess()
+    ff.SteadySolver(model.residual, prefix=f"user_law_{name}_",
+                    options=model.solver_options()).solve()
+    return model
+
+
+def _stiff_block_gap(scene: ff.BlockOnBelt, name: str) -> tuple[np.ndarray, np.ndarray]:
+    """The rigid block's eigenvalues (Im λ >= 0; dense, from its own (M, C, K̄), the law's dual
+    numbers) and the FE block's in |λ| <= 1.5 max |λ_rigid| (SLEPc), paired nearest first, and
+    the gaps |λ_FE - λ_rigid| / |λ_rigid|."""
+    rigid_block = RigidBlock.from_scene(scene)
+    assert rigid_block.law is scene.law  # the user's object itself, never a copy or a constant
+    rigid = rigid_block.eigenvalues(rigid_block.steady_state())
+    rigid = rigid[rigid.imag >= 0]
+    model = _sliding(scene, name)
+    stability = ff.StabilitySolver(model.residual, prefix=f"user_law_{name}_pep_")
+    modes = stability.solve(max_modulus=1.5 * abs(rigid).max())
+    assert all(m.accurate for m in modes), [m.residual for m in modes]
+    fe = np.array([m.value for m in modes])
+    assert len(fe) == len(rigid), (fe, rigid)
+    rows, cols = scipy.optimize.linear_sum_assignment(abs(fe[:, None] - rigid[None, :]))
+    return rigid[cols], abs(fe[rows] - rigid[cols]) / abs(rigid[cols])
+
+
+def test_stiff_fe_block_with_the_user_law_has_the_rigid_blocks_eigenvalues():
+    """The user's law, unchanged, in the stability analysis of the FE block (StabilitySolver,
+    the PEP of ufl.derivatives of the residual) and of the rigid block (RigidBlock, its
+    (M, C, K̄) from the law's dual-number derivatives, dense eigenvalues): two computations
+    that share the law object and nothing else.
+
+    In steady sliding μ(U, p) ≈ 0.55 > μ_crit ≈ 0.37 and μ falls with the slip speed, so
+    below 1.5 max|λ_rigid| there are four eigenvalues (Im λ >= 0): the spring mode split into
+    two real growing ones λ₁λ₂ ≈ K_x/M by the negative damping B0 ∫ c_n d^{m_T} ∂μ/∂s ds
+    (λ₁ + λ₂ ≈ 177 1/s), and the normal/rotation flutter pair, its growth rates ≈ +529 and
+    -472 1/s no longer opposite because of that damping. The FE block tends to the rigid one
+    as E grows: the elastic compliance adds a relative 1/E to each eigenvalue. Measured gap
+    max |λ_FE - λ_rigid| / |λ_rigid| (the flutter pair) at E × 1, 10, 100: 3.8e-2, 4.1e-3,
+    4.1e-4 (the same serially and on 2 ranks), so each step of ×10 in E divides it by 9.3,
+    9.9; the band 7 to 13 asserts the 1/E rate (a higher order term 1/E² shows at E × 1).
+    Every mode's gap falls too. At E × 100, 1e-3 is 2.5 times the measured gap, and far
+    above the PEP's own error (relative residuals ≤ 1e-10, the spring's slow real mode,
+    |λ| ≈ 0.14, the worst conditioned, off by 1e-5). Stiffer still the steady state's
+    round-off (ε_mach ‖J‖ ‖u‖, growing with E) takes over: 4-6e-5 at E × 10³ and 10⁴.
+
+    Without the slope ∂μ/∂s the eigenvalues are others: with the user's μ frozen at the belt
+    speed (the same μ(U, p), the same steady state, the same K̄) the spring mode is the
+    undamped ±i sqrt(K_x/M) ≈ 4.97i and the flutter pair ±490 + 5309i, which the rigid block
+    confirms (gap 3.7e-4); the user's eigenvalues lie 2.2e-2 (the flutter pair) to 36 (the
+    spring's slow mode) of their modulus away from these, beyond ten times the 1e-3: an FE
+    damping matrix without the slope would fail the comparison with the rigid block.
+    """
+    base = ff.BlockOnBelt(law=LAW)
+    gaps = []
+    for factor in (1, 10, 100):
+        rigid, gap = _stiff_block_gap(dataclasses.replace(base, E=factor * base.E),
+                                      f"stiff{factor}")
+        gaps.append(gap)
+    assert len(rigid) == 4 and np.sum(rigid.imag == 0) == 2, rigid
+    assert np.all(rigid[rigid.imag == 0].real > 0)  # the negative slope: two growing modes
+    assert np.all(gaps[1] < gaps[0]) and np.all(gaps[2] < gaps[1]), gaps
+    worst = np.array([g.max() for g in gaps])
+    assert np.all((worst[:-1] / worst[1:] > 7) & (worst[:-1] / worst[1:] < 13)), worst
+    assert worst[-1] < 1e-3, worst
+
+    frozen, frozen_gap = _stiff_block_gap(
+        dataclasses.replace(base, E=100 * base.E,
+                            law=LAW.replace(friction_coefficient=user_mu_at_belt_speed)),
+        "frozen")
+    assert frozen_gap.max() < 1e-3, frozen_gap
+    assert len(frozen) == 3 and abs(frozen[0].real) < 1e-6 * abs(frozen[0]), frozen
+    distance = abs(rigid[:, None] - frozen[None, :]).min(axis=1) / abs(rigid)
+    assert distance.min() > 10 * 1e-3, (rigid, frozen)
+
+
+def test_fe_damping_is_the_users_speed_slope_at_every_contact_node():
+    """C = ∂R/∂u̇ of the FE block in steady sliding against the law's NumPy derivative ∂t/∂w
+    (dual numbers) summed by hand over the contact nodes. With the nodal rule on Q1 facets
+    (the trapezoidal rule: each node carries its tributary length A_i) the friction term of C
+    is the diagonal -B0 A_i ∂t/∂w(d_i, -U) on the nodes' x-dofs and nothing else (no normal
+    damping; the C¹ direction φ'_ε is constant where |w| = U > ε, so all of it is
+    -c_n d^{m_T} ∂μ/∂s, the user's slope in the speed). Both sides evaluate the same
+    expression at the same nodal d_i, so they agree to round-off: 1e-12. With the speed frozen
+    (user_mu_at_belt_speed) the steady state carries the same friction (to the Newton
+    tolerance, 1e-8 of the load), and C vanishes: the damping is the slope alone. Measured:
+    the five nodes' C_ii sum to -70.6 (10³ kg/s; the rigid block's ∂μ/∂s damping is of that
+    size), diagonal and Frobenius norm equal to round-off, serially and on 2 ranks."""
+    scene = ff.BlockOnBelt(law=LAW, degree=1, contact_quadrature="nodal")
+    model = _sliding(scene, "nodal")
+    stability = ff.StabilitySolver(model.residual, prefix="user_law_nodal_pep_")
+    stability.assemble()
+    comm, V = model.msh.comm, model.V
+    bs = V.dofmap.index_map_bs
+    x_dofs = fem.locate_dofs_topological(V.sub(0), model.msh.topology.dim - 1,
+                                         model.facet_tags.find(CONTACT))
+    x_dofs = x_dofs[x_dofs < V.dofmap.index_map.size_local * bs]  # owned
+    x = V.tabulate_dof_coordinates()[x_dofs // bs, 0]
+    nodes = np.unique(np.concatenate(comm.allgather(x)))
+    tributary = np.diff(nodes, prepend=nodes[0]) / 2 + np.diff(nodes, append=nodes[-1]) / 2
+    lengths = tributary[np.searchsorted(nodes, x)]
+    u, u_dot = model.residual.u.x.array, model.residual.u_dot.x.array
+    d, w = -u[x_dofs + 1], u_dot[x_dofs] - scene.belt_speed
+    assert np.all(d > 0) and np.allclose(w, -scene.belt_speed, rtol=0, atol=0)
+    _, dt_dw = LAW.friction_traction_derivatives(d, w)
+    expected = -scene.B0 * lengths * dt_dw
+    diagonal = stability.C.getDiagonal().getArray()
+    assert diagonal[x_dofs] == pytest.approx(expected, rel=1e-12)
+    assert np.all(expected < 0)  # μ falls with the speed: negative damping
+    total = np.sqrt(comm.allreduce(np.sum(expected**2), op=MPI.SUM))
+    assert len(nodes) == 5 and stability.C.norm(PETSc.NormType.FROBENIUS) == pytest.approx(
+        total, rel=1e-12)  # nothing off the diagonal, nothing on other dofs
+
+    frozen = _sliding(dataclasses.replace(
+        scene, law=LAW.replace(friction_coefficient=user_mu_at_belt_speed)), "nodal_frozen")
+    assert frozen.quantities().friction_force == pytest.approx(
+        model.quantities().friction_force, abs=1e-8 * scene.weight)
+    frozen_stability = ff.StabilitySolver(frozen.residual, prefix="user_law_nodal_frozen_pep_")
+    frozen_stability.assemble()
+    assert frozen_stability.C.norm(PETSc.NormType.FROBENIUS) == 0.0
