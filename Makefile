@@ -36,8 +36,8 @@ $(VENV)/.installed: pyproject.toml
 setup: $(VENV)/.installed
 
 demo: setup
-	$(PY) -m fenicsfriction steady block --mu-max 1.55 --steps 31 --out $(OUT)/steady-block
-	$(PY) -m fenicsfriction stability block --mu-max 1.55 --steps 62 --out $(OUT)/stability-block
+	$(PY) -m fenicsfriction block steady --mu-max 1.55 --steps 31 --out $(OUT)/steady-block
+	$(PY) -m fenicsfriction block stability --mu-max 1.55 --steps 62 --out $(OUT)/stability-block
 	FENICSFRICTION_DEMO_OUT=$(OUT)/stick-slip-block $(MPIRUN) $(PY) demos/demo_block_stick_slip.py
 	FENICSFRICTION_DEMO_OUT=$(OUT)/slider $(MPIRUN) $(PY) demos/demo_slider_table2.py
 	FENICSFRICTION_DEMO_OUT=$(OUT)/two_body_contact $(MPIRUN) $(PY) demos/demo_two_body_contact.py

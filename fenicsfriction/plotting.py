@@ -1,4 +1,7 @@
-"""Figures people would rather look at than read (matplotlib, drawn on rank 0)."""
+"""Figures people would rather look at than read (matplotlib, drawn on rank 0): the helpers
+every family's figures are built on (:func:`saved_figure`, ...), and the block's and the
+oscillators' figures. dolfinx is imported only by the helpers that read a mesh
+(:func:`cell_outlines`, :func:`body_cells`), so the mesh-free families' figures do without."""
 
 from __future__ import annotations
 
@@ -9,9 +12,9 @@ import typing
 from mpi4py import MPI
 
 import numpy as np
-from dolfinx import fem
 
-from fenicsfriction import _compat
+if typing.TYPE_CHECKING:
+    from dolfinx import fem
 
 PathLike = str | os.PathLike
 
@@ -49,6 +52,10 @@ def cell_outlines(u: fem.Function) -> tuple[np.ndarray, np.ndarray] | None:
 
     Returns ``(X, U)`` of shape (num_cells, 4, 2) on rank 0 and ``None`` elsewhere.
     """
+    from dolfinx import fem
+
+    from fenicsfriction import _compat
+
     msh = u.function_space.mesh
     V1 = _compat.vector_function_space(msh, 1)
     u1 = fem.Function(V1)

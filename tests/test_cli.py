@@ -35,7 +35,7 @@ def out_dir() -> pathlib.Path:
 
 
 def test_steady_cli_writes_one_balanced_record_per_step(out_dir):
-    code = main(["steady", "block", "--mu-max", "0.9", "--steps", "6", "--out", str(out_dir),
+    code = main(["block", "steady", "--mu-max", "0.9", "--steps", "6", "--out", str(out_dir),
                  "--snapshots", "2"])
     assert code == 0
     records = json.loads((out_dir / "steady.json").read_text())
@@ -62,7 +62,7 @@ def test_steady_cli_writes_one_balanced_record_per_step(out_dir):
 
 
 def test_stability_cli_writes_tracked_loci_and_both_onsets(out_dir):
-    code = main(["stability", "block", "--mu-max", "0.6", "--steps", "6", "--out", str(out_dir),
+    code = main(["block", "stability", "--mu-max", "0.6", "--steps", "6", "--out", str(out_dir),
                  "--onset-tol", "1e-3"])
     assert code == 0
     data = json.loads((out_dir / "stability.json").read_text())
@@ -85,7 +85,7 @@ def test_stability_cli_writes_tracked_loci_and_both_onsets(out_dir):
 
 
 def test_dynamics_cli_writes_a_time_series_whose_energy_balance_closes(out_dir):
-    code = main(["dynamics", "block", "--mu", "0.6", "--t-end", "5e-4", "--dt", "1e-5",
+    code = main(["block", "dynamics", "--mu", "0.6", "--t-end", "5e-4", "--dt", "1e-5",
                  "--b-n", "0.381e10", "--out", str(out_dir), "--stride", "25"])
     assert code == 0
     import csv
@@ -113,7 +113,7 @@ def test_dynamics_cli_writes_a_time_series_whose_energy_balance_closes(out_dir):
 
 def test_steady_cli_stops_at_discrete_tipping_limit_and_reports_it(out_dir):
     """Beyond μ = L/H no steady state exists: exit 1, converged steps kept, no hang."""
-    code = main(["steady", "block", "--mu-max", "1.7", "--steps", "2", "--out", str(out_dir),
+    code = main(["block", "steady", "--mu-max", "1.7", "--steps", "2", "--out", str(out_dir),
                  "--max-halvings", "3", "--snapshots", "0"])
     assert code == 1
     summary = json.loads((out_dir / "summary.json").read_text())
@@ -127,7 +127,7 @@ def test_steady_cli_stops_at_discrete_tipping_limit_and_reports_it(out_dir):
                                              ("--belt-direction", "2", "belt_direction"),
                                              ("--eps", "0", "eps")])
 def test_bad_parameter_value_is_reported_by_name(out_dir, capsys, flag, value, name):
-    args = ["steady", "block", "--mu-max", "0.5", "--steps", "2", "--out", str(out_dir)]
+    args = ["block", "steady", "--mu-max", "0.5", "--steps", "2", "--out", str(out_dir)]
     args += [flag, value]
     assert main(args) == 2
     err = capsys.readouterr().err
@@ -140,7 +140,7 @@ def test_bad_parameter_value_is_reported_by_name(out_dir, capsys, flag, value, n
 @pytest.mark.parametrize("args", [["--mu-max", "-1"], ["--mu-max", "abc"], ["--steps", "0"],
                                   ["--regularisation", "tanh"]])
 def test_user_error_prints_one_line_without_traceback(tmp_path, args):
-    cmd = [sys.executable, "-m", "fenicsfriction", "steady", "block", "--mu-max", "0.5",
+    cmd = [sys.executable, "-m", "fenicsfriction", "block", "steady", "--mu-max", "0.5",
            "--out", str(tmp_path), *args]
     result = subprocess.run(cmd, capture_output=True, text=True, timeout=120, env=_environment())
     assert result.returncode == 2
@@ -178,7 +178,7 @@ def _interrupt(cmd: list[str], table: pathlib.Path, signum: int, rows: int = 5,
 def test_interrupted_dynamics_keeps_every_step_and_exits_130(tmp_path):
     """Ctrl-C in a long run: the rows computed so far, a summary saying where it stopped, one
     line on stderr and status 130 (what a shell reports for SIGINT)."""
-    cmd = [sys.executable, "-m", "fenicsfriction", "dynamics", "block", "--mu", "0.6",
+    cmd = [sys.executable, "-m", "fenicsfriction", "block", "dynamics", "--mu", "0.6",
            "--belt-speed", "0.08", "--t-end", "0.2", "--out", str(tmp_path)]
     result = _interrupt(cmd, tmp_path / "timeseries.csv", signal.SIGINT)
     assert result.returncode == 130, result.stderr
@@ -194,9 +194,9 @@ def test_interrupted_dynamics_keeps_every_step_and_exits_130(tmp_path):
 
 @pytest.mark.skipif(MPI.COMM_WORLD.size > 1,
                     reason="starts its own interpreter; runs in the serial pass")
-@pytest.mark.parametrize("scene", [["mdof", "--t-end", "2000"], ["belt", "--t-end", "1e7"]])
+@pytest.mark.parametrize("scene", [["slider", "--t-end", "2000"], ["belt", "--t-end", "1e7"]])
 def test_terminated_oscillator_keeps_its_samples_and_exits_143(tmp_path, scene):
-    cmd = [sys.executable, "-m", "fenicsfriction", "oscillator", *scene, "--out", str(tmp_path)]
+    cmd = [sys.executable, "-m", "fenicsfriction", "oscillators", *scene, "--out", str(tmp_path)]
     result = _interrupt(cmd, tmp_path / "timeseries.csv", signal.SIGTERM, rows=50)
     assert result.returncode == 143, result.stderr
     assert "Traceback" not in result.stderr
@@ -211,9 +211,9 @@ def test_terminated_oscillator_keeps_its_samples_and_exits_143(tmp_path, scene):
 
 @pytest.mark.skipif(MPI.COMM_WORLD.size > 1,
                     reason="starts its own interpreter; runs in the serial pass")
-@pytest.mark.parametrize("command", [["steady", "block", "--mu-max", "0.5"],
-                                     ["dynamics", "block", "--mu", "0.5", "--t-end", "1e-3"],
-                                     ["oscillator", "belt"]])
+@pytest.mark.parametrize("command", [["block", "steady", "--mu-max", "0.5"],
+                                     ["block", "dynamics", "--mu", "0.5", "--t-end", "1e-3"],
+                                     ["oscillators", "belt"]])
 @pytest.mark.parametrize("where", ["under a file", "/proc"])
 def test_unwritable_output_folder_is_one_line_and_exit_2(tmp_path, command, where):
     blocker = tmp_path / "a-file"
@@ -226,16 +226,71 @@ def test_unwritable_output_folder_is_one_line_and_exit_2(tmp_path, command, wher
     assert len(lines) == 1 and "--out=" in lines[0] and "Traceback" not in result.stderr
 
 
+#: commands of the old grammar (COMMAND SCENE) and the new spelling the hint must name
+OLD_SPELLINGS = [
+    (["steady", "block", "--mu-max", "1"], "'steady block' is now 'block steady'"),
+    (["stability", "block-on-slab", "--mu-max", "1"],
+     "'stability block-on-slab' is now 'block stability --scene block-on-slab'"),
+    (["dynamics", "block", "--mu", "0.6"], "'dynamics block' is now 'block dynamics'"),
+    (["stability-map", "mdof", "--omega-range", "30:34"],
+     "'stability-map mdof' is now 'oscillators slider-map'"),
+    (["oscillator", "mdof"], "'oscillator mdof' is now 'oscillators slider'"),
+    (["oscillator", "belt"], "'oscillator belt' is now 'oscillators belt'"),
+    (["interface", "eq", "--N", "400"], "'interface eq' is now 'multicontact eq'"),
+    (["steady"], "'steady ...' is now 'block steady' or 'block steady --scene block-on-slab'")]
+
+
+@pytest.mark.skipif(MPI.COMM_WORLD.size > 1,
+                    reason="starts its own interpreter; runs in the serial pass")
+@pytest.mark.parametrize(("argv", "hint"), OLD_SPELLINGS)
+def test_old_spelling_prints_the_new_one_in_one_line_and_exits_2(tmp_path, argv, hint):
+    result = subprocess.run([sys.executable, "-m", "fenicsfriction", *argv, "--out",
+                             str(tmp_path)], capture_output=True, text=True, timeout=60,
+                            env=_environment())
+    assert result.returncode == 2
+    assert result.stderr.splitlines() == [f"fenicsfriction: {hint}"], result.stderr
+    assert not (tmp_path / "summary.json").exists()  # nothing ran
+
+
+@pytest.mark.skipif(MPI.COMM_WORLD.size > 1,
+                    reason="starts its own interpreter; runs in the serial pass")
+@pytest.mark.parametrize(("argv", "flag", "value"), [
+    (["block", "steady", "--mu-max", "1", "--scene", "slab"], "--scene", "slab"),
+    (["block", "dynamics", "--mu", "0.6", "--t-end", "1e-3", "--scheme", "rk4"], "--scheme",
+     "rk4"),
+    (["oscillators", "belt", "--law", "coulomb"], "--law", "coulomb"),
+    (["oscillators", "slider-map", "--omega-range", "30"], "--omega-range", "30"),
+    (["contact", "cattaneo", "--penalty-T", "soft"], "--penalty-T", "soft"),
+    (["rolling", "curve", "--xi-range", "0:1", "--a", "1", "--G", "1", "--nu", "0.3", "--mu",
+      "0.3", "--Fn", "1"], "--xi-range", "0:1"),
+    (["multicontact", "eq", "--N", "many"], "--N", "many")])
+def test_bad_flag_value_names_the_flag_in_one_line_and_exits_2(tmp_path, argv, flag, value):
+    result = subprocess.run([sys.executable, "-m", "fenicsfriction", *argv, "--out",
+                             str(tmp_path)], capture_output=True, text=True, timeout=60,
+                            env=_environment())
+    assert result.returncode == 2
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1 and "Traceback" not in result.stderr, result.stderr
+    assert flag in lines[0] and value in lines[0], lines[0]
+
+
+def test_pop_penalty_is_the_flag_penalty_T_not_eps_T(out_dir):
+    """ε names the regularisation only: the old flag of Pop's tangential penalty is refused."""
+    with pytest.raises(SystemExit) as stop:
+        main(["contact", "cattaneo", "--eps-T", "1e4", "--out", str(out_dir)])
+    assert stop.value.code == 2
+
+
 SOLVERS = ("dolfinx", "mpi4py.MPI", "petsc4py.PETSc")
 
 
 @pytest.mark.parametrize(("argv", "not_imported"), [
     (["--help"], (*SOLVERS, "scipy")),
-    (["steady", "block", "--mu-max", "x", "--out", "o"], (*SOLVERS, "scipy")),
-    (["stability", "--help"], (*SOLVERS, "scipy")),
-    (["oscillator", "belt"], (*SOLVERS, "scipy")),
+    (["block", "steady", "--mu-max", "x", "--out", "o"], (*SOLVERS, "scipy")),
+    (["block", "stability", "--help"], (*SOLVERS, "scipy")),
+    (["oscillators", "belt"], (*SOLVERS, "scipy")),
     # checking a reading loads the slider's model (NumPy, SciPy) but no solver
-    (["oscillator", "mdof", "--reading", "nope", "--out", "o"], SOLVERS)])
+    (["oscillators", "slider", "--reading", "nope", "--out", "o"], SOLVERS)])
 def test_help_and_flag_errors_import_no_solver(argv, not_imported):
     """``--help`` and a flag error are answered by argparse alone: neither MPI, PETSc nor
     dolfinx is imported (each costs tenths of a second), so they return at once."""

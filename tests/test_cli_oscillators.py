@@ -19,7 +19,7 @@ def out_dir(shared_tmp_path) -> pathlib.Path:
 
 
 def test_stability_map_cli_finds_the_principal_band_by_both_methods(out_dir):
-    assert main(["stability-map", "mdof", "--omega-range", "62:65.5", "--samples", "8",
+    assert main(["oscillators", "slider-map", "--omega-range", "62:65.5", "--samples", "8",
                  "--out", str(out_dir)]) == 0
     data = json.loads((out_dir / "stability_map.json").read_text())
     assert data["natural_frequencies"] == pytest.approx([0.9950, 31.7807], abs=5e-5)
@@ -34,7 +34,7 @@ def test_belt_cli_cycle_is_the_classic_closed_form(out_dir):
     # harmonic arc x − x_k = R cos ψ about x_k = μ_k N/k from (x_s, v_b), ψ = −φ, to the next
     # ẋ = v_b at ψ = π + φ (x = x_k − Δ), then stuck back up to x_s: Δ = x_s − x_k,
     # R = √(Δ² + (v_b/ω)²), tan φ = v_b/(ωΔ); amplitude 2R, period (π + 2φ)/ω + 2Δ/v_b
-    assert main(["oscillator", "belt", "--t-end", "40", "--out", str(out_dir)]) == 0
+    assert main(["oscillators", "belt", "--t-end", "40", "--out", str(out_dir)]) == 0
     summary = json.loads((out_dir / "summary.json").read_text())
     delta, v, omega = 0.3, 0.5, 1.0
     radius = math.hypot(delta, v / omega)
@@ -58,7 +58,7 @@ def test_belt_cli_cycle_is_the_classic_closed_form(out_dir):
 
 
 def test_mdof_oscillator_cli_writes_the_time_series(out_dir):
-    assert main(["oscillator", "mdof", "--omega", "30.16", "--t-end", "1", "--sample-dt",
+    assert main(["oscillators", "slider", "--omega", "30.16", "--t-end", "1", "--sample-dt",
                  "0.01", "--out", str(out_dir)]) == 0
     if MPI.COMM_WORLD.rank == 0:
         with open(out_dir / "timeseries.csv") as f:
@@ -70,12 +70,12 @@ def test_mdof_oscillator_cli_writes_the_time_series(out_dir):
 
 
 @pytest.mark.parametrize(("args", "name"), [
-    (["oscillator", "belt", "--m", "0"], "m=0.0"),
-    (["oscillator", "belt", "--k", "-1"], "k=-1.0"),
-    (["oscillator", "mdof", "--omega", "0"], "--omega=0.0"),
-    (["stability-map", "mdof", "--omega-range", "5:1"], "--omega-range='5:1'")])
+    (["oscillators", "belt", "--m", "0"], "m=0.0"),
+    (["oscillators", "belt", "--k", "-1"], "k=-1.0"),
+    (["oscillators", "slider", "--omega", "0"], "--omega=0.0"),
+    (["oscillators", "slider-map", "--omega-range", "5:1"], "--omega-range='5:1'")])
 def test_bad_oscillator_input_is_named(out_dir, capsys, args, name):
-    assert main([*args, "--out", str(out_dir)] if "--t-end" in args or args[0] != "oscillator"
+    assert main([*args, "--out", str(out_dir)] if args[1] == "slider-map"
                 else [*args, "--t-end", "1", "--out", str(out_dir)]) == 2
     if MPI.COMM_WORLD.rank == 0:
         assert name in capsys.readouterr().err

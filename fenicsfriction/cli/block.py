@@ -1,10 +1,11 @@
-"""``fenicsfriction steady|stability|dynamics block|block-on-slab``: the finite element block
-on a rigid belt or on an elastic slab.
+"""``fenicsfriction block steady|stability|dynamics [--scene block|block-on-slab]``: the
+finite element block on a rigid belt or on an elastic slab.
 
 Each command writes what it computes as it goes (``steady.json``/``stability.json`` rewritten
 after every μ step, ``timeseries.csv`` one row per time step) and, stopped by a signal or a
 solver failure, keeps what it has, writes ``summary.json`` saying where it stopped and returns
-non-zero (see :mod:`fenicsfriction.signals`).
+non-zero (see :mod:`fenicsfriction.signals`). MPI, PETSc and dolfinx are imported inside the
+run functions, after the flags parse.
 """
 
 from __future__ import annotations
@@ -16,27 +17,136 @@ import pathlib
 import time
 import typing
 
-from mpi4py import MPI
-
-import numpy as np
-
-from fenicsfriction import io, plotting, results
-from fenicsfriction.cli.common import flag, output_folder, scene_from_flags, stop_line
-from fenicsfriction.laws import check
-from fenicsfriction.results import CsvRows
-from fenicsfriction.signals import Interrupted, StopSignals
-from fenicsfriction.studies.block.slab import SCENES
+from fenicsfriction.cli.arguments import LazyChoices, Parser, floats
 
 if typing.TYPE_CHECKING:
+    import numpy as np
+
+    from fenicsfriction.signals import Interrupted
     from fenicsfriction.steady import SteadySolver
     from fenicsfriction.studies.block import BlockModel, BlockOnBelt
 
-__all__ = ["run_dynamics", "run_stability", "run_steady"]
+__all__ = ["add_parser", "run_dynamics", "run_stability", "run_steady"]
+
+#: the scenes, read from the library when a value is checked or the help printed
+_SCENES = LazyChoices("fenicsfriction.studies.block.slab", "SCENES")
+
+
+def _scene_flag(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--scene", choices=_SCENES, default="block",
+                        help="block (on a rigid belt) or block-on-slab (on an elastic slab) "
+                             "(block)")
+
+
+def _continuation_flags() -> argparse.ArgumentParser:
+    """Flags shared by the studies that follow the steady state in μ (None: scene default)."""
+    flags = Parser(add_help=False)
+    _scene_flag(flags)
+    flags.add_argument("--mu-max", type=float, required=True, help="last friction coefficient")
+    flags.add_argument("--steps", type=int, default=30, help="continuation increments (NINCT)")
+    flags.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    flags.add_argument("--refine", type=int, default=1, help="mesh refinement (4r × 3r cells)")
+    flags.add_argument("--degree", type=int,
+                       help="Lagrange degree (block: 2, Q2; block-on-slab: 1, the only one)")
+    flags.add_argument("--E", type=float, help="Young's modulus [10³ kg cm⁻¹ s⁻²] (1.4e6)")
+    flags.add_argument("--B0", type=float, help="breadth out of the plane [cm] (30.5)")
+    flags.add_argument("--K-x", type=float, dest="K_x", help="driver spring [10³ kg s⁻²] (11.1)")
+    flags.add_argument("--spring-height", type=float, help="spring height [cm] (H/2)")
+    flags.add_argument("--belt-speed", type=float, help="belt speed [cm/s] (0.287)")
+    flags.add_argument("--belt-direction", type=int, help="+1 or -1 (+1)")
+    flags.add_argument("--eps", type=float, help="regularisation ε [cm/s] (1e-3)")
+    flags.add_argument("--regularisation", help="c1 or smooth (c1)")
+    flags.add_argument("--contact-quadrature",
+                       help="gauss, gll or nodal (block: gauss; block-on-slab: nodal, its only "
+                            "rule)")
+    _slab_flags(flags)
+    flags.add_argument("--max-halvings", type=int, default=8,
+                       help="step halvings allowed when a continuation step fails")
+    return flags
+
+
+def _slab_flags(parser: argparse.ArgumentParser) -> None:
+    """The slab's fields of the scene block-on-slab (None: the scene's defaults)."""
+    slab = parser.add_argument_group("block-on-slab (the elastic belt)")
+    slab.add_argument("--slab-E", type=float, dest="slab_E",
+                      help="the slab's Young's modulus [10³ kg cm⁻¹ s⁻²] (the block's E)")
+    slab.add_argument("--slab-nu", type=float, help="the slab's Poisson's ratio (the block's ν)")
+    slab.add_argument("--slab-thickness", type=float, help="the slab's thickness [cm] (10)")
+    slab.add_argument("--slab-length", type=float, help="the slab's length [cm] (3 L)")
+    slab.add_argument("--slab-density", type=float,
+                      help="the slab's density [10³ kg cm⁻³] (the block's)")
+
+
+#: the flags of :func:`_slab_flags`, which only the scene block-on-slab accepts
+SLAB_FLAGS = ("slab_E", "slab_nu", "slab_thickness", "slab_length", "slab_density")
+
+
+def add_parser(commands: typing.Any) -> None:
+    """``block steady|stability|dynamics``, each for the scene ``--scene``."""
+    family = commands.add_parser(
+        "block", help="the finite element block on a belt: steady sliding, stability, dynamics",
+        description="The elastic block of Martins, Oden & Simões pressed on a moving belt "
+                    "(rigid, or an elastic slab with --scene block-on-slab).")
+    studies = family.add_subparsers(dest="study", required=True, parser_class=Parser,
+                                    metavar="STUDY")
+    shared = _continuation_flags()
+    steady = studies.add_parser(
+        "steady", parents=[shared], help="steady sliding with continuation in μ (Problem 2)",
+        description="Steady sliding solved by Newton (PETSc SNES) at each μ from 0 to --mu-max; "
+                    "PETSc options can be given as -steady_<option> after the flags.")
+    steady.add_argument("--eps-sequence", type=floats, metavar="E1,E2,...",
+                        help="after the continuation, Kalker's sequential ε process at μ-max")
+    steady.add_argument("--snapshots", type=int, default=4, help="deformed shapes to draw")
+    steady.set_defaults(run=run_steady)
+    stability = studies.add_parser(
+        "stability", parents=[shared], help="eigenvalue loci and flutter onset (Problem 3)",
+        description="Quadratic eigenvalues of the linearised steady sliding (SLEPc PEP) at each "
+                    "μ from 0 to --mu-max, FE and rigid model side by side; PETSc/SLEPc options "
+                    "as -stability_<option> after the flags.")
+    stability.add_argument("--max-frequency", type=float, default=3e4,
+                           help="every eigenvalue with |λ| below this [rad/s] is computed")
+    stability.add_argument("--onset-tol", type=float, default=1e-4,
+                           help="width of the μ interval the onset is bisected to")
+    stability.add_argument("--growth-tol", type=float, default=1e-6,
+                           help="a mode grows when Re λ > growth-tol |λ|")
+    stability.set_defaults(run=run_stability)
+    dynamics = studies.add_parser(
+        "dynamics", help="dynamics from a perturbed steady state (Problem 1ε, PETSc TS)",
+        description="Generalized-α (TSALPHA2) integration from the steady sliding state at --mu "
+                    "plus a normal velocity perturbation; TS/SNES options as -dynamics_<option> "
+                    "after the flags (e.g. -dynamics_ts_adapt_type basic).")
+    _scene_flag(dynamics)
+    dynamics.add_argument("--mu", type=float, required=True, help="friction coefficient")
+    dynamics.add_argument("--t-end", type=float, required=True, help="final time [s]")
+    dynamics.add_argument("--dt", type=float, default=1e-5, help="(initial) time step [s]")
+    dynamics.add_argument("--perturbation", type=float, default=-0.01,
+                          help="initial normal velocity added to the steady state [cm/s]")
+    dynamics.add_argument("--stride", type=int, default=20, help="steps between field outputs")
+    dynamics.add_argument("--probe-x", type=float,
+                          help="abscissa [cm] of the contact node whose tractions are recorded "
+                               "(default: L/2, the paper's node 29)")
+    dynamics.add_argument("--scheme", choices=["alpha2", "central"], default="alpha2",
+                          help="implicit generalized-α, or explicit central differences with "
+                               "a lumped mass (dt capped at 0.9 of the stable step)")
+    dynamics.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    for flag, dest, kind, text in (
+            ("--refine", "refine", int, "mesh refinement (1)"),
+            ("--belt-speed", "belt_speed", float, "belt speed [cm/s] (0.287)"),
+            ("--b-n", "b_n", float, "normal damping [10³ kg cm^(-2-l_n) s⁻¹] (0)"),
+            ("--K-x", "K_x", float, "driver spring [10³ kg s⁻²] (11.1)"),
+            ("--B0", "B0", float, "breadth [cm] (30.5)"),
+            ("--eps", "eps", float, "regularisation ε [cm/s] (1e-3)"),
+            ("--regularisation", "regularisation", str, "c1 or smooth (c1)")):
+        dynamics.add_argument(flag, dest=dest, type=kind, help=text)
+    _slab_flags(dynamics)
+    dynamics.set_defaults(run=run_dynamics)
 
 
 def _scene(args: argparse.Namespace, **fixed: typing.Any) -> BlockOnBelt:
     """The scene from the flags that name its fields (unset flags keep its defaults)."""
-    from fenicsfriction.cli.arguments import SLAB_FLAGS
+    from fenicsfriction.cli.common import flag, scene_from_flags
+    from fenicsfriction.laws import check
+    from fenicsfriction.studies.block.slab import SCENES
 
     scene_cls = SCENES[args.scene]
     names = {f.name for f in dataclasses.fields(scene_cls)}
@@ -49,6 +159,12 @@ def _scene(args: argparse.Namespace, **fixed: typing.Any) -> BlockOnBelt:
 
 def _build(args: argparse.Namespace) -> tuple[BlockOnBelt, BlockModel, SteadySolver, np.ndarray]:
     """Validate the shared flags and return (scene, model, steady solver, μ targets)."""
+    from mpi4py import MPI
+
+    import numpy as np
+
+    from fenicsfriction.cli.common import output_folder
+    from fenicsfriction.laws import check
     from fenicsfriction.steady import SteadySolver
 
     check("--mu-max", args.mu_max, np.isfinite(args.mu_max) and args.mu_max >= 0, "must be >= 0")
@@ -64,6 +180,8 @@ def _build(args: argparse.Namespace) -> tuple[BlockOnBelt, BlockModel, SteadySol
 
 def _stopped(failure: str | None, interrupted: Interrupted | None) -> int:
     """The one closing line of a run that did not finish, and its exit status."""
+    from fenicsfriction.cli.common import stop_line
+
     if interrupted is not None:
         stop_line(f"{interrupted}; the results so far are written")
         return interrupted.exit_code
@@ -75,6 +193,13 @@ def _stopped(failure: str | None, interrupted: Interrupted | None) -> int:
 
 def run_steady(args: argparse.Namespace, log: logging.Logger) -> int:
     """Continuation in μ, the optional ε sequence, fields, JSON and figures."""
+    from mpi4py import MPI
+
+    import numpy as np
+
+    from fenicsfriction import io, plotting, results
+    from fenicsfriction.laws import check
+    from fenicsfriction.signals import Interrupted, StopSignals
     from fenicsfriction.steady import ContinuationError, continuation, epsilon_sequence
 
     comm = MPI.COMM_WORLD
@@ -149,6 +274,11 @@ def run_steady(args: argparse.Namespace, log: logging.Logger) -> int:
 
 def run_stability(args: argparse.Namespace, log: logging.Logger) -> int:
     """Loci of the FE block along μ with the onsets, beside the rigid block's."""
+    from mpi4py import MPI
+
+    from fenicsfriction import io, plotting, results
+    from fenicsfriction.laws import check
+    from fenicsfriction.signals import Interrupted, StopSignals
     from fenicsfriction.stability import (
         EigenSolveError,
         Loci,
@@ -226,7 +356,16 @@ def run_stability(args: argparse.Namespace, log: logging.Logger) -> int:
 
 def run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
     """Steady sliding at μ, a normal velocity kick, then the time integration."""
+    from mpi4py import MPI
+
+    import numpy as np
+
+    from fenicsfriction import io, plotting, results
+    from fenicsfriction.cli.common import output_folder
     from fenicsfriction.dynamics import CentralDifference, DynamicsSolver
+    from fenicsfriction.laws import check
+    from fenicsfriction.results import CsvRows
+    from fenicsfriction.signals import Interrupted, StopSignals
     from fenicsfriction.statistics import stick_slip_statistics
     from fenicsfriction.steady import SteadySolver
     from fenicsfriction.timestepping import DynamicsError

@@ -35,17 +35,17 @@ def named_by_flag(message: str, renamed: dict[str, str] | None = None) -> str:
 def scene_from_flags(cls: type, args: argparse.Namespace, **fixed: typing.Any) -> typing.Any:
     """The scene dataclass ``cls`` from the flags that name its fields (unset flags keep its
     defaults), with ``fixed`` fields set by the command."""
-    fields = {f.name: f for f in dataclasses.fields(cls)}
+    fields = {f.name for f in dataclasses.fields(cls)}
     given = {k: v for k, v in vars(args).items() if v is not None}
+    law_changes: dict[str, typing.Any] = {}
     if "law" in fields:  # the interface law's flags (--mu, --eps, ...) change the scene's law
         from fenicsfriction.laws import InterfaceLaw
         law_names = {f.name for f in dataclasses.fields(InterfaceLaw)}
-        changes = {k: v for k, v in {**given, **fixed}.items() if k in law_names}
+        law_changes = {k: v for k, v in {**given, **fixed}.items() if k in law_names}
         fixed = {k: v for k, v in fixed.items() if k not in law_names}
-        if changes:
-            fixed["law"] = fields["law"].default_factory().replace(**changes)  # type: ignore[operator]
-    names = set(fields) - set(fixed)
-    return cls(**fixed, **{k: v for k, v in given.items() if k in names})
+    names = fields - set(fixed)
+    scene = cls(**fixed, **{k: v for k, v in given.items() if k in names})
+    return scene.with_law(**law_changes) if law_changes else scene
 
 
 def output_folder(path: pathlib.Path, comm: MPI.Comm = MPI.COMM_WORLD) -> pathlib.Path:

@@ -18,35 +18,108 @@ import logging
 import pathlib
 import typing
 
-from mpi4py import MPI
-
-import numpy as np
-
-from fenicsfriction import _compat, plotting, results
-from fenicsfriction.cli.common import (
-    flag,
-    output_folder,
-    scene_from_flags,
-    stop_line,
-    write_rows,
-)
-from fenicsfriction.laws import check
+from fenicsfriction.cli.arguments import Parser, floats
 
 if typing.TYPE_CHECKING:
+    from mpi4py import MPI
+
+    import numpy as np
+
     from fenicsfriction.studies.contact.model import TwoBodyModel
 
-__all__ = ["run_contact"]
+__all__ = ["add_parser", "run_contact"]
 
 #: the logger of the model, whose debug line reports each solve of the load's approach
 _MODEL_LOGGER = "fenicsfriction.studies.contact.model"
 
-#: half-widths of the window of deformed.png around the contact, in contact half-widths
-_WINDOW = (2.5, 1.2)
+
+def _bodies_flags() -> argparse.ArgumentParser:
+    """The two bodies and their interface law, shared by the contact scenes (None: the scene's
+    defaults, given in the help)."""
+    flags = Parser(add_help=False)
+    group = flags.add_argument_group("the two bodies and the interface law")
+    for flag, text in (("--E1", "body 1's Young's modulus (1)"),
+                       ("--nu1", "body 1's Poisson's ratio (0.3)"),
+                       ("--E2", "body 2's Young's modulus (1)"),
+                       ("--nu2", "body 2's Poisson's ratio (0.3)"),
+                       ("--c-n", "normal compliance coefficient: p = c_n d^m_n (1e4)"),
+                       ("--m-n", "normal compliance exponent, >= 1 (1: a linear penalty)")):
+        group.add_argument(flag, type=float, dest=flag[2:].replace("-", "_"), help=text)
+    flags.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    return flags
+
+
+def _hertz_flags(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--load", type=float,
+                        help="P per unit length (2D) or the total force F (3D); default: the "
+                             "load giving a = R/10")
+    parser.add_argument("--radius", type=float, help="R of the cylinder or sphere (1)")
+    parser.add_argument("--refine", type=int,
+                        help="mesh refinement level: each halves the element size (0: 0.005 R "
+                             "at the contact)")
+
+
+def add_parser(commands: typing.Any) -> None:
+    """``contact hertz|patch|cattaneo``: the two-body validation scenes."""
+    contact = commands.add_parser(
+        "contact", help="two elastic bodies in node-to-segment contact, against closed forms",
+        description="Validation scenes of two-body contact: Hertz (2D cylinder, 3D sphere), "
+                    "the contact patch test and Cattaneo-Mindlin's partial slip; each writes "
+                    "contact.json, surface.csv, figures and bodies.xdmf to --out. PETSc "
+                    "options as -contact_<option> after the flags.")
+    contact.set_defaults(run=run_contact)
+    scenes = contact.add_subparsers(dest="scene", required=True, parser_class=Parser,
+                                    metavar="STUDY")
+    bodies = _bodies_flags()
+    hertz = scenes.add_parser(
+        "hertz", parents=[bodies], help="cylinder (2D) or sphere (3D) on a block, vs Hertz",
+        description="A cylinder (plane strain) or a quarter sphere pressed on an elastic "
+                    "block to the load --load: contact half-width (radius) and peak pressure "
+                    "against Hertz's.")
+    hertz.add_argument("--dim", type=int, choices=[2, 3], default=2, help="2 or 3 (2)")
+    _hertz_flags(hertz)
+    hertz.add_argument("--passes", type=int, choices=[1, 2], default=1,
+                       help="1: the cylinder's surface is the slave; 2: each surface in turn")
+    patch = scenes.add_parser(
+        "patch", parents=[bodies], help="the contact patch test (non-matching meshes)",
+        description="Two stacked blocks with non-matching meshes under a uniform pressure "
+                    "must transmit it uniformly (Taylor & Papadopoulos 1991).")
+    patch.add_argument("--dim", type=int, choices=[2, 3], default=2, help="2 or 3 (2)")
+    patch.add_argument("--passes", choices=["1", "2", "both"], default="both",
+                       help="one pass, two passes, or both side by side (both)")
+    patch.add_argument("--pressure", type=float, help="the pressure applied (0.01)")
+    patch.add_argument("--n-upper", type=int, help="elements across the upper block (5)")
+    patch.add_argument("--n-lower", type=int, help="elements across the lower block (7)")
+    cattaneo = scenes.add_parser(
+        "cattaneo", parents=[bodies], help="partial slip under a tangential force (2D)",
+        description="The 2D Hertz cylinder with friction, then a tangential force rising to "
+                    "Q = q μP in increments (Pop's incremental formulation): stick zone "
+                    "and tangential traction against Cattaneo (1938) and Mindlin (1949).")
+    _hertz_flags(cattaneo)
+    cattaneo.add_argument("--passes", type=int, choices=[1, 2], default=1,
+                          help="1: the cylinder's surface is the slave; 2: each in turn")
+    cattaneo.add_argument("--mu", type=float, help="friction coefficient (0.3)")
+    cattaneo.add_argument("--q-ratio", type=float, help="Q/(μP) reached, in [0, 1) (0.5)")
+    cattaneo.add_argument("--increments", type=int, help="increments of Q (10)")
+    cattaneo.add_argument("--eps", type=float,
+                          help="regularisation of the slip increment [length] (1e-6)")
+    cattaneo.add_argument("--eps-sequence", type=floats, metavar="E1,E2,...",
+                          help="Kalker's sequential process: the tangential loading again for "
+                               "each ε (replaces --eps)")
+    cattaneo.add_argument("--formulation", choices=["compliance", "perturbed-lagrangian"],
+                          help="the contact law: normal compliance with regularised friction, "
+                               "or Pop's perturbed Lagrangian (penalties c_n and --penalty-T) "
+                               "(compliance)")
+    cattaneo.add_argument("--penalty-T", dest="penalty_T", type=float,
+                          help="tangential penalty of the perturbed Lagrangian "
+                               "[force/length^3] (1e4)")
 
 
 def _named_by_flag(message: str, args: argparse.Namespace) -> str:
     """A scene's or mesh's ``name=value is invalid: ...`` with ``name`` replaced by its flag,
     when the user gave that flag."""
+    from fenicsfriction.cli.common import flag
+
     given = [k for k, v in vars(args).items() if v is not None]
     for name in sorted(given, key=len, reverse=True):
         if message.startswith(f"{name}="):
@@ -77,6 +150,8 @@ def _write_fields(path: pathlib.Path, model: TwoBodyModel) -> None:
     (collective)."""
     from dolfinx import io
 
+    from fenicsfriction import _compat
+
     geometry = model.geometry
     msh = geometry.mesh
     msh.topology.create_connectivity(msh.topology.dim - 1, msh.topology.dim)
@@ -87,32 +162,6 @@ def _write_fields(path: pathlib.Path, model: TwoBodyModel) -> None:
         _compat.write_meshtags(xdmf, geometry.cell_tags, msh)
         _compat.write_meshtags(xdmf, geometry.facet_tags, msh)
         xdmf.write_function(model.u, 0.0)
-
-
-def _deformed(model: TwoBodyModel, path: pathlib.Path, half_width: float | None,
-              title: str, marks: typing.Sequence[float] = ()) -> None:
-    """deformed.png of a 2D model: around the contact zone at true scale (``half_width``
-    given: Hertz, Cattaneo) or the whole bodies magnified (the patch test)."""
-    if model.dim != 2:
-        return
-    if half_width is not None:
-        w, h = _WINDOW
-        window = (-w * half_width, w * half_width, -h * half_width, h * half_width)
-        cells = plotting.body_cells(model.u, model.geometry.cell_tags, window)
-        scale = 1.0
-    else:
-        cells = plotting.body_cells(model.u, model.geometry.cell_tags)
-        scale = 1.0
-        if cells is not None:
-            corners = cells[0].reshape(-1, 2)
-            extent = np.ptp(corners, axis=0)
-            window = (corners[:, 0].min() - 0.1 * extent[0], corners[:, 0].max() + 0.1 * extent[0],
-                      corners[:, 1].min() - 0.1 * extent[1], corners[:, 1].max() + 0.1 * extent[1])
-            amplitude = np.abs(cells[1]).max()
-            scale = 0.1 * extent[1] / amplitude if amplitude > 0 else 1.0
-            title += f" (displacements ×{scale:.3g})"
-    if cells is not None:
-        plotting.plot_contact_deformed(cells, path, window, scale, title, marks)
 
 
 def _surface_rows(values: typing.Any, columns: dict[str, np.ndarray], dim: int,
@@ -132,48 +181,23 @@ def _hertz_outputs(scene: typing.Any, summary: dict, model: TwoBodyModel, out: p
                    comm: MPI.Comm, log: logging.Logger,
                    tractions: typing.Sequence[tuple[np.ndarray, str]] = ()) -> None:
     """surface.csv, pressure.png, deformed.png (2D), traction.png (Cattaneo), bodies.xdmf."""
-    from fenicsfriction.studies.contact import closed_forms
+    from fenicsfriction.cli.common import write_rows
+    from fenicsfriction.studies.contact import figures
+    from fenicsfriction.studies.contact.validation import surface_comparison
 
-    a, p0 = scene.closed_form()
+    a, _ = scene.closed_form()
     values = model.surface_values()
     dim = model.dim
-    r = values.x[:, 0] if dim == 2 else np.linalg.norm(values.x[:, :2], axis=1)
-    # the tangential traction on the block (the slave's, body 1's, reversed): along Q
-    on_block = -values.traction + 0.0
-    columns = {"pressure": values.pressure, "hertz_pressure": closed_forms.hertz_pressure(r, a, p0),
-               "gap": values.gap}
-    if dim == 2:
-        columns["traction"] = on_block[:, 0]
-    else:
-        columns = {"r": r, **columns, "traction_x": on_block[:, 0], "traction_y": on_block[:, 1]}
+    r, columns = surface_comparison(scene, values)
     cattaneo = summary["scene"] == "cattaneo"
-    if cattaneo:
-        columns["cattaneo_traction"] = closed_forms.cattaneo_traction(r, a, p0, scene.law.mu,
-                                                                      scene.q_ratio)
     write_rows(out / "surface.csv", _surface_rows(values, columns, dim), comm)
-    width = "half_width" if dim == 2 else "contact_radius"
     if comm.rank == 0:
-        grid = np.linspace(-1.5 * a, 1.5 * a, 601) if dim == 2 else np.linspace(0, 1.5 * a, 301)
-        near = np.abs(r) <= 1.5 * a
-        plotting.plot_contact_pressure(
-            [(r[near], values.pressure[near], "computed (slave nodes)")], out / "pressure.png",
-            "x" if dim == 2 else "r = √(x² + y²)",
-            f"{summary['scene']} {dim}D: {width.replace('_', ' ')} {summary[width]:.4g} "
-            f"(Hertz {a:.4g}), peak {summary['max_pressure']:.4g} (Hertz {p0:.4g})",
-            reference=(grid, closed_forms.hertz_pressure(grid, a, p0), "Hertz"),
-            marks=(-a, a) if dim == 2 else (a,))
+        figures.pressure_figure(scene, summary, values, r, out / "pressure.png")
         if cattaneo:
-            c = closed_forms.cattaneo_stick_half_width(a, scene.q_ratio)
-            plotting.plot_contact_traction(
-                values.x[:, 0], tractions, scene.law.mu * values.pressure, grid,
-                closed_forms.cattaneo_traction(grid, a, p0, scene.law.mu, scene.q_ratio),
-                scene.law.mu * closed_forms.hertz_pressure(grid, a, p0), a, c,
-                out / "traction.png",
-                f"Q = {scene.q_ratio:g} μP, μ = {scene.law.mu:g}: stick half-width "
-                f"{summary['stick_half_width']:.4g} (Cattaneo-Mindlin {c:.4g})")
-    _deformed(model, out / "deformed.png", a if dim == 2 else None,
-              f"{summary['scene']}: the contact region, displacements at true scale",
-              marks=(-a, a))
+            figures.traction_figure(scene, summary, values, tractions, out / "traction.png")
+    figures.deformed_figure(model, out / "deformed.png", a if dim == 2 else None,
+                            f"{summary['scene']}: the contact region, displacements at true "
+                            "scale", marks=(-a, a))
     _write_fields(out / "bodies.xdmf", model)
     comm.Barrier()
     log.info(f"results in {out}/: contact.json, surface.csv, pressure.png"
@@ -182,6 +206,8 @@ def _hertz_outputs(scene: typing.Any, summary: dict, model: TwoBodyModel, out: p
 
 
 def _run_hertz(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
+    from fenicsfriction import results
+    from fenicsfriction.cli.common import output_folder, scene_from_flags
     from fenicsfriction.studies.contact.validation import Hertz
 
     scene = scene_from_flags(Hertz, args)
@@ -208,6 +234,11 @@ def _run_hertz(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) ->
 
 
 def _run_cattaneo(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
+    import numpy as np
+
+    from fenicsfriction import results
+    from fenicsfriction.cli.common import output_folder, scene_from_flags
+    from fenicsfriction.laws import check
     from fenicsfriction.studies.contact.validation import Cattaneo
 
     sequence = args.eps_sequence
@@ -261,6 +292,11 @@ def _run_cattaneo(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm)
 
 
 def _run_patch(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
+    import numpy as np
+
+    from fenicsfriction import results
+    from fenicsfriction.cli.common import output_folder, scene_from_flags, write_rows
+    from fenicsfriction.studies.contact import figures
     from fenicsfriction.studies.contact.validation import Patch
 
     pairings = {"1": {"one_pass": 1}, "2": {"two_pass": 2},
@@ -299,14 +335,11 @@ def _run_patch(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) ->
     # the two-pass solution (the one that passes the test) when both were run
     name, model = list(models.items())[-1]
     if comm.rank == 0:
-        x = np.array([c[0].min() for c in curves] + [c[0].max() for c in curves])
-        deviations = ", ".join(f"{n.replace('_', ' ')} {s['pressure_deviation']:.2e}"
-                               for n, s in summaries.items())
-        plotting.plot_contact_pressure(
-            curves, out / "pressure.png", "x", f"patch test {first['dim']}D: largest deviation "
-            f"{deviations}", reference=(np.array([x.min(), x.max()]),
-                                       np.full(2, scenes[name].pressure), "applied"))
-    _deformed(model, out / "deformed.png", None, f"patch test, {name.replace('_', ' ')}")
+        figures.patch_pressure_figure(
+            curves, {n: s["pressure_deviation"] for n, s in summaries.items()}, first["dim"],
+            scenes[name].pressure, out / "pressure.png")
+    figures.deformed_figure(model, out / "deformed.png", None,
+                            f"patch test, {name.replace('_', ' ')}")
     for other, m in models.items():
         _write_fields(out / ("bodies.xdmf" if other == name
                              else f"bodies-{other.replace('_', '-')}.xdmf"), m)
@@ -320,6 +353,9 @@ def _run_patch(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) ->
 def _failed(out: pathlib.Path, name: str, scene: typing.Any, err: Exception,
             comm: MPI.Comm) -> int:
     """A solver failure: contact.json saying so, one line, exit status 1."""
+    from fenicsfriction import results
+    from fenicsfriction.cli.common import stop_line
+
     results.write_summary(out / "contact.json", {
         "scene": name, "parameters": dataclasses.asdict(scene), "failure": str(err)}, comm)
     stop_line(f"{name}: {err}", comm)
@@ -328,6 +364,8 @@ def _failed(out: pathlib.Path, name: str, scene: typing.Any, err: Exception,
 
 def run_contact(args: argparse.Namespace, log: logging.Logger) -> int:
     """``contact hertz|patch|cattaneo``: the scene, its summary and its outputs."""
+    from mpi4py import MPI
+
     run = {"hertz": _run_hertz, "patch": _run_patch, "cattaneo": _run_cattaneo}[args.scene]
     try:
         return run(args, log, MPI.COMM_WORLD)

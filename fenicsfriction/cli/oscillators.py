@@ -1,11 +1,11 @@
-"""``fenicsfriction stability-map mdof`` and ``fenicsfriction oscillator mdof|belt``: the reduced
-friction oscillators (the m.d.o.f. slider with oscillatory normal forces, "Friction-induced
-sliding instability in a multi-degree-of-freedom system with oscillatory normal forces" (2003),
-and the 1-d.o.f. oscillator on a belt).
+"""``fenicsfriction oscillators slider-map|slider|belt``: the reduced friction oscillators (the
+m.d.o.f. slider with oscillatory normal forces, "Friction-induced sliding instability in a
+multi-degree-of-freedom system with oscillatory normal forces" (2003), and the 1-d.o.f.
+oscillator on a belt).
 
 Both time series are written row by row as the integration samples them; a signal stops the run
 at the next sample, a failure of the integration where it failed, with what was computed kept
-(see :mod:`fenicsfriction.signals`).
+(see :mod:`fenicsfriction.signals`). MPI and PETSc are imported inside the run functions.
 """
 
 from __future__ import annotations
@@ -13,24 +13,104 @@ from __future__ import annotations
 import argparse
 import functools
 import logging
+import pathlib
 import time
 import typing
 
-from mpi4py import MPI
+from fenicsfriction.cli.arguments import LazyChoices, Parser, omega_range
 
-import numpy as np
+if typing.TYPE_CHECKING:
+    import numpy as np
 
-from fenicsfriction import laws, plotting, results
-from fenicsfriction.cli.common import output_folder, stop_line
-from fenicsfriction.laws import check
-from fenicsfriction.results import CsvRows
-from fenicsfriction.signals import Interrupted, StopSignals
+    from fenicsfriction.results import CsvRows
 
-__all__ = ["run_oscillator", "run_stability_map"]
+__all__ = ["add_parser", "run_oscillator", "run_stability_map"]
+
+
+def add_parser(commands: typing.Any) -> None:
+    """``oscillators slider-map|slider|belt``."""
+    family = commands.add_parser(
+        "oscillators", help="reduced friction oscillators: the m.d.o.f. slider, the belt",
+        description="The m.d.o.f. slider under oscillatory normal forces (its stability map "
+                    "and its stick-slip response) and the 1-d.o.f. oscillator on a belt.")
+    studies = family.add_subparsers(dest="study", required=True, parser_class=Parser,
+                                    metavar="STUDY")
+    readings = {"choices": LazyChoices("fenicsfriction.studies.oscillators.slider.table2",
+                                       "TABLE2_READINGS"),
+                "default": "paper",
+                "metavar": "READING",
+                "help": "reading of the paper's dimensionless Table 2 model: %(choices)s "
+                        "(default: %(default)s)"}
+    smap = studies.add_parser(
+        "slider-map", help="stability of steady sliding vs forcing frequency (m.d.o.f. slider)",
+        description="Growth rate of perturbations of steady sliding of the Table 2 slider by "
+                    "first-order averaging and by Floquet multipliers (PETSc TS), with the "
+                    "unstable bands.")
+    smap.add_argument("--omega-range", type=omega_range, required=True, metavar="LO:HI")
+    smap.add_argument("--samples", type=int, default=101, help="forcing frequencies sampled")
+    smap.add_argument("--methods", default="averaging,floquet",
+                      help="comma-separated: averaging, floquet")
+    smap.add_argument("--reading", **readings)
+    smap.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    smap.set_defaults(run=run_stability_map)
+    time_response = Parser(add_help=False)
+    time_response.add_argument("--t-end", type=float, default=100.0,
+                               help="final (dimensionless) time")
+    time_response.add_argument("--eps", type=float,
+                               help="regularised law of this width (no events)")
+    time_response.add_argument("--rtol", type=float, default=1e-8,
+                               help="relative tolerance of the steps")
+    time_response.add_argument("--sample-dt", type=float, default=0.01,
+                               help="output sampling step")
+    time_response.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    mdof = studies.add_parser(
+        "slider", parents=[time_response],
+        help="stick-slip time response of the m.d.o.f. slider (Table 2)",
+        description="Integrates the m.d.o.f. slider with stick and slip switched at events "
+                    "located by PETSc TS (or a regularised law with --eps); TS options as "
+                    "-hybrid_<option>.")
+    mdof.add_argument("--omega", type=float, default=30.78, help="forcing frequency ω_o")
+    mdof.add_argument("--reading", **readings)
+    mdof.add_argument("--normal-force", choices=["signed", "absolute", "clipped"],
+                      default="signed", help="how N enters friction (signed, as eq. 21)")
+    mdof.add_argument("--coupled", action="store_true",
+                      help="the roughness under a contact follows its tangential motion")
+    mdof.add_argument("--perturbation", type=float, default=0.01,
+                      help="initial slider velocity added to steady sliding")
+    mdof.set_defaults(run=run_oscillator, scene="mdof")
+    belt = studies.add_parser(
+        "belt", parents=[time_response],
+        help="stick-slip time response of the 1-d.o.f. oscillator on a belt",
+        description="Integrates m ẍ + c ẋ + k x = μ(v_b − ẋ) N with stick and slip switched at "
+                    "events located by PETSc TS (or a regularised law with --eps); TS options "
+                    "as -belt_<option>.")
+    for flag, default, text in (("--m", 1.0, "mass"), ("--k", 1.0, "stiffness"),
+                                ("--c", 0.0, "damping"), ("--N", 1.0, "normal force"),
+                                ("--v-belt", 0.5, "belt speed"),
+                                ("--mu-s", 0.6, "static coefficient"),
+                                ("--mu-k", 0.3, "kinetic coefficient (constant, stribeck)"),
+                                ("--slope", 0.03, "dμ/d|v| (piecewise)"),
+                                ("--v-c", 15.0, "end of the slope (piecewise)"),
+                                ("--v-s", 0.5, "Stribeck speed (stribeck)")):
+        belt.add_argument(flag, type=float, default=default, help=f"{text} ({default})")
+    belt.add_argument("--law", choices=["constant", "piecewise", "stribeck"],
+                      default="constant", help="μ(v) while slipping (constant: μ_k, with μ_s "
+                                               "for stick)")
+    belt.add_argument("--x0", type=float, default=0.0, help="initial displacement (0)")
+    belt.add_argument("--v0", type=float,
+                      help="initial velocity (the belt's: the mass starts stuck to the belt)")
+    belt.set_defaults(run=run_oscillator, scene="belt")
 
 
 def run_stability_map(args: argparse.Namespace, log: logging.Logger) -> int:
     """Averaging and Floquet growth rates over a range of forcing frequencies, with bands."""
+    from mpi4py import MPI
+
+    import numpy as np
+
+    from fenicsfriction import plotting, results
+    from fenicsfriction.cli.common import output_folder
+    from fenicsfriction.laws import check
     from fenicsfriction.studies.oscillators.slider import (
         TABLE2_PAPER_BANDS,
         stability_map,
@@ -74,6 +154,9 @@ def _belt(args: argparse.Namespace, table: CsvRows,
     Returns:
         (summary, what to plot).
     """
+    import numpy as np
+
+    from fenicsfriction import laws
     from fenicsfriction.statistics import belt_summary
     from fenicsfriction.studies.oscillators import BeltOscillator
     from fenicsfriction.studies.oscillators.belt import STICK
@@ -130,6 +213,8 @@ def _slider(args: argparse.Namespace, table: CsvRows,
         (summary, what to plot, the failure of the integration or None). A run the
         integration could not finish is summarised up to where it stopped.
     """
+    import numpy as np
+
     from fenicsfriction.events import HybridError, integrate_hybrid
     from fenicsfriction.statistics import mode_intervals
     from fenicsfriction.studies.oscillators.slider import SliderMotion, table2_slider
@@ -183,12 +268,20 @@ def run_oscillator(args: argparse.Namespace, log: logging.Logger) -> int:
     (status 130/143) and a failure of the integration where it failed (status 1); either way
     ``summary.json`` says where and why, the rows stay on disk and one line is printed.
     """
+    from mpi4py import MPI
+
+    from fenicsfriction import plotting, results
+    from fenicsfriction.cli.common import output_folder, stop_line
+    from fenicsfriction.laws import check
+    from fenicsfriction.results import CsvRows
+    from fenicsfriction.signals import Interrupted, StopSignals
     from fenicsfriction.timestepping import DynamicsError
 
     check("--t-end", args.t_end, args.t_end > 0, "must be > 0")
     check("--sample-dt", args.sample_dt, 0 < args.sample_dt <= args.t_end,
           "must lie in (0, t-end]")
-    check("--omega", args.omega, args.omega > 0, "must be > 0")
+    if args.scene == "mdof":
+        check("--omega", args.omega, args.omega > 0, "must be > 0")
     out = output_folder(args.out)
     comm = MPI.COMM_WORLD
     next_report = [0.0]

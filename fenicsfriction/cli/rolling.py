@@ -6,7 +6,8 @@ Each command writes to ``--out``: ``rolling.json`` (one record, or one per point
 ``method``, ``parameters``, ``wall_time_s``), ``traction.png`` (the traction against its bound
 with the adhesion area), ``creep_curve.png`` (curves: the methods side by side with Kalker's
 linear theory) and, for the finite elements, ``rolling.xdmf`` (the displacement and the surface
-traction). Every point of a curve prints one progress line.
+traction). Every point of a curve prints one progress line. The figures are
+:mod:`fenicsfriction.studies.rolling.figures`.
 """
 
 from __future__ import annotations
@@ -16,15 +17,78 @@ import logging
 import pathlib
 import typing
 
-from mpi4py import MPI
+from fenicsfriction.cli.arguments import Parser, creep_range, floats
 
-import numpy as np
+if typing.TYPE_CHECKING:
+    from mpi4py import MPI
 
-from fenicsfriction import plotting, results
-from fenicsfriction.cli.common import flag, named_by_flag, output_folder, stop_line
-from fenicsfriction.laws import check
+__all__ = ["add_parser", "run_rolling"]
 
-__all__ = ["run_rolling"]
+
+def _rolling_flags() -> argparse.ArgumentParser:
+    """The Hertzian contact, the creepages and the methods' discretisations, shared by the
+    rolling commands (None: the defaults given in the help)."""
+    flags = Parser(add_help=False)
+    contact = flags.add_argument_group("the contact (any consistent units)")
+    for flag, text in (("--a", "semi-axis along the rolling direction x [length]"),
+                       ("--b", "lateral semi-axis [length] (3D; default: a, a circle)"),
+                       ("--G", "shear modulus of the (quasi-identical) bodies [force/length²]"),
+                       ("--nu", "Poisson's ratio, in [0, 0.5]"),
+                       ("--mu", "friction coefficient"),
+                       ("--Fn", "normal force [force] (2D: per unit length)")):
+        contact.add_argument(flag, type=float, dest=flag[2:], required=flag not in ("--b",),
+                             help=text)
+    creep = flags.add_argument_group("creepages (rigid slip over rolling distance)")
+    creep.add_argument("--eta", type=float, default=0.0, help="lateral creepage η (0)")
+    creep.add_argument("--phi", type=float, default=0.0, help="spin φ [1/length] (0)")
+    fastsim = flags.add_argument_group("fastsim (Kalker's simplified theory)")
+    fastsim.add_argument("--nx", type=int, help="elements per strip along x")
+    fastsim.add_argument("--ny", type=int, help="strips across the contact")
+    fastsim.add_argument("--pressure", choices=["ellipsoidal", "parabolic"],
+                         help="the traction bound's pressure profile")
+    fe = flags.add_argument_group("fe (Kalker's complete theory by finite elements)")
+    fe.add_argument("--dim", type=int, choices=[2, 3], default=3,
+                    help="2: Carter's cylinders (plane strain); 3: the Hertzian ellipse (3)")
+    fe.add_argument("--cells-per-a", type=int,
+                    help="cells over the semi-axis a in the contact zone (8)")
+    fe.add_argument("--block-size", type=float,
+                    help="the half-space block's half-width and depth over a (20)")
+    fe.add_argument("--normal", choices=["hertz", "contact"], dest="normal",
+                    help="2D: Hertz's pressure, or a frictionless contact against a rigid "
+                         "parabola (hertz)")
+    fe.add_argument("--eps-sequence", type=floats, metavar="E1,E2,...",
+                    help="Kalker's sequential process: the regularisation ε of the slip, "
+                         "relative to the creepage, decreasing, each solve from the previous "
+                         "one (10 down to 0.01 in steps of √10)")
+    flags.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    return flags
+
+
+def add_parser(commands: typing.Any) -> None:
+    """``rolling fastsim|fe|curve``: Kalker's steady rolling of a Hertzian contact."""
+    rolling = commands.add_parser(
+        "rolling", help="steady rolling contact: creep forces by Kalker's theories",
+        description="Steady rolling of two quasi-identical elastic bodies with a Hertzian "
+                    "contact: the creep forces, the traction and the adhesion area by the "
+                    "simplified theory (FASTSIM) or by the complete theory (finite elements, "
+                    "the sequential ε process). Each writes rolling.json, figures and (fe) "
+                    "rolling.xdmf to --out; PETSc options as -rolling_<option> after the flags.")
+    rolling.set_defaults(run=run_rolling)
+    methods = rolling.add_subparsers(dest="method", required=True, parser_class=Parser,
+                                     metavar="STUDY")
+    flags = _rolling_flags()
+    for name, text in (("fastsim", "Kalker's FASTSIM (no mesh): one creepage"),
+                       ("fe", "the complete theory by finite elements: one creepage")):
+        one = methods.add_parser(name, parents=[flags], help=text, description=text + ".")
+        one.add_argument("--xi", type=float, default=0.0, help="longitudinal creepage ξ (0)")
+    curve = methods.add_parser(
+        "curve", parents=[flags], help="the creep-force curve over a range of ξ",
+        description="The creep-force curve Fx(ξ) by one method, beside FASTSIM and Kalker's "
+                    "linear theory; one rolling.json record per point.")
+    curve.add_argument("--method", choices=["fastsim", "fe"], dest="curve_method",
+                       default="fastsim", help="the theory computing the curve (fastsim)")
+    curve.add_argument("--xi-range", type=creep_range, required=True, metavar="LO:HI:N",
+                       help="N longitudinal creepages from LO to HI")
 
 
 #: the flags of each method's discretisation
@@ -59,6 +123,8 @@ def _fastsim_records(p: dict, args: argparse.Namespace,
                      xi: typing.Sequence[float]) -> tuple[list, list]:
     """(records, FASTSIM results) of the parameters ``p`` at the creepages ``xi`` (with the
     flags' η and φ)."""
+    import numpy as np
+
     from fenicsfriction.studies.rolling.fastsim import creep_curve
 
     grid = {k: p[k] for k in _METHOD_FLAGS["fastsim"] if k in p}
@@ -69,24 +135,7 @@ def _fastsim_records(p: dict, args: argparse.Namespace,
     return records, points
 
 
-def _fastsim_traction(result: typing.Any, p: dict, path: pathlib.Path) -> None:
-    plotting.plot_rolling_traction_map(
-        result.x.ravel(), result.y.ravel(), result.px.ravel(), result.py.ravel(),
-        p["mu"] * result.pn.ravel(), result.adhesion.ravel(), p["a"], p["b"], path,
-        f"FASTSIM: ξ = {result.xi:.4g}, η = {result.eta:.4g}, φ = {result.phi:.4g};\n"
-        f"Fx/(μFn) = {result.Fx / (p['mu'] * result.Fn):.4f}, adhesion "
-        f"{result.adhesion_fraction:.1%} of the area")
-
-
 # --- the finite element complete theory -------------------------------------------------------
-
-def _cylinders(p: dict) -> tuple[float, float]:
-    """Hertz's peak pressure p0 and the relative radius R of Carter's cylinders (2D)."""
-    from fenicsfriction.studies.rolling import RollingContact
-
-    scene = RollingContact(dim=2, a=p["a"], G=p["G"], nu=p["nu"], Fn=p["Fn"])
-    return scene.peak_pressure, scene.radius
-
 
 def _fe_model(p: dict, comm: MPI.Comm) -> typing.Any:
     """The finite element model of the parameters ``p`` (built once, re-solved per creepage)."""
@@ -117,69 +166,21 @@ def _fe_records(model: typing.Any, p: dict, args: argparse.Namespace,
     return records, solutions
 
 
-def _fe_traction(result: typing.Any, p: dict, dim: int, path: pathlib.Path) -> None:
-    """traction.png of a finite element solution: the line contact against Carter (2D), the
-    elliptic map (3D)."""
-    xi = result.creepage[0]
-    title = (f"complete theory (FE): ξ = {xi:.4g}; Fx/(μFn) = "
-             f"{result.Fx / (p['mu'] * result.Fn):.4f}, adhesion {result.adhesion_fraction:.1%}")
-    bound = p["mu"] * result.pressure
-    if dim == 2:
-        from fenicsfriction.studies.rolling import closed_forms
-        p0, radius = _cylinders(p)
-        grid = np.linspace(-p["a"], p["a"], 401)
-        exact = (grid, closed_forms.carter_traction(grid, xi, p["mu"], p["a"], p0, radius),
-                 "Carter (1926)")
-        plotting.plot_rolling_traction_line(result.x[:, 0], result.traction[:, 0], bound,
-                                            result.stick(), path, title, exact)
-    else:
-        plotting.plot_rolling_traction_map(
-            result.x[:, 0], result.x[:, 1], result.traction[:, 0], result.traction[:, 1], bound,
-            result.stick(), p["a"], p["b"], path, title.replace("; ", ";\n"))
-
-
 # --- outputs ------------------------------------------------------------------------------------
 
-def _creep_curve_png(records: list[dict], p: dict, args: argparse.Namespace,
-                     path: pathlib.Path) -> None:
-    """Fx/(μFn) against ξ: the records' method, FASTSIM beside it (cheap), Kalker's linear
-    theory (3D) or Carter's closed form (2D)."""
-    xi = np.array([r["creepage"]["xi"] for r in records])
-    scale = p["mu"] * p["Fn"]
-    fine = np.linspace(min(xi.min(), 0.0), xi.max(), 200)
-    method = records[0]["method"]
-    curves = [(xi, np.array([r["Fx"] for r in records]) / scale,
-               "FASTSIM" if method == "fastsim" else "finite elements (complete theory)",
-               "o-" if method == "fastsim" else "s")]
-    if method == "fastsim" or p["dim"] == 3:
-        from fenicsfriction.studies.rolling.fastsim import creep_curve, linear_theory
-        if method != "fastsim":
-            others = creep_curve(p["a"], p["b"], p["G"], p["nu"], p["mu"], p["Fn"], xi=fine,
-                                 eta=np.full(len(fine), args.eta),
-                                 phi=np.full(len(fine), args.phi))
-            curves.append((fine, np.array([r.Fx for r in others]) / scale, "FASTSIM", "-"))
-        slope = linear_theory(p["a"], p["b"], p["G"], p["nu"], xi=1.0).Fx
-        if args.eta == 0 and args.phi == 0:
-            linear = np.clip(slope * fine / scale, -1.0, 1.0)
-            curves.append((fine, linear, "Kalker's linear theory (C11), clipped at μFn", "k:"))
-    else:
-        from fenicsfriction.studies.rolling.closed_forms import carter_force
-        p0, radius = _cylinders(p)
-        curves.append((fine, np.array([carter_force(x, p["mu"], p["a"], p0, radius)
-                                       for x in fine]) / scale, "Carter (1926)", "k-"))
-    plotting.plot_creep_curves(
-        curves, path, "longitudinal creepage ξ", "Fx / (μ Fn)",
-        f"creep-force curve: a = {p['a']:.4g}"
-        + (f", b = {p['b']:.4g}" if "b" in p else " (line contact)") + f", ν = {p['nu']:g}, "
-        f"μ = {p['mu']:g}, η = {args.eta:g}, φ = {args.phi:g}")
-
-
 def _write(out: pathlib.Path, records: list[dict], curve: bool, comm: MPI.Comm) -> None:
+    from fenicsfriction import results
+
     data: typing.Any = {"records": records} if curve else records[0]
     results.write_summary(out / "rolling.json", data, comm)
 
 
 def _validate(args: argparse.Namespace) -> None:
+    import numpy as np
+
+    from fenicsfriction.cli.common import flag
+    from fenicsfriction.laws import check
+
     for name in ("a", "G", "Fn"):
         check(flag(name), getattr(args, name), np.isfinite(getattr(args, name))
               and getattr(args, name) > 0, "must be a finite number > 0")
@@ -190,12 +191,14 @@ def _validate(args: argparse.Namespace) -> None:
 
 
 #: the scenes' and models' parameter names whose flag is not ``--name``
-_FLAGS = {"eps": "--eps-sequence", "pressure": "--normal", "xi": "--xi", "eta": "--eta",
+_FLAGS = {"pressure": "--normal", "xi": "--xi", "eta": "--eta",
           "phi": "--phi"}
 
 
 def run_rolling(args: argparse.Namespace, log: logging.Logger) -> int:
     """``rolling fastsim|fe|curve``: the creep forces, the traction, the outputs."""
+    from fenicsfriction.cli.common import named_by_flag
+
     try:
         return _run(args, log)
     except ValueError as err:  # the models name their parameters: name the flags
@@ -203,6 +206,12 @@ def run_rolling(args: argparse.Namespace, log: logging.Logger) -> int:
 
 
 def _run(args: argparse.Namespace, log: logging.Logger) -> int:
+    from mpi4py import MPI
+
+    from fenicsfriction import results
+    from fenicsfriction.cli.common import output_folder, stop_line
+    from fenicsfriction.studies.rolling import figures
+
     comm = MPI.COMM_WORLD
     _validate(args)
     curve = args.method == "curve"
@@ -213,7 +222,7 @@ def _run(args: argparse.Namespace, log: logging.Logger) -> int:
     if method == "fastsim":
         records, points = _fastsim_records(p, args, xi)
         if comm.rank == 0:
-            _fastsim_traction(points[-1], p, out / "traction.png")
+            figures.fastsim_traction_figure(points[-1], p, out / "traction.png")
         for r in records:
             log.info(f"ξ = {r['creepage']['xi']:.4g}  Fx = {r['Fx']:.6g}  Fy = {r['Fy']:.6g}  "
                      f"Fx/(μFn) = {r['Fx'] / (r['mu'] * r['Fn']):+.5f}  adhesion "
@@ -232,12 +241,12 @@ def _run(args: argparse.Namespace, log: logging.Logger) -> int:
         from fenicsfriction.studies.rolling import write_xdmf
         write_xdmf(out / "rolling.xdmf", model)
         if comm.rank == 0:
-            _fe_traction(solutions[-1], p, model.dim, out / "traction.png")
+            figures.fe_traction_figure(solutions[-1], p, model.dim, out / "traction.png")
         written = ["rolling.json", "traction.png", "rolling.xdmf"]
     _write(out, records, curve, comm)
     if curve:
         if comm.rank == 0:
-            _creep_curve_png(records, p, args, out / "creep_curve.png")
+            figures.creep_curve_figure(records, p, args.eta, args.phi, out / "creep_curve.png")
         written.append("creep_curve.png")
     comm.Barrier()
     log.info(f"results in {out}/: {', '.join(written)}")

@@ -29,7 +29,7 @@ from fenicsfriction.laws import check
 from fenicsfriction.studies.contact import closed_forms, geometry
 from fenicsfriction.studies.contact.model import Material, SurfaceValues, TwoBodyModel
 
-__all__ = ["Cattaneo", "Hertz", "Patch"]
+__all__ = ["Cattaneo", "Hertz", "Patch", "surface_comparison"]
 
 #: the regularisation during Cattaneo's normal loading, relative to the contact half-width
 NORMAL_LOADING_EPS = 1e-2
@@ -373,3 +373,33 @@ class Cattaneo(Hertz):
             s["newton_iterations"] for s in sequence)
         summary["eps_sequence"] = sequence
         return summary, model
+
+
+def surface_comparison(scene: Hertz, values: SurfaceValues
+                       ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """The slave surface's nodal values beside the closed forms of a Hertz or Cattaneo scene.
+
+    Args:
+        scene: the scene solved (its :meth:`Hertz.closed_form` gives a and p0).
+        values: the slave surface's values (:meth:`TwoBodyModel.surface_values`).
+
+    Returns:
+        (r, columns): the distance of each node from the axis (x in 2D, √(x² + y²) in 3D) and
+        the columns of ``surface.csv``: the pressure beside Hertz's, the gap, the tangential
+        traction on the block (along Q) and, for Cattaneo, Cattaneo-Mindlin's traction.
+    """
+    a, p0 = scene.closed_form()
+    dim = values.x.shape[1]
+    r = values.x[:, 0] if dim == 2 else np.linalg.norm(values.x[:, :2], axis=1)
+    # the tangential traction on the block (the slave's, body 1's, reversed): along Q
+    on_block = -values.traction + 0.0
+    columns = {"pressure": values.pressure, "hertz_pressure": closed_forms.hertz_pressure(r, a, p0),
+               "gap": values.gap}
+    if dim == 2:
+        columns["traction"] = on_block[:, 0]
+    else:
+        columns = {"r": r, **columns, "traction_x": on_block[:, 0], "traction_y": on_block[:, 1]}
+    if isinstance(scene, Cattaneo):
+        columns["cattaneo_traction"] = closed_forms.cattaneo_traction(r, a, p0, scene.law.mu,
+                                                                      scene.q_ratio)
+    return r, columns

@@ -1,26 +1,135 @@
-"""``fenicsfriction interface eq|master-equation|stability-map|interaction|fk|slider``: Braun's
-nonhomogeneous frictional interface — the earthquake-like (EQ) model of many contacts, its master
-equation, the elastic instability, the elastic interaction of contacts, Frenkel-Kontorova slip
-fronts and an elastic slider on an EQ interface.
+"""``fenicsfriction multicontact eq|master-equation|stability-map|interaction|fk|slider``:
+Braun's nonhomogeneous frictional interface — the earthquake-like (EQ) model of many contacts,
+its master equation, the elastic instability, the elastic interaction of contacts,
+Frenkel-Kontorova slip fronts and an elastic slider on an EQ interface.
 
-Each command writes ``interface.json`` (the parameters and the command's numbers), CSV tables
-and PNG figures to ``--out``; the slider also ``slider.xdmf``.
+Each command writes ``multicontact.json`` (the parameters and the command's numbers), CSV
+tables and PNG figures (:mod:`fenicsfriction.studies.multicontact.figures`) to ``--out``; the
+slider also ``slider.xdmf``.
 """
 
 from __future__ import annotations
 
 import argparse
 import logging
+import pathlib
 import typing
 
-from mpi4py import MPI
+from fenicsfriction.cli.arguments import Parser, floats
 
-import numpy as np
+if typing.TYPE_CHECKING:
+    from mpi4py import MPI
 
-from fenicsfriction import plotting, results
-from fenicsfriction.cli.common import named_by_flag, output_folder, write_rows
+__all__ = ["add_parser", "run_multicontact"]
 
-__all__ = ["run_interface"]
+
+def add_parser(commands: typing.Any) -> None:
+    """``multicontact eq|master-equation|...``: Braun's nonhomogeneous frictional interface."""
+    family = commands.add_parser(
+        "multicontact", help="a nonhomogeneous frictional interface of many contacts (Braun)",
+        description="Braun's earthquake-like interface: contacts that break at thresholds and "
+                    "re-form; each command writes multicontact.json, CSV tables and figures "
+                    "to --out.")
+    family.set_defaults(run=run_multicontact)
+    models = family.add_subparsers(dest="model", required=True, parser_class=Parser,
+                                   metavar="STUDY")
+    contacts = Parser(add_help=False)
+    group = contacts.add_argument_group("the contacts (any consistent units)")
+    for name, kind, default, text in (
+            ("--N", int, 1000, "number of contacts"), ("--k", float, 1.0, "contact stiffness"),
+            ("--x-s-mean", float, 1.0, "mean threshold stretching x_c"),
+            ("--x-s-std", float, 0.1, "spread σ of the Gaussian thresholds"),
+            ("--seed", int, 0, "seed of the random numbers")):
+        group.add_argument(name, type=kind, default=default, help=f"{text} ({default})")
+    group.add_argument("--newborn", choices=["relaxed", "gaussian"], default="relaxed",
+                       help="stretching of re-formed contacts: δ(x), or Gaussian (relaxed)")
+    group.add_argument("--newborn-mean", type=float, default=0.0,
+                       help="mean of the Gaussian newborn stretching (0)")
+    group.add_argument("--newborn-std", type=float, default=0.1,
+                       help="spread of the Gaussian newborn stretching (0.1)")
+    contacts.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    for name, text in (("eq", "the EQ model moved quasistatically, beside its master equation"),
+                       ("master-equation", "the master equation of the stretching distribution")):
+        command = models.add_parser(name, parents=[contacts], help=text, description=text + ".")
+        command.add_argument("--X-max", type=float,
+                             help="the slider's last position (5 contact lives: 5 x_c N k/S, "
+                                  "5 x_c without interaction)")
+        command.add_argument("--h", type=float, default=0.01,
+                             help="the master equation's step ΔX = Δx (0.01)")
+        if name == "eq":
+            command.add_argument("--realisations", type=int, default=1,
+                                 help="independent interfaces averaged (1)")
+            command.add_argument("--coupling", type=float,
+                                 help="interacting contacts: k/(E a) of a √N × √N lattice "
+                                      "between two identical bodies (N a square, e.g. --N 256); "
+                                      "none by default")
+            command.add_argument("--nu", type=float, default=0.3,
+                                 help="Poisson's ratio of the bodies, with --coupling (0.3)")
+    smap = models.add_parser(
+        "stability-map", parents=[contacts],
+        help="smooth sliding or stick-slip of the EQ model over K (or the coupling) and σ/x_c",
+        description="With --K: the spring-driven EQ model (PETSc TS) over drive stiffnesses and "
+                    "threshold spreads, each run classified, with the master equation's K* "
+                    "overlaid. With --couplings: interacting contacts on a √N × √N lattice "
+                    "moved quasistatically over couplings k/(E a) and spreads, stick-slip where "
+                    "one avalanche drops the force by more than --drop-threshold.")
+    smap.add_argument("--K", type=floats, metavar="K1,K2,...", help="drive stiffnesses")
+    smap.add_argument("--couplings", type=floats, metavar="C1,C2,...",
+                      help="couplings k/(E a) of interacting contacts (instead of --K; "
+                           "N a square, e.g. --N 256)")
+    smap.add_argument("--drop-threshold", type=float, default=0.05,
+                      help="with --couplings: the force drop in one avalanche, over the "
+                           "kinetic force, that is stick-slip (0.05)")
+    smap.add_argument("--lives", type=float, default=8.0,
+                      help="with --couplings: the distance moved, in contact lives (8)")
+    smap.add_argument("--spreads", type=floats, default=[0.1, 0.3], metavar="S1,S2,...",
+                      help="relative threshold spreads σ/x_c (0.1,0.3)")
+    interaction = models.add_parser(
+        "interaction", help="the response of contacts to a break, through the half-space",
+        description="Contacts on an n x n lattice of an elastic half-space (Landau-Lifshitz's "
+                    "Green tensor): the force response δf(r) of the others when the centre one "
+                    "breaks, its r^-1 and r^-3 laws and their crossover against λ_c = a²E/k.")
+    interaction.add_argument("--n", type=int, default=256, help="lattice side (256)")
+    interaction.add_argument("--lambda-c", type=float, default=16.0,
+                             help="the elastic correlation length over the spacing (16)")
+    interaction.add_argument("--nu", type=float, default=0.3, help="Poisson's ratio (0.3)")
+    interaction.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    fk = models.add_parser(
+        "fk", help="Frenkel-Kontorova slip fronts (PETSc TS, breaks as events)",
+        description="m ü + m η u̇ − g(u_{i+1} + u_{i−1} − 2u_i) + F_s(u_i) + K u_i = f: a front "
+                    "of breaking contacts from the relaxed left part, its speed against the "
+                    "continuum travelling wave.")
+    for name, kind, default, text in (
+            ("--n", int, 200, "contacts"), ("--m", float, 1.0, "mass per contact"),
+            ("--eta", float, 1.0, "damping rate η"), ("--g", float, 100.0, "chain stiffness"),
+            ("--k", float, 1.0, "contact stiffness"), ("--K", float, 0.25, "substrate stiffness"),
+            ("--u-s", float, 1.0, "contact threshold"), ("--force", float, 1.0, "driving force f"),
+            ("--t-end", float, 100.0, "final time"),
+            ("--spread", float, 0.0, "relative spread of the thresholds (defects)"),
+            ("--seed", int, 1, "seed of the thresholds")):
+        fk.add_argument(name, type=kind, default=default, help=f"{text} ({default})")
+    fk.add_argument("--forces", type=floats, metavar="F1,F2,...",
+                    help="also measure the front speed at each of these forces")
+    fk.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    slider = models.add_parser(
+        "slider", help="an elastic slider on EQ contacts, pushed at its trailing edge (dolfinx)",
+        description="A 2D elastic slider whose base is held by breaking contacts, pushed at its "
+                    "trailing edge: detachment fronts, precursors, the force of global slip.")
+    for name, kind, text in (
+            ("--L", float, "length [m] (0.1)"), ("--H", float, "height [m] (0.01)"),
+            ("--nx", int, "cells along L (40)"), ("--ny", int, "cells along H (4)"),
+            ("--E", float, "Young's modulus [Pa] (1e9)"), ("--nu", float, "Poisson's ratio (0.3)"),
+            ("--rho", float, "density [kg/m³] (1000)"),
+            ("--k", float, "contact stiffness per base length [N/m²] (1e10)"),
+            ("--threshold", float, "mean threshold stretch [m] (1e-6)"),
+            ("--spread", float, "relative spread of the thresholds (0.5)"),
+            ("--delay", float, "time a broken contact stays off [s] (0)"),
+            ("--push-speed", float, "speed of the pushing stage [m/s] (0.01)"),
+            ("--seed", int, "seed of the thresholds (0)")):
+        slider.add_argument(name, type=kind, help=text)
+    slider.add_argument("--t-end", type=float, default=5e-3, help="final time [s] (5e-3)")
+    slider.add_argument("--dt", type=float, default=1e-6, help="time step [s] (1e-6)")
+    slider.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
 
 
 # --- the EQ model, its master equation, the elastic instability ---------------------------------
@@ -49,14 +158,17 @@ def _interacting(args: argparse.Namespace, model: typing.Any) -> typing.Any:
     return InteractingEQModel.lattice(model, args.coupling, nu=args.nu)
 
 
-def _interface_json(result: typing.Any) -> dict[str, typing.Any]:
+def _record(result: typing.Any) -> dict[str, typing.Any]:
     """A result's record with the issue's names: parameters, the forces, K*, X and F."""
     data = result.to_json()
     return {**data, "X": list(map(float, result.X)), "F": list(map(float, result.F))}
 
 
 def _run_eq(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
-    from fenicsfriction.studies.multicontact import MasterEquation
+
+    from fenicsfriction import results
+    from fenicsfriction.cli.common import output_folder, write_rows
+    from fenicsfriction.studies.multicontact import MasterEquation, figures
 
     model = _eq_model(args)
     interacting = _interacting(args, model)
@@ -71,32 +183,21 @@ def _run_eq(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> in
              + f"; X to {X_max:g}, {args.realisations} realisation(s), seed {args.seed}")
     run = moved.quasistatic(X_max, realisations=args.realisations, seed=args.seed)
     me = MasterEquation(model, args.h).solve(X_max)
-    summary = {"command": "eq", **_interface_json(run), "K_star": me.K_star,
+    summary = {"command": "eq", **_record(run), "K_star": me.K_star,
                "master_equation": {"kinetic_force": me.kinetic_force,
                                    "static_force": me.static_force, "h": me.h}}
-    results.write_summary(out / "interface.json", summary, comm)
+    results.write_summary(out / "multicontact.json", summary, comm)
     write_rows(out / "force.csv", ({"X": x, "F": f, "F_std": e}
                              for x, f, e in zip(run.X, run.F, run.F_std, strict=True)), comm)
-    files = "interface.json, force.csv, eq.png"
+    files = "multicontact.json, force.csv, eq.png"
     if interacting is not None:
         write_rows(out / "avalanches.csv", ({"X": x, "breaks": b, "force_drop": d} for x, b, d
                                             in zip(run.avalanche_X, run.avalanche_size,
                                                    run.force_drop, strict=True)), comm)
         files += ", avalanches.csv"
     if comm.rank == 0:
-        with plotting.saved_figure(out / "eq.png", ncols=2, figsize=(11, 4)) as (a1, a2):
-            a1.plot(run.X, run.F, "-", lw=1, label=f"EQ model ({args.realisations} realisation(s))")
-            a1.plot(me.X, me.F, "k-", lw=1.2, label="master equation"
-                    + ("" if interacting is None else " (no interaction)"))
-            a1.set(xlabel="X", ylabel="F", title="friction force against the slider's position")
-            a1.legend(fontsize=8)
-            centres = 0.5 * (run.histogram_edges[1:] + run.histogram_edges[:-1])
-            a2.bar(centres, run.histogram, width=np.diff(run.histogram_edges), alpha=0.5,
-                   label="EQ model")
-            a2.plot(me.x, me.Q / me.h, "k-", label="master equation")
-            a2.set(xlabel="stretching x", ylabel="density Q(x; X)",
-                   title=f"stretchings at X = {X_max:g}")
-            a2.legend(fontsize=8)
+        figures.eq_figure(run, me, args.realisations, interacting is not None, X_max,
+                          out / "eq.png")
     log.info(f"static force {run.static_force:.6g} (master equation {me.static_force:.6g}), "
              f"kinetic {run.kinetic_force:.6g} ({me.kinetic_force:.6g}), K* = {me.K_star:.6g}"
              + ("" if interacting is None else
@@ -106,34 +207,33 @@ def _run_eq(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> in
 
 
 def _run_master_equation(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
-    from fenicsfriction.studies.multicontact import MasterEquation
+
+    from fenicsfriction import results
+    from fenicsfriction.cli.common import output_folder, write_rows
+    from fenicsfriction.studies.multicontact import MasterEquation, figures
 
     model = _eq_model(args)
     out = output_folder(args.out, comm)
     X_max = 5.0 * args.x_s_mean if args.X_max is None else args.X_max
     me = MasterEquation(model, args.h).solve(X_max)
-    results.write_summary(out / "interface.json",
-                          {"command": "master-equation", **_interface_json(me)}, comm)
+    results.write_summary(out / "multicontact.json",
+                          {"command": "master-equation", **_record(me)}, comm)
     write_rows(out / "force.csv", ({"X": x, "F": f} for x, f in zip(me.X, me.F, strict=True)), comm)
     if comm.rank == 0:
-        with plotting.saved_figure(out / "master_equation.png", ncols=2,
-                                   figsize=(11, 4)) as (a1, a2):
-            a1.plot(me.X, me.F, "k-")
-            a1.axhline(me.kinetic_force, color="gray", ls=":", label="kinetic")
-            a1.set(xlabel="X", ylabel="F", title=f"F(X): static {me.static_force:.4g}, K* = "
-                                                 f"{me.K_star:.4g}")
-            a1.legend(fontsize=8)
-            a2.plot(me.x, me.Q / me.h, "k-")
-            a2.set(xlabel="stretching x", ylabel="Q(x; X)", title=f"Q at X = {me.X[-1]:.4g}")
+        figures.master_equation_figure(me, out / "master_equation.png")
     log.info(f"static force {me.static_force:.6g}, kinetic {me.kinetic_force:.6g}, "
              f"K* = {me.K_star:.6g}, mass error {me.mass_error:.1e}; results in {out}/: "
-             "interface.json, force.csv, master_equation.png")
+             "multicontact.json, force.csv, master_equation.png")
     return 0
 
 
 def _run_stability_map(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
+    import numpy as np
+
+    from fenicsfriction import results
+    from fenicsfriction.cli.common import output_folder, write_rows
     from fenicsfriction.laws import check
-    from fenicsfriction.studies.multicontact import instability_map
+    from fenicsfriction.studies.multicontact import figures, instability_map
 
     check("--K", args.K, (args.K is None) != (args.couplings is None),
           "give --K (drive stiffnesses) or --couplings (interacting contacts), one of the two")
@@ -144,7 +244,7 @@ def _run_stability_map(args: argparse.Namespace, log: logging.Logger, comm: MPI.
              f"{args.N} contacts")
     smap = instability_map(args.K, args.spreads, n_contacts=args.N, k=args.k,
                            x_s_mean=args.x_s_mean, seed=args.seed)
-    results.write_summary(out / "interface.json", {"command": "stability-map",
+    results.write_summary(out / "multicontact.json", {"command": "stability-map",
                                                    **smap.to_json()}, comm)
     write_rows(out / "map.csv", ({"relative_spread": s, "K": K, "K_star": smap.K_star[i],
                             "stick_slip": bool(smap.stick_slip[i, j]),
@@ -152,33 +252,22 @@ def _run_stability_map(args: argparse.Namespace, log: logging.Logger, comm: MPI.
                            for i, s in enumerate(smap.relative_spread)
                            for j, K in enumerate(smap.K)), comm)
     if comm.rank == 0:
-        with plotting.saved_figure(out / "stability_map.png", figsize=(6.5, 4.5)) as (ax,):
-            _classified(ax, smap.K, smap.relative_spread, smap.stick_slip)
-            ax.plot(smap.K_star, smap.relative_spread, "k-", label="K* = −max F′(X)")
-            ax.set(xscale="log", xlabel="drive stiffness K", ylabel="threshold spread σ/x_c",
-                   title="elastic instability of the EQ interface")
-            ax.legend(fontsize=8)
+        figures.stability_map_figure(smap, out / "stability_map.png")
     agree = np.mean(smap.stick_slip == (smap.K[None, :] < smap.K_star[:, None]))
     log.info(f"{agree:.0%} of the runs on the side of K* the master equation predicts; "
-             f"results in {out}/: interface.json, map.csv, stability_map.png")
+             f"results in {out}/: multicontact.json, map.csv, stability_map.png")
     return 0
-
-
-def _classified(ax: typing.Any, x: np.ndarray, spreads: np.ndarray,
-                stick_slip: np.ndarray) -> None:
-    """The runs of a map as crosses (stick-slip) and circles (smooth sliding)."""
-    xx, ss = np.meshgrid(x, spreads)
-    stuck = stick_slip.astype(bool)
-    ax.scatter(xx[stuck], ss[stuck], marker="x", color="tab:red", label="stick-slip")
-    ax.scatter(xx[~stuck], ss[~stuck], marker="o", facecolors="none", edgecolors="tab:blue",
-               label="smooth sliding")
 
 
 def _run_coupling_map(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
     import math
 
+    import numpy as np
+
+    from fenicsfriction import results
+    from fenicsfriction.cli.common import output_folder, write_rows
     from fenicsfriction.laws import check
-    from fenicsfriction.studies.multicontact import coupling_map
+    from fenicsfriction.studies.multicontact import coupling_map, figures
 
     n_side = math.isqrt(args.N)
     check("--N", args.N, n_side**2 == args.N, "must be a square n² with --couplings (e.g. 256)")
@@ -188,7 +277,7 @@ def _run_coupling_map(args: argparse.Namespace, log: logging.Logger, comm: MPI.C
     cmap = coupling_map(args.couplings, args.spreads, n_side=n_side, k=args.k,
                         x_s_mean=args.x_s_mean, lives=args.lives,
                         drop_threshold=args.drop_threshold, seed=args.seed)
-    results.write_summary(out / "interface.json", {"command": "stability-map",
+    results.write_summary(out / "multicontact.json", {"command": "stability-map",
                                                    **cmap.to_json()}, comm)
     write_rows(out / "map.csv", ({"relative_spread": s, "coupling": c,
                                   "stick_slip": bool(cmap.stick_slip[i, j]),
@@ -197,34 +286,25 @@ def _run_coupling_map(args: argparse.Namespace, log: logging.Logger, comm: MPI.C
                                  for i, s in enumerate(cmap.relative_spread)
                                  for j, c in enumerate(cmap.coupling)), comm)
     if comm.rank == 0:
-        with plotting.saved_figure(out / "coupling_map.png", ncols=2,
-                                   figsize=(11, 4.5)) as (a1, a2):
-            shown = np.where(cmap.coupling > 0, cmap.coupling,
-                             np.min(cmap.coupling[cmap.coupling > 0], initial=1.0) / 3)
-            _classified(a1, shown, cmap.relative_spread, cmap.stick_slip)
-            a1.set(xscale="log", xlabel="coupling k/(E a) (no interaction at the left edge)",
-                   ylabel="threshold spread σ/x_c", title="stick-slip of interacting contacts")
-            a1.legend(fontsize=8)
-            for i, s in enumerate(cmap.relative_spread):
-                a2.plot(shown, cmap.largest_drop[i], "o-", label=f"σ/x_c = {s:g}")
-            a2.axhline(cmap.drop_threshold, color="gray", ls=":", label="threshold")
-            a2.set(xscale="log", yscale="log", xlabel="coupling k/(E a)",
-                   ylabel="largest drop of F in one avalanche / F_k",
-                   title="avalanches grow with the interaction")
-            a2.legend(fontsize=8)
+        figures.coupling_map_figure(cmap, out / "coupling_map.png")
     log.info(f"stick-slip in {int(np.sum(cmap.stick_slip))} of {cmap.stick_slip.size} runs; "
              "per coupling: " + ", ".join(f"{c:g}: {int(n)}" for c, n in
                                            zip(cmap.coupling, cmap.stick_slip.sum(axis=0),
                                                strict=True))
-             + f"; results in {out}/: interface.json, map.csv, coupling_map.png")
+             + f"; results in {out}/: multicontact.json, map.csv, coupling_map.png")
     return 0
 
 
 # --- the elastic interaction of contacts --------------------------------------------------------
 
 def _run_interaction(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
+    import numpy as np
+
+    from fenicsfriction import results
+    from fenicsfriction.cli.common import output_folder, write_rows
     from fenicsfriction.studies.multicontact import (
         LatticeInteraction,
+        figures,
         fit_power_laws,
         radial_profile,
     )
@@ -249,29 +329,24 @@ def _run_interaction(args: argparse.Namespace, log: logging.Logger, comm: MPI.Co
                "near_exponent": fit.near_exponent, "far_exponent": fit.far_exponent,
                "crossover": fit.crossover, "crossover_over_lambda_c": fit.crossover / lam,
                "r": list(map(float, r)), "dF": list(map(float, f))}
-    results.write_summary(out / "interface.json", summary, comm)
+    results.write_summary(out / "multicontact.json", summary, comm)
     write_rows(out / "response.csv", ({"r": x, "dF": y} for x, y in zip(r, f, strict=True)), comm)
     if comm.rank == 0:
-        with plotting.saved_figure(out / "interaction.png", figsize=(6, 4.2)) as (ax,):
-            ax.loglog(r, f, "o", ms=3, label="|δf(r)| / |δf(0)|")
-            for slope, pre, where, style in (
-                    (fit.near_exponent, fit.near_prefactor, r < near, "k--"),
-                    (fit.far_exponent, fit.far_prefactor, r > 3 * lam, "k:")):
-                if np.any(where):
-                    ax.loglog(r[where], pre * r[where] ** slope, style, label=f"slope {slope:.2f}")
-            ax.axvline(lam, color="gray", lw=0.8, label="λ_c")
-            ax.set(xlabel="r / a", ylabel="response of the other contacts",
-                   title="a contact breaks: the response against distance")
-            ax.legend(fontsize=8)
+        figures.interaction_figure(r, f, fit, near, lam, out / "interaction.png")
     log.info(f"near exponent {fit.near_exponent:.3f} (r < {near:g}), far {fit.far_exponent:.3f} "
              f"(r > 3 λ_c), crossover at {fit.crossover / lam:.2f} λ_c; results in {out}/: "
-             "interface.json, response.csv, interaction.png")
+             "multicontact.json, response.csv, interaction.png")
     return 0
 
 
 # --- Frenkel-Kontorova slip fronts --------------------------------------------------------------
 
 def _run_fk(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
+    import numpy as np
+
+    from fenicsfriction import results
+    from fenicsfriction.cli.common import output_folder, write_rows
+    from fenicsfriction.studies.multicontact import figures
     from fenicsfriction.studies.multicontact.frenkel_kontorova import FKChain, front_speeds
 
     chain = FKChain(n=args.n, m=args.m, eta=args.eta, g=args.g, k=args.k, K=args.K,
@@ -302,43 +377,26 @@ def _run_fk(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> in
         summary["front_speeds"] = sweep.to_json()
         write_rows(out / "front_speeds.csv", sweep.rows(), comm)
     write_rows(out / "fk.csv", run.rows(), comm)
-    results.write_summary(out / "interface.json", summary, comm)
+    results.write_summary(out / "multicontact.json", summary, comm)
     if comm.rank == 0:
-        panels = 2 if args.forces else 1
-        with plotting.saved_figure(out / "fk.png", ncols=panels,
-                                   figsize=(5.5 * panels, 4)) as axes:
-            ax = axes[0]
-            sites = np.flatnonzero(broken)
-            ax.plot(run.break_time[sites], sites * chain.a, ".", ms=3)
-            ax.set(xlabel="t", ylabel="x of the contact (first break)",
-                   title=f"front in the x–t plane, f = {args.force:g}")
-            if args.forces:
-                ax = axes[1]
-                s = summary["front_speeds"]
-                fine = np.linspace(chain.f_min, chain.f_max, 201)[1:-1]
-                ax.plot(s["force"], s["measured"], "o", label="chain")
-                ax.plot(fine, chain.continuum_front_speed(fine), "k-",
-                        label="continuum travelling wave")
-                ax.plot(fine, chain.low_velocity_speed(fine), "k--", lw=0.8,
-                        label="low-velocity limit")
-                ax.plot(fine, chain.high_velocity_speed(fine), "k:", lw=0.8,
-                        label="high-velocity limit")
-                ax.set_ylim(0, 1.2 * chain.sound_speed)
-                ax.axhline(chain.sound_speed, color="gray", ls=":", label="sound speed")
-                ax.set(xlabel="f", ylabel="front speed", title="front speed against the force")
-                ax.legend(fontsize=8)
+        figures.fk_figure(chain, run, args.force,
+                          summary["front_speeds"] if args.forces else None, out / "fk.png")
     log.info(f"{summary['contacts_broken']} contacts broken; front speed "
              f"{summary.get('front_speed', float('nan')):.6g} (continuum "
              f"{summary['continuum_front_speed'] or float('nan'):.6g}); results in {out}/: "
-             "interface.json, fk.csv, fk.png" + (", front_speeds.csv" if args.forces else ""))
+             "multicontact.json, fk.csv, fk.png" + (", front_speeds.csv" if args.forces else ""))
     return 0
 
 
 # --- the elastic slider on an EQ interface ------------------------------------------------------
 
 def _run_slider(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
+    import numpy as np
+
+    from fenicsfriction import results
+    from fenicsfriction.cli.common import output_folder
     from fenicsfriction.io import FieldWriter
-    from fenicsfriction.studies.multicontact import ElasticSlider, ElasticSliderModel
+    from fenicsfriction.studies.multicontact import ElasticSlider, ElasticSliderModel, figures
 
     names = ("L", "H", "nx", "ny", "E", "nu", "rho", "k", "threshold", "spread", "delay",
              "push_speed", "seed")
@@ -362,20 +420,13 @@ def _run_slider(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -
                "breaks": len(history.breaks), "fronts": [f.to_json() for f in history.fronts],
                "slip_force": history.slip_force,
                "peak_push_force": float(np.max(history.push_force))}
-    results.write_summary(out / "interface.json", summary, comm)
+    results.write_summary(out / "multicontact.json", summary, comm)
     with FieldWriter(out / "slider.xdmf", model) as writer:
         writer.write(float(model.time.value))
     if comm.rank == 0:
-        with plotting.saved_figure(out / "fronts.png", ncols=2, figsize=(11, 4)) as (a1, a2):
-            a1.plot(np.array(history.time) * 1e3, np.array(history.front_position) / scene.L, "-")
-            for b in history.breaks:
-                a1.plot(b.time * 1e3, b.x / scene.L, ".", color="tab:red", ms=2)
-            a1.set(xlabel="t [ms]", ylabel="x / L", title="detachment fronts (breaks in red)")
-            a2.plot(np.array(history.time) * 1e3, history.push_force, "-")
-            a2.set(xlabel="t [ms]", ylabel="push force [N/m]",
-                   title="the force on the trailing edge")
+        figures.slider_figure(history, scene.L, out / "fronts.png")
     log.info(f"{len(history.breaks)} breaks, {len(history.fronts)} fronts, slip force "
-             f"{history.slip_force}; results in {out}/: interface.json, slider.csv, fronts.png, "
+             f"{history.slip_force}; results in {out}/: multicontact.json, slider.csv, fronts.png, "
              "slider.xdmf")
     return 0
 
@@ -384,8 +435,12 @@ def _run_slider(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -
 _FLAGS = {"n_contacts": "--N", "relative_spread": "--spreads", "X_max": "--X-max"}
 
 
-def run_interface(args: argparse.Namespace, log: logging.Logger) -> int:
-    """``interface COMMAND``: the model, its numbers and figures."""
+def run_multicontact(args: argparse.Namespace, log: logging.Logger) -> int:
+    """``multicontact STUDY``: the model, its numbers and figures."""
+    from mpi4py import MPI
+
+    from fenicsfriction.cli.common import named_by_flag
+
     run = {"eq": _run_eq, "master-equation": _run_master_equation,
            "stability-map": _run_stability_map, "interaction": _run_interaction,
            "fk": _run_fk, "slider": _run_slider}[args.model]

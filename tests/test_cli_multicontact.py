@@ -1,6 +1,6 @@
-"""``fenicsfriction interface ...``: interface.json with the documented names, the numbers against
-the closed forms of the EQ model and the travelling front, the figures, and a bad value as one
-line and exit status 2. Serial and under ``mpirun -n 2``."""
+"""``fenicsfriction multicontact ...``: multicontact.json with the documented names, the numbers
+against the closed forms of the EQ model and the travelling front, the figures, and a bad value
+as one line and exit status 2. Serial and under ``mpirun -n 2``."""
 
 import json
 
@@ -12,12 +12,12 @@ from fenicsfriction.cli import main
 
 
 def _json(path):
-    return json.loads((path / "interface.json").read_text())
+    return json.loads((path / "multicontact.json").read_text())
 
 
 def test_eq_against_its_master_equation_and_the_kinetic_closed_form(shared_tmp_path):
     out = shared_tmp_path / "eq"
-    assert main(["interface", "eq", "--N", "4000", "--x-s-std", "0.1", "--X-max", "6",
+    assert main(["multicontact", "eq", "--N", "4000", "--x-s-std", "0.1", "--X-max", "6",
                  "--out", str(out)]) == 0
     summary = _json(out)
     assert {"parameters", "kinetic_force", "static_force", "K_star", "X", "F"} <= set(summary)
@@ -33,7 +33,7 @@ def test_eq_against_its_master_equation_and_the_kinetic_closed_form(shared_tmp_p
 
 def test_eq_with_interacting_contacts_writes_its_avalanches(shared_tmp_path):
     out = shared_tmp_path / "eq-coupled"
-    assert main(["interface", "eq", "--N", "144", "--coupling", "0.1", "--out", str(out)]) == 0
+    assert main(["multicontact", "eq", "--N", "144", "--coupling", "0.1", "--out", str(out)]) == 0
     summary = _json(out)
     assert summary["parameters"]["coupling"] == 0.1
     # the bodies in series soften the interface: S < N k (0.29 N k on this lattice)
@@ -46,7 +46,7 @@ def test_eq_with_interacting_contacts_writes_its_avalanches(shared_tmp_path):
 
 def test_coupling_map_has_no_stick_slip_without_interaction_and_some_with(shared_tmp_path):
     out = shared_tmp_path / "coupling-map"
-    assert main(["interface", "stability-map", "--N", "144", "--couplings", "0,0.1",
+    assert main(["multicontact", "stability-map", "--N", "144", "--couplings", "0,0.1",
                  "--spreads", "0.3", "--lives", "6", "--out", str(out)]) == 0
     summary = _json(out)
     assert summary["stick_slip"] == [[False, True]]
@@ -55,7 +55,7 @@ def test_coupling_map_has_no_stick_slip_without_interaction_and_some_with(shared
 
 def test_master_equation_conserves_the_contacts(shared_tmp_path):
     out = shared_tmp_path / "me"
-    assert main(["interface", "master-equation", "--x-s-std", "0.3", "--out", str(out)]) == 0
+    assert main(["multicontact", "master-equation", "--x-s-std", "0.3", "--out", str(out)]) == 0
     summary = _json(out)
     assert summary["mass_error"] < 1e-12
     assert summary["kinetic_force"] == pytest.approx(1000 * (1 + 0.09) / 2, rel=1e-3)
@@ -63,7 +63,7 @@ def test_master_equation_conserves_the_contacts(shared_tmp_path):
 
 def test_stability_map_is_smooth_well_above_K_star_and_stick_slip_well_below(shared_tmp_path):
     out = shared_tmp_path / "map"
-    assert main(["interface", "stability-map", "--N", "300", "--K", "25,1000", "--spreads",
+    assert main(["multicontact", "stability-map", "--N", "300", "--K", "25,1000", "--spreads",
                  "0.3", "--out", str(out)]) == 0
     summary = _json(out)
     K_star = summary["K_star"][0]
@@ -73,7 +73,7 @@ def test_stability_map_is_smooth_well_above_K_star_and_stick_slip_well_below(sha
 
 def test_fk_front_runs_near_the_continuum_travelling_wave(shared_tmp_path):
     out = shared_tmp_path / "fk"
-    assert main(["interface", "fk", "--n", "120", "--g", "100", "--force", "1.0",
+    assert main(["multicontact", "fk", "--n", "120", "--g", "100", "--force", "1.0",
                  "--t-end", "30", "--out", str(out)]) == 0
     summary = _json(out)
     # g = 100: the chain's front is within 1-2 % of the continuum's away from f_min, f_max
@@ -87,7 +87,7 @@ def test_fk_front_runs_near_the_continuum_travelling_wave(shared_tmp_path):
 def test_interaction_response_falls_like_r_minus_3_beyond_the_correlation_length(
         shared_tmp_path):
     out = shared_tmp_path / "interaction"
-    assert main(["interface", "interaction", "--n", "192", "--lambda-c", "4",
+    assert main(["multicontact", "interaction", "--n", "192", "--lambda-c", "4",
                  "--out", str(out)]) == 0
     summary = _json(out)
     # beyond λ_c the broken contact's dipole is unscreened: δf ∝ r^-3 (Braun (slides));
@@ -108,14 +108,14 @@ def test_interaction_response_falls_like_r_minus_3_beyond_the_correlation_length
     (["stability-map", "--N", "144", "--couplings", "-0.1"], "--couplings")])
 def test_bad_value_is_one_line_naming_the_parameter_and_exit_2(shared_tmp_path, capsys, argv,
                                                                 name):
-    code = main(["interface", *argv, "--out", str(shared_tmp_path / "bad")])
+    code = main(["multicontact", *argv, "--out", str(shared_tmp_path / "bad")])
     assert code == 2
     assert_one_error_line(capsys.readouterr().err, name)
 
 
 def test_slider_writes_its_fronts_and_fields(shared_tmp_path):
     out = shared_tmp_path / "slider"
-    assert main(["interface", "slider", "--nx", "10", "--ny", "2", "--t-end", "1.6e-3",
+    assert main(["multicontact", "slider", "--nx", "10", "--ny", "2", "--t-end", "1.6e-3",
                  "--dt", "4e-6", "--spread", "0.05", "--push-speed", "1e-3",
                  "--out", str(out)]) == 0
     summary = _json(out)
