@@ -23,6 +23,7 @@ MODULES = [
     "fenicsfriction.studies.multicontact.interaction",
     "fenicsfriction.studies.multicontact.interacting",
     "fenicsfriction.studies.multicontact.frenkel_kontorova",
+    "fenicsfriction.studies.multicontact.figures", "fenicsfriction.studies.rolling.figures",
     "fenicsfriction.studies.oscillators.slider", "fenicsfriction.studies.oscillators.belt",
     "fenicsfriction.studies.oscillators.bouncing_mass",
 ]
