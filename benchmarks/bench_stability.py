@@ -260,7 +260,7 @@ def run_mesh(dim: int, refine: int, comm: MPI.Comm, dense_max_dofs: int,
 
 def rigid_reference(scene: ff.BlockOnBelt) -> dict:
     """Eigenvalues of the rigid 3-dof block of the same data at μ = MU."""
-    rigid = RigidBlock.from_scene(scene, mu=MU)
+    rigid = RigidBlock.from_scene(scene, law=scene.law.replace(mu=MU))
     values = [v for v in rigid.eigenvalues(rigid.steady_state()) if v.imag >= 0]
     return named_modes(values)
 

@@ -101,7 +101,7 @@ assert len({c["mode"] for c in onset.colliding}) == 2
 q = None
 rigid_max_re = []
 for mu in mu_grid:
-    block = RigidBlock.from_scene(scene, mu=mu)
+    block = RigidBlock.from_scene(scene, law=scene.law.replace(mu=mu))
     q = block.steady_state(q)
     lam = block.eigenvalues(q)
     rigid_max_re.append(lam.real.max())

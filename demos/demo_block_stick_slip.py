@@ -214,8 +214,9 @@ def run_rigid(block: RigidBlock, name: str, stem: str
 FIG12_SPEEDS = [0.127, 0.08, 0.287]  # [cm/s]
 RIGID = {f"U = {U} cm/s": RigidBlock.from_scene(belt_scene(U)) for U in BELT_SPEEDS}
 RIGID.update({f"Figs. 10-12: μ = 1, U = {U} cm/s": RigidBlock.with_modal_damping(
-    (0.005, 0.04, 0.04), mu=1.0, belt_speed=U, B0=14.0, inertia=70.0, K_x=2388.0,
-    b_n=0.381e10, eps=EPS) for U in FIG12_SPEEDS})
+    (0.005, 0.04, 0.04), belt_speed=U, B0=14.0, inertia=70.0, K_x=2388.0,
+    law=ff.InterfaceLaw(mu=1.0, b_n=0.381e10, eps=EPS)) for U in FIG12_SPEEDS})
+
 
 # %% [markdown]
 # ## All runs, shared out over the ranks

@@ -186,10 +186,11 @@ def out_dir() -> pathlib.Path:
 
 
 def test_stability_cli_on_the_slab_writes_the_blocks_json(out_dir):
-    """``fenicsfriction stability block-on-slab`` writes stability.json as for the block, with
-    the FE model's μ_crit between the grid points that bracket it (0.2 stable, 0.3 not)."""
-    code = main(["stability", "block-on-slab", "--slab-E", "1.4e7", "--slab-thickness", "5",
-                 "--mu-max", "0.3", "--steps", "3", "--onset-tol", "1e-3",
+    """``fenicsfriction block stability --scene block-on-slab`` writes stability.json as for the
+    block, with the FE model's μ_crit between the grid points that bracket it (0.2 stable,
+    0.3 not)."""
+    code = main(["block", "stability", "--scene", "block-on-slab", "--slab-E", "1.4e7",
+                 "--slab-thickness", "5", "--mu-max", "0.3", "--steps", "3", "--onset-tol", "1e-3",
                  "--out", str(out_dir)])
     assert code == 0
     data = json.loads((out_dir / "stability.json").read_text())
@@ -203,9 +204,9 @@ def test_stability_cli_on_the_slab_writes_the_blocks_json(out_dir):
 def test_dynamics_cli_on_the_slab_closes_its_energy_balance(out_dir):
     """The energies of both bodies and the interface powers on both: E(t) - E(0) - W(t) stays
     within the scheme's (ω dt)² ~ 1e-3 of the oscillation's kinetic energy."""
-    code = main(["dynamics", "block-on-slab", "--slab-E", "1.4e7", "--slab-thickness", "5",
-                 "--mu", "0.4", "--t-end", "3e-4", "--dt", "1e-5", "--stride", "30",
-                 "--out", str(out_dir)])
+    code = main(["block", "dynamics", "--scene", "block-on-slab", "--slab-E", "1.4e7",
+                 "--slab-thickness", "5", "--mu", "0.4", "--t-end", "3e-4", "--dt", "1e-5",
+                 "--stride", "30", "--out", str(out_dir)])
     assert code == 0
     import csv
     rows = list(csv.DictReader((out_dir / "timeseries.csv").open()))
@@ -217,7 +218,7 @@ def test_dynamics_cli_on_the_slab_closes_its_energy_balance(out_dir):
 
 
 def test_slab_flags_are_refused_by_the_rigid_belt_scene(out_dir, capsys):
-    code = main(["steady", "block", "--slab-E", "1e9", "--mu-max", "0.1", "--steps", "1",
+    code = main(["block", "steady", "--slab-E", "1e9", "--mu-max", "0.1", "--steps", "1",
                  "--out", str(out_dir)])
     assert code == 2
     if COMM.rank == 0:  # the one line is printed by rank 0
