@@ -13,9 +13,13 @@ from fenicsfriction.dynamics import DynamicsSolver
 from fenicsfriction.stability import StabilitySolver
 
 
-def steady_block(mu: float, comm=MPI.COMM_WORLD, prefix="dyn", **scene):
-    """A converged steady sliding state of the block at μ."""
-    model = ff.BlockOnBelt(**scene, law=ff.InterfaceLaw(mu=mu)).build(comm, with_friction=mu > 0)
+def steady_block(mu: float, comm=MPI.COMM_WORLD, prefix="dyn", **fields):
+    """A converged steady sliding state of the block at μ (``fields``: the scene's and its
+    law's, e.g. ``belt_speed``, ``b_n``, ``eps``)."""
+    law_fields = {f.name for f in dataclasses.fields(ff.InterfaceLaw)}
+    law = ff.InterfaceLaw(mu=mu, **{k: v for k, v in fields.items() if k in law_fields})
+    scene = ff.BlockOnBelt(**{k: v for k, v in fields.items() if k not in law_fields}, law=law)
+    model = scene.build(comm, with_friction=mu > 0)
     model.initial_guess()
     solver = ff.SteadySolver(model.residual, prefix=f"{prefix}_steady_",
                              options=model.solver_options())
