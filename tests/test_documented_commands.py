@@ -45,7 +45,10 @@ def documented_commands() -> list[tuple[str, str]]:
                 if re.search(r"\[-|\|", command):  # a synopsis
                     continue
                 found.append((page.name, line))
-    return list(dict.fromkeys(found))
+    first: dict[str, str] = {}  # a line shown on several pages runs once
+    for page, line in found:
+        first.setdefault(line, page)
+    return [(page, line) for line, page in first.items()]
 
 
 COMMANDS = documented_commands()
