@@ -8,8 +8,9 @@ under AFTER_DIR (after the ``--rename`` substitutions of path parts, e.g. a rena
 folder); every number must be identical (bit for bit, as parsed), except the values of timing
 keys (wall times, JIT times, speed-ups, CPU counts), which are listed apart. ``--logs`` compares
 the numbers printed on each line of two logs (a demo's stdout), reporting the lines that
-differ so that a reader can tell timing lines from results. Exit status 1 if any non-timing
-number differs or a file is missing.
+differ so that a reader can tell timing lines from results. ``--nested law`` compares the
+entries of a record that moved into a sub-record ``law`` with their old places. Exit status 1
+if any non-timing number differs or a file is missing.
 """
 
 from __future__ import annotations
@@ -35,8 +36,24 @@ def _same(a: object, b: object) -> bool:
     return a == b
 
 
+def _gather(a: dict, b: dict, nested: tuple[str, ...]) -> tuple[dict, dict]:
+    """``a`` and ``b`` with the entries of a ``nested`` sub-record that only ``b`` has (e.g. the
+    parameters of an interface law now recorded as ``law: {...}``) lifted to ``b``'s level
+    where ``a`` holds them there, so that they are compared rather than reported as moved."""
+    b = dict(b)
+    for name in nested:
+        if name in b and name not in a and isinstance(b[name], dict):
+            inner = dict(b.pop(name))
+            for k in [k for k in inner if k in a and k not in b]:
+                b[k] = inner.pop(k)
+            if inner:
+                b[name] = inner
+    return a, b
+
+
 def compare_json(a: object, b: object, where: str, out: dict) -> None:
     if isinstance(a, dict) and isinstance(b, dict):
+        a, b = _gather(a, b, out["nested"])
         for k in sorted(set(a) | set(b)):
             if k not in a or k not in b:
                 out["keys"].append(f"{where}/{k}: only {'after' if k in b else 'before'}")
@@ -93,9 +110,13 @@ def main() -> int:
     parser.add_argument("after", type=pathlib.Path)
     parser.add_argument("--rename", action="append", default=[], metavar="OLD=NEW")
     parser.add_argument("--logs", nargs=2, action="append", default=[], type=pathlib.Path)
+    parser.add_argument("--nested", action="append", default=[], metavar="KEY",
+                        help="a sub-record (e.g. law) whose entries were recorded one level up "
+                             "before")
     args = parser.parse_args()
     renames = [tuple(r.split("=", 1)) for r in args.rename]
-    out: dict = {"diff": [], "keys": [], "timing": 0, "numbers": 0, "files": 0, "missing": []}
+    out: dict = {"diff": [], "keys": [], "timing": 0, "numbers": 0, "files": 0, "missing": [],
+                 "nested": tuple(args.nested)}
     for pa in sorted(args.before.rglob("*")):
         if pa.suffix not in (".json", ".csv"):
             continue
