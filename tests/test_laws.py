@@ -51,10 +51,10 @@ def test_derivatives_are_central_differences_of_the_regularisations(name):
     h = 1e-6
     fd = (f(w + h, EPS) - f(w - h, EPS)) / (2 * h)
     # truncation: 0 for the piecewise quadratic/linear φ_ε, h²|ψ'''|/6 ≤ h²/ε² ~ 1e-11 for ψ_ε;
-    # round-off: ε_mach |f| / h ≤ 1e-16 * 3 / 1e-6 = 3e-10
+    # round-off: u_mach |f| / h ≤ 1e-16 * 3 / 1e-6 = 3e-10
     np.testing.assert_allclose(fd, df(w, EPS), rtol=0, atol=1e-8)
     # the second derivative (scalar slip) likewise from φ'_ε: truncation 0 (c1) or
-    # h² |ψ''''| / 6 ≲ h² / ε³ ~ 4e-11 (ψ_ε); round-off ε_mach / h = 1e-10
+    # h² |ψ''''| / 6 ≲ h² / ε³ ~ 4e-11 (ψ_ε); round-off u_mach / h = 1e-10
     fd2 = (df(w + h, EPS) - df(w - h, EPS)) / (2 * h)
     np.testing.assert_allclose(fd2, ddf(w, EPS), rtol=0, atol=1e-8)
     assert ddf(0.0, EPS) == pytest.approx(1 / EPS, rel=1e-14)  # both: 1/ε at zero slip

@@ -267,7 +267,7 @@ def test_energy_is_conserved_to_second_order_and_exactly_for_a_linear_foundation
 def test_bouncing_mass_linearisation_is_the_derivative_of_its_residual(y, y_dot, m_n, b_n):
     """(M, C, K) against central differences of R, in contact with and without damping and
     in flight (all zero but M). Steps 1e-6 of |y| and of |ẏ|: truncation ≈ (1e-6)²,
-    round-off ε_mach W/(h K) ≲ 1e-9; tolerance 1e-7 (measured ≤ 8e-11 for K, 1e-9 for C)."""
+    round-off u_mach W/(h K) ≲ 1e-9; tolerance 1e-7 (measured ≤ 8e-11 for K, 1e-9 for C)."""
     bm = BouncingMass(law=InterfaceLaw(m_n=m_n, b_n=b_n, c_n=1e10 if m_n > 1 else 1e6))
     hy, hv = 1e-6 * abs(y), 1e-6 * abs(y_dot)
     M, C, K = bm.linearisation([y], [y_dot])

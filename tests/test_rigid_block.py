@@ -56,7 +56,7 @@ def test_linearisation_is_the_derivative_of_the_residual(state):
     Steps: 1e-4 of the mean penetration d0 for u_yG (and u_xG; θ: that over L), 1e-5 cm/s
     for velocities (θ̇: over L). ∫ d_+^{2.5} ds is C³ in q, also across lift-off, so the
     truncation is ≈ (h/d)²/8 ≈ 5e-9 for q and ≲ (h/ε)² = 1e-8 for q̇; round-off,
-    ε_mach (W + K_x u_xG) / (h ‖K̄‖), is ≈ 3e-11. Tolerance 1e-7; measured ≤ 2e-10 (K̄) and
+    u_mach (W + K_x u_xG) / (h ‖K̄‖), is ≈ 3e-11. Tolerance 1e-7; measured ≤ 2e-10 (K̄) and
     ≤ 3e-10 (C). Rows (forces, forces, moment) and columns (cm, cm, rad) are brought to
     common units with L before taking norms.
     """
@@ -160,7 +160,7 @@ def test_stiff_fe_block_has_the_eigenvalues_of_the_rigid_block(B0, spring_height
 
     The difference has two sources: the block's elasticity, relative 1/E (5e-5 at E × 10³,
     5e-6 at E × 10⁴ for μ ≤ 0.5 with the spring at mid-height; stiffer still, the steady
-    state's round-off floor ε_mach ‖J‖ ‖u‖ grows with E and takes over), and the FE contact
+    state's round-off floor u_mach ‖J‖ ‖u‖ grows with E and takes over), and the FE contact
     quadrature, inexact once part of the base lifts off — at μ = 1.2 with the spring at
     mid-height the centre of pressure is μ H/2 = 18 cm from G, past the 13.6 cm a fully
     pressed base can carry (p ∝ d^{2.5}, d linear) — where it is 1.9e-3 and does not shrink

@@ -119,7 +119,7 @@ def test_associated_traction_is_minus_the_gradient_of_the_regularised_dissipatio
     gradient = np.stack([(dissipation(w + h * e) - dissipation(w - h * e)) / (2 * h)
                          for e in np.eye(2)], axis=-1)
     # central differences: truncation h² |D'''| ~ (1e-4)² bound/ε^0 (D''' ~ 1/ε², times ε²),
-    # round-off ε_mach |D| / h ≤ 1e-16 * 0.05 / 1e-7: both below 1e-7 of |t| ~ bound
+    # round-off u_mach |D| / h ≤ 1e-16 * 0.05 / 1e-7: both below 1e-7 of |t| ~ bound
     np.testing.assert_allclose(-rule.traction(bound, w, EPS, regularisation), gradient,
                                rtol=0, atol=1e-7 * bound)
 

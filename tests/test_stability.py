@@ -74,7 +74,7 @@ def sensitivity(K, C, M, lam: complex) -> tuple[float, float]:
 
     κ = α ‖x‖‖y‖ / (|λ| |y^H (2λM + C) x|) and η = σ_min(T(λ)) / α with
     α = |λ|²‖M‖ + |λ|‖C‖ + ‖K‖; x, y are the right/left singular vectors of σ_min (Tisseur
-    2000). σ_min is itself computed to ≈ ε_mach ‖T(λ)‖, so η is never below about ε_mach.
+    2000). σ_min is itself computed to ≈ u_mach ‖T(λ)‖, so η is never below about u_mach.
     """
     T = lam**2 * M + lam * C + K
     U, s, Vh = np.linalg.svd(T)
@@ -154,13 +154,13 @@ def test_stiffness_and_damping_are_the_derivatives_of_the_residual():
     K̄: the step h = 1e-3 d_min keeps every contact point in contact (d ≥ d_min ≈ 3e-5 cm, the
     law is smooth there). The central-difference truncation of d^{m} is
     h² (m-1)(m-2)/(6 d²) = h²/(8 d²) ≈ 1.3e-7 relative to the contact part; round-off is
-    sqrt(n) ε_mach ‖K̄‖_∞ ‖u‖_∞ / (h ‖K̄ δu‖) ≈ 9e-7 (u carries the 24 cm rigid displacement
+    sqrt(n) u_mach ‖K̄‖_∞ ‖u‖_∞ / (h ‖K̄ δu‖) ≈ 9e-7 (u carries the 24 cm rigid displacement
     the soft spring allows, whose elastic forces cancel only to that level). Measured: 3e-8
     (4e-8 on 2 ranks); the friction coupling alone is 2.3e-3 of K̄ δu, so an error of 0.04 %
     in it would show. The spring (K_x = 11.1 against ‖K̄‖ ≈ 5e8) is invisible in a random
     direction, so K̄ is also applied to the rigid translation along the belt, which changes no
     penetration: R is exactly linear along it and K̄ δu = K_x at the spring's dof, nothing
-    else. Tolerance: the round-off sqrt(n) ε_mach ‖K̄‖_∞ (1 + ‖u‖_∞/h) / K_x ≈ 3e-7 of K_x
+    else. Tolerance: the round-off sqrt(n) u_mach ‖K̄‖_∞ (1 + ‖u‖_∞/h) / K_x ≈ 3e-7 of K_x
     (h = 10 cm); measured 2e-8 for both comparisons.
     C: R is linear in u̇ except for ψ'_ε(u̇_T - U_T), analytic within ε of any real slip
     speed, so the truncation is ≲ (h/ε)² = 1e-8 for h = 1e-5 cm/s (tolerance 10 times that);
@@ -234,8 +234,8 @@ def test_stiffness_is_symmetric_but_for_the_friction_coupling():
     symmetric, so K̄ - K̄ᵀ vanishes at μ = 0 and, at μ > 0, equals F - Fᵀ with F the derivative
     of the friction term alone.
 
-    Both sides are sums of the same element contributions; an entry is rounded at ε_mach
-    times the element entries it sums (≤ ‖K̄‖_F), so 1e-13 ‖K̄‖_F (≈ 500 ε_mach) is round-off
+    Both sides are sums of the same element contributions; an entry is rounded at u_mach
+    times the element entries it sums (≤ ‖K̄‖_F), so 1e-13 ‖K̄‖_F (≈ 500 u_mach) is round-off
     for the 126 × 126 matrix. Measured: 6.5e-17 ‖K̄‖_F for both (serial and 2 ranks), while
     the friction skew part is 2.4e-3 ‖K̄‖_F at μ = 0.5.
     """
@@ -272,7 +272,7 @@ def test_pep_finds_every_eigenvalue_in_the_disc_as_the_dense_solve_does(mu):
     2 κ(λ) (η_PEP + η_dense) where that is larger: a double-precision solve cannot pin an
     eigenvalue more closely than κ η. That happens for the spring mode only (|λ| ≈ 4.97):
     κ ≈ 1.6e9, because ‖K̄‖ ≈ 5e8 while the mode feels only K_x = 11.1, so both solves are
-    only good to κ ε_mach ≈ 4e-7 there. Measured: 3e-12 to 3e-11 for the five other modes;
+    only good to κ u_mach ≈ 4e-7 there. Measured: 3e-12 to 3e-11 for the five other modes;
     3.4e-8 for the spring mode (a 40-digit Newton refinement puts the PEP value 5e-10 and
     the dense value 3.4e-8 from the exact eigenvalue of the same matrices).
     """
@@ -352,10 +352,10 @@ def test_the_mass_is_assembled_again_only_when_the_density_changes():
 def test_distributed_eigenvalues_equal_the_serial_ones():
     """μ = 0.5 on COMM_WORLD (mesh split) and on COMM_SELF (each rank alone).
 
-    Both steady states are converged to the round-off floor sqrt(n) ε_mach ‖J‖ ‖u‖ of their
-    residual (SteadySolver), i.e. they are exact for operators perturbed by ≈ sqrt(n) ε_mach
+    Both steady states are converged to the round-off floor sqrt(n) u_mach ‖J‖ ‖u‖ of their
+    residual (SteadySolver), i.e. they are exact for operators perturbed by ≈ sqrt(n) u_mach
     relative, and each eigenvalue moves by κ(λ) times that. Tolerance: 1e-8, or
-    sqrt(n) κ ε_mach where larger — the spring mode only (κ ≈ 1.2e9: 2.9e-6). Measured:
+    sqrt(n) κ u_mach where larger — the spring mode only (κ ≈ 1.2e9: 2.9e-6). Measured:
     2.2e-9 for the spring mode, ≤ 4e-11 for the five others.
     """
     results = []
@@ -431,5 +431,5 @@ def test_a_subspace_size_given_in_the_options_is_kept_as_nev_grows():
     assert len(fixed_modes) == len(modes)
     for a in modes:  # the flutter pair ±Re λ has one modulus: match by distance, not order
         b = min(fixed_modes, key=lambda m, a=a: abs(m.value - a.value))
-        # the spring mode (|λ| ≈ 5) is conditioned to κ ε_mach ≈ 4e-7 (see the dense test)
+        # the spring mode (|λ| ≈ 5) is conditioned to κ u_mach ≈ 4e-7 (see the dense test)
         assert b.value == pytest.approx(a.value, rel=1e-6 if abs(a.value) < 10 else 1e-9)

@@ -46,7 +46,7 @@ def user_mu_at_belt_speed(speed, pressure):
 @pytest.mark.parametrize("regularisation", ["c1", "smooth"])
 def test_numpy_derivatives_of_the_user_law_are_its_central_differences(w, regularisation):
     """∂t/∂d and ∂t/∂w from dual numbers against central differences, h = 1e-6 of the variable:
-    truncation h² |t'''| and round-off ε_mach |t|/h, both below 1e-7 relative."""
+    truncation h² |t'''| and round-off u_mach |t|/h, both below 1e-7 relative."""
     law = LAW.replace(regularisation=regularisation)
     d = np.array([2e-5, 6e-5, 1e-4])
     dt_dd, dt_dw = law.friction_traction_derivatives(d, w)
@@ -284,7 +284,7 @@ def test_stiff_fe_block_with_the_user_law_has_the_rigid_blocks_eigenvalues():
     Every mode's gap falls too. At E × 100, 1e-3 is 2.5 times the measured gap, and far
     above the PEP's own error (relative residuals ≤ 1e-10, the spring's slow real mode,
     |λ| ≈ 0.14, the worst conditioned, off by 1e-5). Stiffer still the steady state's
-    round-off (ε_mach ‖J‖ ‖u‖, growing with E) takes over: 4-6e-5 at E × 10³ and 10⁴.
+    round-off (u_mach ‖J‖ ‖u‖, growing with E) takes over: 4-6e-5 at E × 10³ and 10⁴.
 
     Without the slope ∂μ/∂s the eigenvalues are others: with the user's μ frozen at the belt
     speed (the same μ(U, p), the same steady state, the same K̄) the spring mode is the

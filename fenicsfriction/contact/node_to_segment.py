@@ -54,7 +54,7 @@ __all__ = ["FORMULATIONS", "ContactOperator", "NodalValues", "NodeToSegment",
 
 #: the contact laws: ``"compliance"`` (normal compliance, friction regularised on the slip
 #: rate: Martins & Oden 1986) and ``"perturbed-lagrangian"`` (Pop, eq. 27: normal and
-#: tangential penalties ε_N = c_n, κ_T with their multipliers eliminated node by node)
+#: tangential penalties κ_N = c_n, κ_T with their multipliers eliminated node by node)
 FORMULATIONS = ("compliance", "perturbed-lagrangian")
 
 Value = typing.Any
@@ -82,7 +82,7 @@ class NodeToSegment:
         frozen: keep the pairing of the first search (derivative tests).
         formulation: one of :data:`FORMULATIONS`. The perturbed Lagrangian's multipliers
             are nodal and enter their own equations quadratically, so they are eliminated at
-            each slave node: λ_N = ε_N (-g)_+ (linear compliance, ``c_n`` = ε_N, m_n = 1) and
+            each slave node: λ_N = κ_N (-g)_+ (linear compliance, ``c_n`` = κ_N, m_n = 1) and
             λ_T = κ_T times the slip increment from the last committed λ_T (:meth:`commit`),
             returned to μλ_N in slide. The law's ε is then unused.
         penalty_T: the tangential penalty κ_T [force/length³] (perturbed Lagrangian).

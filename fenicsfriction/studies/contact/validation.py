@@ -220,7 +220,7 @@ class Cattaneo(Hertz):
         q_ratio: Q / (μ P), in [0, 1).
         increments: load increments of Q (the quasi-static path; the stick zone only shrinks).
         formulation: ``"compliance"`` (the regularised law) or ``"perturbed-lagrangian"``
-            (Pop, eq. 27: penalties ε_N = the law's ``c_n`` and κ_T = ``penalty_T``
+            (Pop, eq. 27: penalties κ_N = the law's ``c_n`` and κ_T = ``penalty_T``
             [force/length³]).
     """
 
