@@ -72,7 +72,7 @@ _EXPORTS: dict[str, str] = {
     "table2_slider": "studies.oscillators", "stability_map": "studies.oscillators",
     "AveragedStability": "studies.oscillators", "FloquetStability": "studies.oscillators",
     "StabilityMap": "studies.oscillators",
-    # studies: the multi-contact interface
+    # studies: multicontact (Braun's many breaking contacts)
     "EQModel": "studies.multicontact", "MasterEquation": "studies.multicontact",
     "InteractingEQModel": "studies.multicontact", "FKChain": "studies.multicontact",
 }
