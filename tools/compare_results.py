@@ -59,7 +59,7 @@ def compare_json(a: object, b: object, where: str, out: dict) -> None:
             if k not in a or k not in b:
                 out["keys"].append(f"{where}/{k}: only {'after' if k in b else 'before'}")
                 continue
-            if TIMING.search(k):
+            if out["timing_key"].search(k):
                 if not _same(a[k], b[k]):
                     out["timing"] += 1
                 continue
@@ -82,7 +82,7 @@ def compare_csv(pa: pathlib.Path, pb: pathlib.Path, where: str, out: dict) -> No
         out["diff"].append(f"{where}: shape or header differs")
         return
     header = ra[0] if ra else []
-    skip = {i for i, h in enumerate(header) if TIMING.search(h)}
+    skip = {i for i, h in enumerate(header) if out["timing_key"].search(h)}
     for r, (x, y) in enumerate(zip(ra[1:], rb[1:], strict=True)):
         for c, (u, v) in enumerate(zip(x, y, strict=True)):
             if c in skip:
@@ -123,13 +123,17 @@ def main() -> int:
     parser.add_argument("after", type=pathlib.Path)
     parser.add_argument("--rename", action="append", default=[], metavar="OLD=NEW")
     parser.add_argument("--logs", nargs=2, action="append", default=[], type=pathlib.Path)
+    parser.add_argument("--timing", action="append", default=[], metavar="REGEX",
+                        help="more keys whose values are measured times or their ratios (a "
+                             "benchmark's own names, e.g. 'ratio$')")
     parser.add_argument("--nested", action="append", default=[], metavar="KEY",
                         help="a sub-record (e.g. law) whose entries were recorded one level up "
                              "before")
     args = parser.parse_args()
     renames = [tuple(r.split("=", 1)) for r in args.rename]
     out: dict = {"diff": [], "keys": [], "timing": 0, "numbers": 0, "files": 0, "missing": [],
-                 "nested": tuple(args.nested)}
+                 "nested": tuple(args.nested),
+                 "timing_key": re.compile("|".join([TIMING.pattern, *args.timing]), re.I)}
     for pa in sorted(args.before.rglob("*")):
         if pa.suffix not in (".json", ".csv"):
             continue
