@@ -88,5 +88,5 @@ benchmark: setup
 	$(PY) benchmarks/bench_slider.py --out $(OUT)/benchmarks
 
 clean:
-	rm -rf .venv .venv-debian13 results *.egg-info
+	rm -rf .venv .venv-debian13 results build docs/_generated *.egg-info
 	@echo "(the Debian 13 chroot .debian13/ is kept: rm -rf .debian13 removes it)"
