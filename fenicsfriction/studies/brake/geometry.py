@@ -139,13 +139,16 @@ def _sector(occ: typing.Any, r_in: float, r_out: float, angle: float, z0: float,
 
 
 def _classify(gmsh: typing.Any, volume: int, rules: dict[int, typing.Callable]) -> dict:
-    """The boundary faces of ``volume`` sorted by the first rule (tag -> test of the face's
-    centre of mass) they pass; faces passing none are left out."""
+    """The boundary faces of ``volume`` sorted by the first rule they pass (tag -> test of the
+    face's centre of mass and of its largest distance to the axis, from its bounding box: a
+    whole cylinder has its centre on the axis); faces passing none are left out."""
     found: dict[int, list[int]] = {tag: [] for tag in rules}
     for _, face in gmsh.model.getBoundary([(3, volume)], oriented=False):
         x, y, z = gmsh.model.occ.getCenterOfMass(2, face)
+        box = gmsh.model.getBoundingBox(2, face)
+        reach = max(abs(box[0]), abs(box[1]), abs(box[3]), abs(box[4]))
         for tag, rule in rules.items():
-            if rule(x, y, z):
+            if rule(x, y, z, reach):
                 found[tag].append(face)
                 break
     return found
@@ -178,21 +181,19 @@ def brake(comm: MPI.Comm, h: float = 0.006, geometry: BrakeGeometry | None = Non
         pad_out = _sector(occ, g.pad_r_in, g.pad_r_out, g.pad_angle, half, tp)
         occ.synchronize()  # no fragment: the bodies keep their own faces and nodes
 
-        def radius(x: float, y: float) -> float:
-            return math.hypot(x, y)
-
         faces = _classify(gmsh, disc, {
-            DISC_TOP: lambda x, y, z: abs(z - half) < tol,
-            DISC_BOTTOM: lambda x, y, z: abs(z + half) < tol,
-            DISC_HUB: lambda x, y, z: abs(z) < tol and radius(x, y) < g.r_hub})
+            DISC_TOP: lambda x, y, z, reach: abs(z - half) < tol,
+            DISC_BOTTOM: lambda x, y, z, reach: abs(z + half) < tol,
+            # the bounding box of a cylinder is its radius, up to gmsh's tolerance
+            DISC_HUB: lambda x, y, z, reach: reach < 0.5 * (g.r_hub + g.r_disc)})
         for volume, face, back, abutment, sign in (
                 (pad_in, PAD_IN_FACE, PAD_IN_BACK, PAD_IN_ABUTMENT, -1),
                 (pad_out, PAD_OUT_FACE, PAD_OUT_BACK, PAD_OUT_ABUTMENT, 1)):
             faces.update(_classify(gmsh, volume, {
-                face: lambda x, y, z, s=sign: abs(z - s * half) < tol,
-                back: lambda x, y, z, s=sign: abs(z - s * (half + tp)) < tol,
+                face: lambda x, y, z, reach, s=sign: abs(z - s * half) < tol,
+                back: lambda x, y, z, reach, s=sign: abs(z - s * (half + tp)) < tol,
                 # the end faces are planes through the axis: their centres at angle ±α/2
-                abutment: lambda x, y, z: abs(abs(math.degrees(math.atan2(y, x)))
+                abutment: lambda x, y, z, reach: abs(abs(math.degrees(math.atan2(y, x)))
                                               - g.pad_angle / 2) < 1e-3}))
         for tag, entities in ((DISC, [disc]), (PAD_IN, [pad_in]), (PAD_OUT, [pad_out])):
             gmsh.model.addPhysicalGroup(3, entities, tag)

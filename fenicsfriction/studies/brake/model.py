@@ -94,7 +94,7 @@ FRICTION_MATERIAL = Solid(E=8e9, nu=0.25, rho=2500.0)
 def default_law(mu: float = 0.0) -> laws.InterfaceLaw:
     """The pad-disc interface: linear normal compliance c_n = 1e13 Pa/m (a contact layer ten
     times stiffer than a 10 mm pad, E/t = 8e11 Pa/m), Coulomb friction μ regularised over
-    ε = 1e-3 m/s (a thousandth of the sliding speed at the default ω)."""
+    ε = 1e-3 m/s (a ten-thousandth of the sliding speed at the default ω)."""
     return laws.InterfaceLaw(c_n=1e13, m_n=1.0, mu=mu, eps=1e-3)
 
 
@@ -106,7 +106,10 @@ class BrakeModel:
         law: the interface law (its μ is the starting value of :attr:`mu`, a ``fem.Constant``
             that a sweep changes without compiling again); default :func:`default_law`.
         pressure: the pressure on the pads' backs [Pa].
-        omega: the disc's angular velocity [rad/s], counter-clockwise about +z.
+        omega: the disc's angular velocity [rad/s], counter-clockwise about +z (default 100:
+            11 m/s at the pads' mean radius). It enters through the friction's viscous part
+            μp/|w| only, which damps the modes that slide the pads on the disc: at 10 rad/s
+            it suppresses the instabilities that 100 rad/s shows up to μ = 0.8.
         disc, pad: the solids (default grey cast iron and a friction material).
 
     Attributes:
@@ -117,7 +120,7 @@ class BrakeModel:
     """
 
     def __init__(self, mesh: BrakeMesh, law: laws.InterfaceLaw | None = None,
-                 pressure: float = 1e6, omega: float = 10.0, disc: Solid = CAST_IRON,
+                 pressure: float = 1e6, omega: float = 100.0, disc: Solid = CAST_IRON,
                  pad: Solid = FRICTION_MATERIAL):
         laws.check_positive("pressure", pressure)
         law = law or default_law()
@@ -175,6 +178,12 @@ class BrakeModel:
     def stability(self) -> StabilitySolver:
         """The quadratic eigenproblem at the current state (prefix ``brake_pep_``)."""
         return StabilitySolver(self.residual, prefix="brake_pep_")
+
+    def pencil(self) -> tuple[typing.Any, typing.Any, typing.Any]:
+        """(M, C, K̄) assembled at the current state (PETSc matrices of :attr:`stability`,
+        overwritten by the next call)."""
+        self.stability.assemble()
+        return self.stability.M, self.stability.C, self.stability.K
 
     def _press(self) -> None:
         """Move each pad rigidly onto the disc by the penetration that carries the pressure
