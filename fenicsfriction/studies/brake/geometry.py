@@ -49,11 +49,30 @@ __all__ = ["DISC", "DISC_BOTTOM", "DISC_HUB", "DISC_TOP", "NAMES", "PAD_IN", "PA
            "PAD_IN_BACK", "PAD_IN_FACE", "PAD_OUT", "PAD_OUT_ABUTMENT", "PAD_OUT_BACK",
            "PAD_OUT_FACE", "BrakeGeometry", "BrakeMesh", "brake"]
 
-DISC, PAD_IN, PAD_OUT = 1, 2, 3
-DISC_HUB, DISC_TOP, DISC_BOTTOM = 10, 11, 12
-PAD_IN_FACE, PAD_OUT_FACE = 20, 21
-PAD_IN_BACK, PAD_OUT_BACK = 22, 23
-PAD_IN_ABUTMENT, PAD_OUT_ABUTMENT = 24, 25
+#: cell tag of the disc
+DISC = 1
+#: cell tag of the inboard pad (z < 0)
+PAD_IN = 2
+#: cell tag of the outboard pad (z > 0)
+PAD_OUT = 3
+#: facet tag of the disc's inner cylinder, clamped
+DISC_HUB = 10
+#: facet tag of the disc's face z = +h/2, the outboard pad's master surface
+DISC_TOP = 11
+#: facet tag of the disc's face z = -h/2, the inboard pad's master surface
+DISC_BOTTOM = 12
+#: facet tag of the inboard pad's friction face (slave)
+PAD_IN_FACE = 20
+#: facet tag of the outboard pad's friction face (slave)
+PAD_OUT_FACE = 21
+#: facet tag of the inboard pad's back, under the pressure
+PAD_IN_BACK = 22
+#: facet tag of the outboard pad's back, under the pressure
+PAD_OUT_BACK = 23
+#: facet tag of the inboard pad's two radial end faces, held in their plane
+PAD_IN_ABUTMENT = 24
+#: facet tag of the outboard pad's two radial end faces, held in their plane
+PAD_OUT_ABUTMENT = 25
 
 #: the physical groups' names
 NAMES = {DISC: "disc", PAD_IN: "pad-in", PAD_OUT: "pad-out", DISC_HUB: "disc-hub",

@@ -62,7 +62,7 @@ from fenicsfriction.studies.brake.geometry import (
     BrakeMesh,
 )
 
-__all__ = ["BrakeModel", "Solid", "default_law"]
+__all__ = ["CAST_IRON", "FRICTION_MATERIAL", "BrakeModel", "Solid", "default_law"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -241,6 +241,42 @@ class BrakeModel:
         """The contact force on each pad [N], rows (inboard, outboard), columns x, y, z (all
         ranks)."""
         return self.comm.allreduce(np.array([f.sum(axis=0) for f in self.nodal_forces()]))
+
+    @functools.cached_property
+    def _body_masses(self) -> dict[str, typing.Any]:
+        import dolfinx.fem.petsc
+
+        dx = ufl.Measure("dx", domain=self.mesh.mesh, subdomain_data=self.mesh.cell_tags)
+        w, v = ufl.TrialFunction(self.V), ufl.TestFunction(self.V)
+        masses = {}
+        for name, tag, solid in (("disc", DISC, self.solids["disc"]),
+                                 ("pad-in", PAD_IN, self.solids["pad"]),
+                                 ("pad-out", PAD_OUT, self.solids["pad"])):
+            A = dolfinx.fem.petsc.assemble_matrix(
+                _compat.form(solid.rho * ufl.inner(w, v) * dx(tag)))
+            A.assemble()
+            masses[name] = A
+        return masses
+
+    def kinetic_shares(self, vector: np.ndarray) -> dict[str, float]:
+        r"""How a mode's kinetic energy splits between the bodies: :math:`\phi^H M_b \phi /
+        \phi^H M \phi` for the disc and each pad (``vector``: this rank's owned entries, e.g.
+        a :class:`~fenicsfriction.stability.Mode`'s), the same on every rank. A disc mode has
+        nearly all of it in the disc."""
+        masses = self._body_masses
+        x, y = next(iter(masses.values())).createVecs()
+        energy = {}
+        for name, A in masses.items():
+            total = 0.0
+            for part in (vector.real, vector.imag):
+                x.setArray(part)
+                A.mult(x, y)
+                total += x.dot(y)
+            energy[name] = total
+        x.destroy()
+        y.destroy()
+        whole = sum(energy.values())
+        return {name: value / whole for name, value in energy.items()}
 
     def load(self) -> float:
         """The pressure's resultant on one pad's back [N] (p times the meshed area)."""
