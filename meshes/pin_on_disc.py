@@ -2,7 +2,6 @@
 tetrahedra) as a gmsh mesh with named physical groups:
 ``python meshes/pin_on_disc.py --out results/pin_on_disc.msh --refine 1``."""
 
-import pathlib
 import time
 
 from mpi4py import MPI

@@ -30,7 +30,6 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import typing
 
 from mpi4py import MPI
 
@@ -75,10 +74,15 @@ class PinOnDisc:
 
     Args:
         material: both bodies' material.
-        law: the interface law: c_n [N/m³] (linear compliance, m_n = 1, a spring c_n per unit
-            area of the pin's face: 1e14 N/m³ makes the face's springs as stiff as the
-            elements of the mesh beside it, their compliance 1e-8 m under the load), μ and
-            ε [m/s] (ε ≪ ω R_p).
+        law: the interface law: c_n [N/m³] (linear compliance, m_n = 1: a spring c_n per unit
+            area of the pin's face), μ and ε [m/s] (ε ≪ ω R_p). The default c_n = 1e11 N/m³,
+            a face stiffness c_n A = 5e6 N/m, is the compliance of a layer of friction
+            material (E/t for E of a few GPa over some 10 mm). It is not stiffer for a reason:
+            a flat face in full contact takes a share κ/(1 + κ), κ = c_n L / E, of the
+            friction's bending moment μ N L/2 on the pin, and lifts off at one edge once that
+            exceeds N r/4, that is for μ ≳ r/(2 L) (1 + κ)/κ. With c_n = 1e14 (κ = 24) the
+            face lifts off from μ ≈ 0.04 and Newton stalls on the shrinking contact; with 1e11
+            (κ = 0.024) the face stays in full contact up to μ ≈ 1.7.
         pressure: the axial pressure on the pin's top, p [Pa] (the normal load is p π r²).
         omega: the disc's angular velocity ω [rad/s], about +e_z.
         holder: the holder's stiffness across the pin's axis per unit area of the held side,
@@ -87,7 +91,7 @@ class PinOnDisc:
     """
 
     material: Steel = Steel()
-    law: laws.InterfaceLaw = laws.InterfaceLaw(c_n=1e14, m_n=1.0, eps=1e-3)
+    law: laws.InterfaceLaw = laws.InterfaceLaw(c_n=1e11, m_n=1.0, eps=1e-3)
     pressure: float = 1e6
     omega: float = 10.0
     holder: float = 1e13
