@@ -29,6 +29,5 @@ if __name__ == "__main__":
     print(f"{args.out}: {m.mesh.topology.index_map(3).size_global} tetrahedra, {vertices} "
           f"vertices ({3 * vertices} unknowns), {time.perf_counter() - start:.1f} s")
     for tag, name in geometry.NAMES.items():
-        data = m.cell_tags if tag in (geometry.DISC, geometry.PAD_IN, geometry.PAD_OUT) \
-            else m.facet_tags
+        data = m.cell_tags if tag < 10 else m.facet_tags
         print(f"  {name} = {tag}: {int(np.count_nonzero(data.values == tag))}")

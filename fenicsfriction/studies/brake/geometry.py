@@ -1,37 +1,43 @@
 r"""The simplified disc brake's mesh: an annular disc and two pads pressed on its faces.
 
-The disc is an annulus (inner radius ``r_hub``, outer ``r_disc``, thickness ``thickness``)
-centred on the z axis, its mid-plane z = 0, clamped on its inner cylinder (the hub). It is
-described in Eulerian form: the mesh does not turn, the rotation enters only through the
-disc's velocity at the contact (the transport velocity of the friction law). The two pads are
-annular sectors (radii ``pad_r_in``, ``pad_r_out``, opening ``pad_angle`` about the +x axis,
-thickness ``pad_thickness``) lying on the disc's faces: the inboard pad under z = -h/2, the
-outboard pad over z = +h/2. No backplate: the pressure acts on the pads' backs.
+The disc is the brake-squeal scenes' shared disc
+(:func:`fenicsfriction.studies.squeal.geometry.add_disc`, tagged by
+:func:`~fenicsfriction.studies.squeal.geometry.disc_groups`): an annulus about the z
+axis (inner radius ``r_hub``, outer ``r_disc``), its top face z = 0, its bottom z =
+-``thickness``, clamped on its inner cylinder (the hub). It is described in Eulerian form: the
+mesh does not turn, the rotation enters only through the disc's velocity at the contact (the
+transport velocity of the friction law). The two pads are annular sectors (radii
+``pad_r_in``, ``pad_r_out``, opening ``pad_angle`` about the +x axis, thickness
+``pad_thickness``) lying on the disc's faces: the outboard pad on the top face, the inboard
+pad under the bottom one. No backplate: the pressure acts on the pads' backs.
 
 The three bodies are meshed apart (no common node: the meshes do not match on the contact
 faces) with tetrahedra of size ``h`` (degree-1 geometry), on rank 0 of ``comm``, and read into
 one distributed dolfinx mesh.
 
-Tags (module constants; the gmsh physical groups carry the names in brackets):
+Tags (the disc's are those of :mod:`fenicsfriction.studies.squeal.geometry`; the gmsh physical
+groups carry the names in brackets):
 
-==================  =====  =======================================================
-name                value  entities
-==================  =====  =======================================================
-:data:`DISC`        1      the disc's cells (``disc``)
-:data:`PAD_IN`      2      the inboard pad's cells (``pad-in``)
-:data:`PAD_OUT`     3      the outboard pad's cells (``pad-out``)
-:data:`DISC_HUB`    10     the disc's inner cylinder, clamped (``disc-hub``)
-:data:`DISC_TOP`    11     the disc's face z = +h/2, master of the outboard pad (``disc-top``)
-:data:`DISC_BOTTOM` 12     the disc's face z = -h/2, master of the inboard pad (``disc-bottom``)
-:data:`PAD_IN_FACE` 20     the inboard pad's friction face, slave (``pad-in-face``)
-:data:`PAD_OUT_FACE` 21    the outboard pad's friction face, slave (``pad-out-face``)
-:data:`PAD_IN_BACK` 22     the inboard pad's back, under pressure (``pad-in-back``)
-:data:`PAD_OUT_BACK` 23    the outboard pad's back, under pressure (``pad-out-back``)
-:data:`PAD_IN_ABUTMENT` 24   the inboard pad's two radial end faces (``pad-in-abutment``)
-:data:`PAD_OUT_ABUTMENT` 25  the outboard pad's two radial end faces (``pad-out-abutment``)
-==================  =====  =======================================================
+=========================  =====  ================================================================
+name                       value  entities
+=========================  =====  ================================================================
+``DISC``                   1      the disc's cells (``disc``)
+:data:`PAD_IN`             2      the inboard pad's cells (``pad-in``)
+:data:`PAD_OUT`            3      the outboard pad's cells (``pad-out``)
+``DISC_HUB``               10     the disc's inner cylinder, clamped (``disc-hub``)
+``DISC_TOP``               11     the disc's face z = 0, master of the outboard pad (``disc-top``)
+``DISC_BOTTOM``            12     the face z = -thickness, master of the inboard pad
+                                  (``disc-bottom``)
+``DISC_RIM``               13     the disc's outer cylinder, free (``disc-rim``)
+:data:`PAD_IN_FACE`        20     the inboard pad's friction face, slave (``pad-in-face``)
+:data:`PAD_OUT_FACE`       21     the outboard pad's friction face, slave (``pad-out-face``)
+:data:`PAD_IN_BACK`        22     the inboard pad's back, under pressure (``pad-in-back``)
+:data:`PAD_OUT_BACK`       23     the outboard pad's back, under pressure (``pad-out-back``)
+:data:`PAD_IN_ABUTMENT`    24     the inboard pad's two radial end faces (``pad-in-abutment``)
+:data:`PAD_OUT_ABUTMENT`   25     the outboard pad's two radial end faces (``pad-out-abutment``)
+=========================  =====  ================================================================
 
-The disc's rim and the pads' cylindrical sides are free and untagged.
+The pads' cylindrical sides are free and untagged.
 """
 
 from __future__ import annotations
@@ -44,23 +50,25 @@ from mpi4py import MPI
 
 from fenicsfriction import laws
 from fenicsfriction.meshing import gmsh_mesh
+from fenicsfriction.studies.squeal.geometry import (
+    DISC,
+    DISC_BOTTOM,
+    DISC_HUB,
+    DISC_RIM,
+    DISC_TOP,
+    Disc,
+    add_disc,
+    disc_groups,
+)
 
-__all__ = ["DISC", "DISC_BOTTOM", "DISC_HUB", "DISC_TOP", "NAMES", "PAD_IN", "PAD_IN_ABUTMENT",
-           "PAD_IN_BACK", "PAD_IN_FACE", "PAD_OUT", "PAD_OUT_ABUTMENT", "PAD_OUT_BACK",
-           "PAD_OUT_FACE", "BrakeGeometry", "BrakeMesh", "brake"]
+__all__ = ["NAMES", "PAD_IN", "PAD_IN_ABUTMENT", "PAD_IN_BACK", "PAD_IN_FACE", "PAD_OUT",
+           "PAD_OUT_ABUTMENT", "PAD_OUT_BACK", "PAD_OUT_FACE", "BrakeGeometry", "BrakeMesh",
+           "brake"]
 
-#: cell tag of the disc
-DISC = 1
 #: cell tag of the inboard pad (z < 0)
 PAD_IN = 2
 #: cell tag of the outboard pad (z > 0)
 PAD_OUT = 3
-#: facet tag of the disc's inner cylinder, clamped
-DISC_HUB = 10
-#: facet tag of the disc's face z = +h/2, the outboard pad's master surface
-DISC_TOP = 11
-#: facet tag of the disc's face z = -h/2, the inboard pad's master surface
-DISC_BOTTOM = 12
 #: facet tag of the inboard pad's friction face (slave)
 PAD_IN_FACE = 20
 #: facet tag of the outboard pad's friction face (slave)
@@ -76,7 +84,8 @@ PAD_OUT_ABUTMENT = 25
 
 #: the physical groups' names
 NAMES = {DISC: "disc", PAD_IN: "pad-in", PAD_OUT: "pad-out", DISC_HUB: "disc-hub",
-         DISC_TOP: "disc-top", DISC_BOTTOM: "disc-bottom", PAD_IN_FACE: "pad-in-face",
+         DISC_TOP: "disc-top", DISC_BOTTOM: "disc-bottom", DISC_RIM: "disc-rim",
+         PAD_IN_FACE: "pad-in-face",
          PAD_OUT_FACE: "pad-out-face", PAD_IN_BACK: "pad-in-back", PAD_OUT_BACK: "pad-out-back",
          PAD_IN_ABUTMENT: "pad-in-abutment", PAD_OUT_ABUTMENT: "pad-out-abutment"}
 
@@ -158,16 +167,13 @@ def _sector(occ: typing.Any, r_in: float, r_out: float, angle: float, z0: float,
 
 
 def _classify(gmsh: typing.Any, volume: int, rules: dict[int, typing.Callable]) -> dict:
-    """The boundary faces of ``volume`` sorted by the first rule they pass (tag -> test of the
-    face's centre of mass and of its largest distance to the axis, from its bounding box: a
-    whole cylinder has its centre on the axis); faces passing none are left out."""
+    """The boundary faces of a pad ``volume`` sorted by the first rule (tag -> test of the
+    face's centre of mass) they pass; faces passing none are left out."""
     found: dict[int, list[int]] = {tag: [] for tag in rules}
     for _, face in gmsh.model.getBoundary([(3, volume)], oriented=False):
         x, y, z = gmsh.model.occ.getCenterOfMass(2, face)
-        box = gmsh.model.getBoundingBox(2, face)
-        reach = max(abs(box[0]), abs(box[1]), abs(box[3]), abs(box[4]))
         for tag, rule in rules.items():
-            if rule(x, y, z, reach):
+            if rule(x, y, z):
                 found[tag].append(face)
                 break
     return found
@@ -188,31 +194,25 @@ def brake(comm: MPI.Comm, h: float = 0.006, geometry: BrakeGeometry | None = Non
     """
     laws.check_positive("h", h)
     g = geometry or BrakeGeometry()
-    half, tp = g.thickness / 2, g.pad_thickness
+    disc_shape = Disc(inner_radius=g.r_hub, outer_radius=g.r_disc, thickness=g.thickness)
+    top, bottom, tp = 0.0, -g.thickness, g.pad_thickness
     tol = 1e-6 * g.r_disc
 
     def construct(gmsh: typing.Any) -> None:
         occ = gmsh.model.occ
-        disc_outer = occ.addCylinder(0, 0, -half, 0, 0, g.thickness, g.r_disc)
-        hub = occ.addCylinder(0, 0, -half, 0, 0, g.thickness, g.r_hub)
-        (_, disc), = occ.cut([(3, disc_outer)], [(3, hub)])[0]
-        pad_in = _sector(occ, g.pad_r_in, g.pad_r_out, g.pad_angle, -half - tp, tp)
-        pad_out = _sector(occ, g.pad_r_in, g.pad_r_out, g.pad_angle, half, tp)
+        disc = add_disc(gmsh, disc_shape)
+        pad_in = _sector(occ, g.pad_r_in, g.pad_r_out, g.pad_angle, bottom - tp, tp)
+        pad_out = _sector(occ, g.pad_r_in, g.pad_r_out, g.pad_angle, top, tp)
         occ.synchronize()  # no fragment: the bodies keep their own faces and nodes
-
-        faces = _classify(gmsh, disc, {
-            DISC_TOP: lambda x, y, z, reach: abs(z - half) < tol,
-            DISC_BOTTOM: lambda x, y, z, reach: abs(z + half) < tol,
-            # the bounding box of a cylinder is its radius, up to gmsh's tolerance
-            DISC_HUB: lambda x, y, z, reach: reach < 0.5 * (g.r_hub + g.r_disc)})
-        for volume, face, back, abutment, sign in (
-                (pad_in, PAD_IN_FACE, PAD_IN_BACK, PAD_IN_ABUTMENT, -1),
-                (pad_out, PAD_OUT_FACE, PAD_OUT_BACK, PAD_OUT_ABUTMENT, 1)):
+        faces = disc_groups(gmsh, disc_shape, disc)
+        for volume, face, back, abutment, z_face, z_back in (
+                (pad_in, PAD_IN_FACE, PAD_IN_BACK, PAD_IN_ABUTMENT, bottom, bottom - tp),
+                (pad_out, PAD_OUT_FACE, PAD_OUT_BACK, PAD_OUT_ABUTMENT, top, top + tp)):
             faces.update(_classify(gmsh, volume, {
-                face: lambda x, y, z, reach, s=sign: abs(z - s * half) < tol,
-                back: lambda x, y, z, reach, s=sign: abs(z - s * (half + tp)) < tol,
+                face: lambda x, y, z, zf=z_face: abs(z - zf) < tol,
+                back: lambda x, y, z, zb=z_back: abs(z - zb) < tol,
                 # the end faces are planes through the axis: their centres at angle ±α/2
-                abutment: lambda x, y, z, reach: abs(abs(math.degrees(math.atan2(y, x)))
+                abutment: lambda x, y, z: abs(abs(math.degrees(math.atan2(y, x)))
                                               - g.pad_angle / 2) < 1e-3}))
         for tag, entities in ((DISC, [disc]), (PAD_IN, [pad_in]), (PAD_OUT, [pad_out])):
             gmsh.model.addPhysicalGroup(3, entities, tag)

@@ -47,10 +47,6 @@ from fenicsfriction.rotation import RigidRotation
 from fenicsfriction.stability import StabilitySolver
 from fenicsfriction.steady import SteadySolver
 from fenicsfriction.studies.brake.geometry import (
-    DISC,
-    DISC_BOTTOM,
-    DISC_HUB,
-    DISC_TOP,
     PAD_IN,
     PAD_IN_ABUTMENT,
     PAD_IN_BACK,
@@ -61,6 +57,7 @@ from fenicsfriction.studies.brake.geometry import (
     PAD_OUT_FACE,
     BrakeMesh,
 )
+from fenicsfriction.studies.squeal.geometry import DISC, DISC_BOTTOM, DISC_HUB, DISC_TOP
 
 __all__ = ["CAST_IRON", "FRICTION_MATERIAL", "BrakeModel", "Solid", "default_law"]
 
