@@ -9,8 +9,13 @@ bisected to ``--tol`` in μ (μ_crit), and the two modes that coupled are named 
 frequencies at the stable end and their kinetic energy in the disc.
 
 Recorded per mesh: the unknowns, the lowest ``--count`` frequencies at μ = 0, μ_crit and the
-coupled pair, the growth rate at the last μ, the wall time. Between the meshes: each
-frequency's observed order of convergence from three successive meshes,
+coupled pair, the growth rate at the last μ, the wall time; and the frequencies of the disc
+alone (clamped at its hub, no pad) on the same mesh, whose doublets would be exact pairs on a
+cyclically symmetric mesh: their split is the tetrahedral mesh's own asymmetry, to be
+compared with the split of the brake's pair, which sets μ_crit. The table gives both splits
+near the coupled pair (without an onset, near the brake's two closest frequencies).
+
+Between the meshes: each frequency's observed order of convergence from three successive meshes,
 p = log(|f₁ − f₂| / |f₂ − f₃|) / log(h₁/h₂) (degree-1 tetrahedra: 2 for eigenvalues, in
 theory), and the change of μ_crit.
 
@@ -27,15 +32,61 @@ import time
 from mpi4py import MPI
 
 import numpy as np
+import ufl
 from _common import parser as benchmark_parser
 from _common import save
+from dolfinx import fem
 
-from fenicsfriction import cea
+from fenicsfriction import _compat, cea, forms
 from fenicsfriction.results import get_logger, to_plain, write_summary
 from fenicsfriction.studies.brake import geometry, model
+from fenicsfriction.studies.squeal.geometry import DISC, DISC_HUB
 
 SIZES = [0.006, 0.0048, 0.00384]
 MUS = [0.0, 0.025, 0.05, 0.075, 0.1, 0.15, 0.2, 0.3]
+
+
+def disc_alone(brake: model.BrakeModel, count: int) -> list[float]:
+    """The lowest ``count`` frequencies [Hz] of the disc alone on the brake's mesh: its
+    stiffness and mass, the hub clamped and every pad node held."""
+    import dolfinx.fem.petsc
+
+    mesh, V = brake.mesh, brake.V
+    dx = ufl.Measure("dx", domain=mesh.mesh, subdomain_data=mesh.cell_tags)
+    w, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+    disc = brake.solids["disc"]
+    pads = np.isin(mesh.cell_tags.values, (geometry.PAD_IN, geometry.PAD_OUT))
+    hub = mesh.facet_tags.indices[mesh.facet_tags.values == DISC_HUB]
+    held = np.unique(np.concatenate([
+        _compat.cell_dofs(V, mesh.cell_tags.indices[pads]),
+        fem.locate_dofs_topological(V, 2, hub)]))
+    bc = fem.dirichletbc(np.zeros(3), held, V)
+    # over every cell (the held pads' rows become identity rows: their pattern must exist)
+    pad = brake.solids["pad"]
+    stiffness = forms.elasticity(w, v, disc.E, disc.nu, dx(DISC)) + sum(
+        forms.elasticity(w, v, pad.E, pad.nu, dx(tag)) for tag in (geometry.PAD_IN,
+                                                                   geometry.PAD_OUT))
+    mass = forms.inertia(disc.rho, w, v, dx(DISC)) + sum(
+        forms.inertia(pad.rho, w, v, dx(tag)) for tag in (geometry.PAD_IN, geometry.PAD_OUT))
+    K = dolfinx.fem.petsc.assemble_matrix(_compat.form(stiffness), [bc])
+    M = dolfinx.fem.petsc.assemble_matrix(_compat.form(mass), [bc], 0.0)
+    K.assemble()
+    M.assemble()
+    basis = cea.ModalBasis(K, M, modes=count, prefix="brake_disc_")
+    return basis.frequencies.tolist()
+
+
+def split(frequencies: list[float], near: float) -> float:
+    """The gap between the two frequencies of ``frequencies`` nearest ``near`` [Hz]."""
+    a, b = sorted(sorted(frequencies, key=lambda f: abs(f - near))[:2])
+    return b - a
+
+
+def closest_pair(frequencies: list[float]) -> float:
+    """The mean frequency of the two nearest neighbours (the doublet most nearly merged)."""
+    f = np.sort(frequencies)
+    i = int(np.argmin(np.diff(f)))
+    return float(0.5 * (f[i] + f[i + 1]))
 
 
 def run(h: float, args, comm: MPI.Comm, say) -> dict:
@@ -59,9 +110,11 @@ def run(h: float, args, comm: MPI.Comm, say) -> dict:
         pair = [next(m for m in sweep.modes[step] if m.ident == ident) for ident in first.modes]
         shares = [brake.kinetic_shares(m.vector)["disc"] for m in pair]
         onset = {**to_plain(sweep.refine(first, args.tol)), "disc_share": shares}
+    alone = disc_alone(brake, args.count + 4)
     last = sweep.modes[-1]
     growing = max(last, key=lambda m: m.value.real)
     record = {"h": h, "dofs": brake.dofs, "frequencies": frequencies, "onset": onset,
+              "disc_alone": alone,
               "growth_at_last_mu": [growing.value.real, growing.value.imag / (2 * math.pi)],
               "records": sweep.records, "wall_time_s": time.perf_counter() - t0}
     say(f"h = {h * 1e3:.2f} mm: {brake.dofs} unknowns, μ_crit "
@@ -126,16 +179,19 @@ def main(argv=None) -> None:
         args.out.mkdir(parents=True, exist_ok=True)
         plot(runs, args.out / "brake_convergence.png")
         print("\n| h [mm] | unknowns | f₁ … f₆ at μ = 0 [Hz] | μ_crit | coupled pair [Hz] "
-              "(disc share) | wall [s] |\n|---|---|---|---|---|---|")
+              "(disc share) | pair's split at μ = 0 [Hz] | disc alone: split [Hz] | wall [s] |\n"
+              "|---|---|---|---|---|---|---|---|")
         for r in runs:
             o = r["onset"]
             pair = "—" if o is None else ", ".join(
                 f"{f:.0f} ({s:.2f})" for f, s in zip(o["frequencies"], o["disc_share"],
                                                      strict=True))
             crit = "—" if o is None else f"{o['p_crit']:.4f}"
+            near = o["frequency"] if o else closest_pair(r["frequencies"])
             print(f"| {r['h'] * 1e3:.2f} | {r['dofs']:,} | "
                   + ", ".join(f"{f:.0f}" for f in r["frequencies"][:6])
-                  + f" | {crit} | {pair} | {r['wall_time_s']:.0f} |")
+                  + f" | {crit} | {pair} | {split(r['frequencies'], near):.1f} | "
+                  f"{split(r['disc_alone'], near):.1f} | {r['wall_time_s']:.0f} |")
         for k, p in enumerate(rates):
             print(f"\norder from meshes {k + 1}-{k + 3}: "
                   + ", ".join(f"{x:.2f}" for x in p))

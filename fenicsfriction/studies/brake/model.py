@@ -12,9 +12,8 @@ regularised Coulomb friction on the slip velocity
 the last term the disc's rigid rotation (:class:`fenicsfriction.rotation.RigidRotation`). The
 disc is Eulerian: its mesh does not turn and its material moves through it, an approximation
 that keeps the disc's own inertia as that of a disc at rest (no gyroscopic or centrifugal
-terms; they grow as ω and ω² and are small at braking speeds, Ouyang, Mottershead et al.
-1998). This is the usual complex eigenvalue analysis of brake squeal (Kinkaid, O'Reilly &
-Papadopoulos 2003).
+terms, which grow as ω and ω²). This is the usual complex eigenvalue analysis of brake squeal
+(reviewed by Kinkaid, O'Reilly & Papadopoulos 2003, J. Sound Vib. 267, 105-166).
 
 Supports: the disc is clamped on its hub; each pad is held in its plane (x and y) on its two
 radial end faces, the abutments of the caliper, and free along the axis, where the pressure
