@@ -38,6 +38,7 @@ __all__ = [
     "model_to_mesh",
     "nodal_quadrature",
     "petsc_vec",
+    "read_msh",
     "scalar_function_space",
     "vector_function_space",
     "write_meshtags",
@@ -218,6 +219,23 @@ def model_to_mesh(model: typing.Any, comm: MPI.Comm, rank: int,
     except ImportError:
         reader = importlib.import_module("dolfinx.io.gmshio")
     data = reader.model_to_mesh(model, comm, rank, gdim=gdim)
+    if hasattr(data, "mesh"):
+        return data.mesh, data.cell_tags, data.facet_tags
+    msh, cell_tags, facet_tags = data
+    return msh, cell_tags, facet_tags
+
+
+def read_msh(path: str, comm: MPI.Comm, rank: int,
+             gdim: int) -> tuple[mesh.Mesh, mesh.MeshTagsMetaClass, mesh.MeshTagsMetaClass]:
+    """A gmsh ``.msh`` file (read on ``rank``) as a distributed mesh with its cell and facet
+    tags: ``read_from_msh`` of ``dolfinx.io.gmshio`` up to 0.9 (a tuple) and of
+    ``dolfinx.io.gmsh`` from 0.10 (a ``MeshData``)."""
+    import importlib
+    try:
+        reader = importlib.import_module("dolfinx.io.gmsh")  # dolfinx >= 0.10
+    except ImportError:
+        reader = importlib.import_module("dolfinx.io.gmshio")
+    data = reader.read_from_msh(path, comm, rank, gdim=gdim)
     if hasattr(data, "mesh"):
         return data.mesh, data.cell_tags, data.facet_tags
     msh, cell_tags, facet_tags = data
