@@ -92,7 +92,7 @@ def generated_mesh(case: Case, comm: MPI.Comm) -> tuple[mesh.Mesh, mesh.MeshTags
     Returns:
         (mesh, cell tags, facet tags, body name -> cell tag, "BODY.SIDE" -> facet tag); body
         ``i`` (from 0, in the case's order) has cell tag ``i + 1`` and its sides facet tags
-        ``10 (i + 1) + k``, k = 1..6 in the order left, right, bottom, top, back, front.
+        ``10 (i + 1) + k``, k = 1..6 in the order xmin, xmax, ymin, ymax, zmin, zmax.
     """
     dim, degree = case.model["dim"], case.model["degree"]
     bodies = list(case.bodies.items())

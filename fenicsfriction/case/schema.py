@@ -37,9 +37,9 @@ __all__ = ["ANALYSES", "CONTINUABLE", "Case", "CaseError", "interface_law", "rea
 CONTINUABLE = ("mu", "c_n", "b_n", "g", "eps", "load_scale", "speed", "omega")
 #: the analyses a case can ask for, in the order they run
 ANALYSES = ("steady", "cea", "transient")
-#: the sides of the generated shapes: name -> (axis, 0 at the lower end / 1 at the upper)
-SIDES = {"left": (0, 0), "right": (0, 1), "bottom": (1, 0), "top": (1, 1),
-         "back": (2, 0), "front": (2, 1)}
+#: the sides of the generated shapes, "BODY.SIDE": name -> (axis, 0 the lower end, 1 the upper)
+SIDES = {"xmin": (0, 0), "xmax": (0, 1), "ymin": (1, 0), "ymax": (1, 1),
+         "zmin": (2, 0), "zmax": (2, 1)}
 #: the components by name
 COMPONENTS = {"x": 0, "y": 1, "z": 2}
 
@@ -392,8 +392,8 @@ def _body(c: _Checker, t: Table, where: str, model: Table) -> Table:
 class _Surfaces:
     """Resolves the surface and body names of supports, loads and contacts.
 
-    A generated body's sides are ``"BODY.SIDE"`` (SIDE one of :data:`SIDES`, back/front in
-    3D); a gmsh body's surfaces are physical groups of dimension dim - 1, by name or number,
+    A generated body's sides are ``"BODY.SIDE"`` (SIDE one of :data:`SIDES`, zmin/zmax in
+    3D only); a gmsh body's surfaces are physical groups of dimension dim - 1, by name or number,
     checked against the file later (:func:`_check_groups`).
     """
 
