@@ -59,7 +59,7 @@ class _Checker:
 
     def fail(self, key: str, value: typing.Any, allowed: str) -> typing.NoReturn:
         shown = value if isinstance(value, str) and value.startswith("<") else repr(value)
-        raise CaseError(f"{self.path}: {key} = {shown} is invalid: {allowed}")
+        raise CaseError(f"{self.path}: {key}={shown} is invalid: {allowed}")
 
     def keys(self, table: Table, where: str, allowed: typing.Iterable[str],
              required: typing.Iterable[str] = ()) -> None:
@@ -240,6 +240,12 @@ def read_case(path: str | pathlib.Path, make_mesh: bool = True) -> Case:
     if generated and len(generated) < len(bodies):
         c.fail("bodies", sorted(bodies), "either every body is generated (shape) or every body "
                "is a physical group of mesh.file (group)")
+    boxes = [(n, b["axes"]) for n, b in bodies.items() if "shape" in b]
+    for i, (first, a) in enumerate(boxes):
+        for second, b in boxes[i + 1:]:
+            if all(x[0] < y[-1] and y[0] < x[-1] for x, y in zip(a, b, strict=True)):
+                c.fail(f"bodies.{second}", "<shape>", f"overlaps bodies.{first}: generated "
+                       "bodies may touch but not overlap")
     mesh = None
     if not generated:
         c.keys(data, "", TOP_KEYS, required=("mesh",))
@@ -266,6 +272,11 @@ def read_case(path: str | pathlib.Path, make_mesh: bool = True) -> Case:
         case.steady = _steady(c, c.table(data.get("steady", {}), "steady"), case)
     if "cea" in data:
         case.cea = _cea(c, c.table(data["cea"], "cea"), case)
+    damped = [n for n, b in bodies.items() if b["modal_damping"] is not None]
+    if damped and (case.cea is None or case.cea["method"] != "projection"):
+        c.fail(f"bodies.{damped[0]}.modal_damping", bodies[damped[0]]["modal_damping"],
+               "modal damping is defined on the modal basis of cea.method = 'projection' "
+               "only (use rayleigh_alpha/rayleigh_beta for the full problem)")
     if "transient" in data:
         if case.cea is None:
             c.fail("transient", "<table>", "needs a [cea] table: it starts from the steady "
@@ -585,6 +596,12 @@ def _contact(c: _Checker, t: Table, where: str, surfaces: _Surfaces, model: Tabl
                 c.fail(f"{where}.foundation.normal", contact["normal"],
                        f"a rotating plane foundation turns about its normal: must be parallel "
                        f"to motion.axis = {a}")
+        if motion is not None and motion["type"] == "translation" and t.get("moving", True):
+            n, v = contact["normal"], motion["velocity"]
+            if abs(sum(a * b for a, b in zip(n, v, strict=True))) > 1e-12 * math.hypot(
+                    *n) * math.hypot(*v):
+                c.fail("motion.velocity", v, f"a plane foundation slides in its plane: must be "
+                       f"orthogonal to {where}.foundation.normal = {n}")
         if motion is not None and motion["type"] == "rotation" and dim == 2:
             c.fail("motion.type", "rotation", "a rigid plane foundation cannot rotate in 2D: "
                    "mesh the rotating body and use a body-to-body contact (slave, master)")
