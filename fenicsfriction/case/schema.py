@@ -650,11 +650,14 @@ def _steady(c: _Checker, t: Table, case: Case) -> Table:
             "max_halvings": c.number(t, "max_halvings", "steady", 8, low=0, integer=True)}
 
 
-def _check_parameter(c: _Checker, case: Case, name: str, value: float) -> None:
+def _check_parameter(c: _Checker, case: Case, name: str, value: float,
+                     where: str = "steady.values") -> None:
     """A value of the continued parameter, checked as the law (or the motion) checks it."""
-    where = f"steady.values (parameter {name})"
     if name in case.law:
-        _checked_law(c, {**case.law, name: value}, where)
+        try:
+            interface_law({**case.law, name: value})
+        except ValueError as err:
+            c.fail(where, value, f"{name}: {str(err).partition(' is invalid: ')[2] or err}")
     elif name == "omega" and value == 0:
         c.fail(where, value, "must be nonzero")
     elif name == "speed" and value <= case.law["eps"]:
@@ -690,7 +693,7 @@ def _transient(c: _Checker, t: Table, case: Case) -> Table:
         c.fail("transient.dt", dt, f"must be <= t_end = {t_end:g}")
     assert case.steady is not None
     at = c.number(t, "at", "transient", case.steady["values"][-1])
-    _check_parameter(c, case, case.parameter, at)
+    _check_parameter(c, case, case.parameter, at, "transient.at")
     return {"at": at, "amplitude": c.number(t, "amplitude", "transient", low=0, strict_low=True),
             "t_end": t_end, "dt": dt,
             "stride": c.number(t, "stride", "transient", 10, low=1, integer=True)}
