@@ -39,12 +39,14 @@ import itertools
 
 from mpi4py import MPI
 
+import dolfinx.fem.petsc
 import numpy as np
 import pytest
 import ufl
 from dolfinx import fem
 
 from fenicsfriction import _compat, forms
+from fenicsfriction.meshing import annulus
 from fenicsfriction.rotation import RigidRotation
 from fenicsfriction.stability import StabilitySolver
 
@@ -68,28 +70,6 @@ def thin_ring(n: int, h: float) -> float:
 def bryan(n: int) -> float:
     """(ω_+ - ω_-)/(2Ω) in the space-fixed frame: n(n² - 1)/(n² + 1)."""
     return n * (n**2 - 1) / (n**2 + 1)
-
-
-def annulus(comm: MPI.Comm, r_in: float, r_out: float, n_radial: int, n_around: int):
-    """Nine-node quadrilaterals on the exact (r, θ) grid, periodic in θ (all on rank 0)."""
-    if comm.rank == 0:
-        n_r, n_t = 2 * n_radial + 1, 2 * n_around
-        r, t = np.meshgrid(np.linspace(r_in, r_out, n_r), np.arange(n_t) * np.pi / n_around,
-                           indexing="ij")
-        x = np.column_stack([(r * np.cos(t)).ravel(), (r * np.sin(t)).ravel()])
-
-        def node(i, j):
-            return i * n_t + j % n_t
-
-        # dolfinx's order: vertices (0,0) (1,0) (0,1) (1,1), edge midpoints of the reference
-        # edges (0,1) (0,2) (1,3) (2,3), centre; ξ radial, η along θ
-        cells = np.array([[node(i, j), node(i + 2, j), node(i, j + 2), node(i + 2, j + 2),
-                           node(i + 1, j), node(i, j + 1), node(i + 2, j + 1),
-                           node(i + 1, j + 2), node(i + 1, j + 1)]
-                          for i in range(0, 2 * n_radial, 2) for j in range(0, n_t, 2)])
-    else:
-        x, cells = np.zeros((0, 2)), np.zeros((0, 9), dtype=np.int64)
-    return _compat.create_mesh_from_arrays(comm, cells, x, "quadrilateral", degree=2)
 
 
 def ring(h_over_R: float, frame: str, mesh=None):
@@ -213,3 +193,44 @@ def test_eigenvalues_do_not_depend_on_the_partition(spectra):
     for spin, reference in SERIAL.items():
         for n, values in reference.items():
             assert spectra[0.05, "space", spin][n] == pytest.approx(values, rel=1e-9)
+
+
+def dense(A) -> np.ndarray:
+    """The whole of a (distributed) PETSc matrix as a NumPy array on every rank."""
+    rows = np.arange(*A.getOwnershipRange(), dtype=np.int32)
+    local = A.getValues(rows, np.arange(A.getSize()[1], dtype=np.int32))
+    return np.vstack(A.getComm().tompi4py().allgather(local))
+
+
+def assembled(form) -> np.ndarray:
+    A = dolfinx.fem.petsc.assemble_matrix(_compat.form(form))
+    A.assemble()
+    values = dense(A)
+    A.destroy()
+    return values
+
+
+def test_gyroscopic_matrix_is_skew_and_the_softening_symmetric_negative_semidefinite():
+    """G = -Gᵀ and -K_c = -K_cᵀ ≤ 0 to round-off, by construction. On the ring (w·n = 0) G
+    equals the form before integration by parts, 2ρ⟨(w·∇)u̇, v⟩, up to the boundary term
+    ∫ρ(w·n) u̇·v left by the degree-2 circles, whose w·n is O((2π/n_around)⁴) (measured
+    4.1e-5 with 24 elements around, 2.6e-6 with 48). (The softening has no such check: before
+    integration by parts it takes second derivatives, whose jumps between C⁰ elements it
+    misses.)"""
+    h = 0.05 * R
+    mesh = annulus(COMM, R - h / 2, R + h / 2, 1, 48)
+    area = COMM.allreduce(dolfinx.fem.assemble_scalar(_compat.form(1.0 * ufl.dx(mesh))))
+    assert area == pytest.approx(2 * np.pi * R * h, rel=1e-6)  # measured -6.1e-7
+    V = _compat.vector_function_space(mesh, 2)
+    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+    w = RigidRotation(omega=300.0).velocity(ufl.SpatialCoordinate(mesh))
+    dx = ufl.dx(mesh)
+    G = assembled(forms.gyroscopic(RHO, w, u, v, dx))
+    softening = assembled(forms.centrifugal_softening(RHO, w, u, v, dx))
+    scale_G, scale_K = np.abs(G).max(), np.abs(softening).max()
+    assert np.abs(G + G.T).max() < 1e-14 * scale_G  # measured 2.4e-16
+    assert np.abs(softening - softening.T).max() < 1e-14 * scale_K
+    eigenvalues = np.linalg.eigvalsh(softening)
+    assert eigenvalues.max() < 1e-14 * scale_K < -eigenvalues.min()
+    G_direct = assembled(2 * RHO * ufl.inner(forms.convective_derivative(w, u), v) * dx)
+    assert np.abs(G - G_direct).max() < 1e-5 * scale_G
