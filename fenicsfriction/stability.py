@@ -61,7 +61,7 @@ from fenicsfriction.numerics import bisect
 from fenicsfriction.petsc_options import options_with_defaults
 from fenicsfriction.results import Record
 
-__all__ = ["EigenSolveError", "Loci", "Mode", "Onset", "StabilitySolver", "mac",
+__all__ = ["EigenSolveError", "Eigensolver", "Loci", "Mode", "Onset", "StabilitySolver", "mac",
            "relative_residual", "track", "unstable_intervals"]
 
 DEFAULT_OPTIONS = {
@@ -342,6 +342,17 @@ def track(previous: list[Mode], current: list[Mode], comm: MPI.Comm,
     return next_ident
 
 
+class Eigensolver(typing.Protocol):
+    """What :class:`Loci` asks of its eigensolver: :class:`StabilitySolver`, or one that
+    projects it on a modal basis (:class:`fenicsfriction.cea.coupling_map.ProjectedStability`).
+    """
+
+    comm: MPI.Comm
+
+    def solve(self, max_modulus: float) -> list[Mode]:
+        """Every eigenvalue with |λ| <= ``max_modulus`` (Im λ >= 0), sorted by |λ|."""
+
+
 @dataclasses.dataclass
 class Onset(Record):
     """Where a mode starts to grow along a continuation (see :meth:`Loci.onset`).
@@ -377,13 +388,14 @@ class Loci:
 
     Args:
         steady: steady solver of the problem (its ``u`` is moved along the continuation).
-        stability: quadratic eigensolver of the same residual.
+        stability: quadratic eigensolver of the same residual (a :class:`StabilitySolver`
+            or any :class:`Eigensolver`).
         parameter: the ``fem.Constant`` continued.
         max_modulus: every eigenvalue with |λ| <= max_modulus is computed at each step.
         growth_tol: a mode is unstable when Re λ > growth_tol |λ|.
     """
 
-    def __init__(self, steady: typing.Any, stability: StabilitySolver, parameter: typing.Any,
+    def __init__(self, steady: typing.Any, stability: Eigensolver, parameter: typing.Any,
                  max_modulus: float,
                  growth_tol: float = 1e-6):
         check("growth_tol", growth_tol, growth_tol > 0, "must be > 0")
