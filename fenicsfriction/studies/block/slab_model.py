@@ -132,6 +132,12 @@ class SlabModel(BlockModel):
         """The volume measure of the slab."""
         return ufl.Measure("dx", domain=self.msh, subdomain_data=self.cell_tags)(SLAB)
 
+    def _friction_factor(self) -> fem.Constant | None:
+        """μ when the contact's friction bound is μ c_n; None otherwise (the contact's
+        friction has no factor of its own)."""
+        factor = super()._friction_factor()
+        return factor if factor is self.mu else None
+
     def _interface(self, u: fem.Function, u_dot: fem.Function, u_ddot: fem.Function,
                    v: ufl.Argument) -> tuple[ufl.Form, list]:
         """The slab's inertia and elasticity, and the block-slab contact (a coupling whose
