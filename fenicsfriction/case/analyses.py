@@ -46,7 +46,7 @@ from fenicsfriction.case.schema import Case
 if typing.TYPE_CHECKING:
     from fenicsfriction.stability import Mode, StabilitySolver
 
-__all__ = ["BandSolver", "Outcome", "growth_rate", "run_case"]
+__all__ = ["BandSolver", "ModallyDamped", "Outcome", "eigensolver", "growth_rate", "run_case"]
 
 
 @dataclasses.dataclass
@@ -96,6 +96,51 @@ class BandSolver:
         """The modes of the band (``max_modulus`` is the band's, 2π fmax)."""
         return [m for m in self.solver.solve(max_modulus)
                 if m.value.imag / (2 * math.pi) >= self.fmin]
+
+
+class ModallyDamped:
+    r"""Modal CEA with modal damping: the quadratic eigenproblem projected on the m lowest real
+    modes of the frictionless problem
+    (:class:`~fenicsfriction.cea.coupling_map.ProjectedStability`), with
+    :math:`\mathrm{diag}(2\zeta_i\omega_i)` added to the projected damping matrix
+    :math:`\Phi^T C \Phi` — the damping of each basis mode i, defined on the basis only (so
+    these pairs carry no residual against the full matrices: ``residual`` is NaN).
+
+    Args:
+        stability: the full solver (its matrices are assembled and projected).
+        modes: the number m of basis modes.
+        zeta: one ratio for every mode, or one per mode.
+        prefix: PETSc options prefix of the basis's EPS.
+    """
+
+    def __init__(self, stability: StabilitySolver, modes: int, zeta: typing.Sequence[float],
+                 prefix: str = "stability_basis_"):
+        from fenicsfriction.cea.coupling_map import ProjectedStability
+
+        self.projected = ProjectedStability(stability, modes, prefix=prefix)
+        self.comm = stability.comm
+        self.zeta = np.broadcast_to(np.asarray(zeta, dtype=float), (modes,))
+
+    def solve(self, max_modulus: float) -> list[Mode]:
+        """The projected eigenvalues with |λ| <= ``max_modulus`` (Im λ >= 0), by |λ|."""
+        from fenicsfriction.cea.dense import quadratic_eig
+        from fenicsfriction.stability import Mode
+
+        projected = self.projected
+        if projected.basis is None or not np.any(self.zeta):
+            modes = projected.solve(max_modulus)  # the first call computes the basis
+            if not np.any(self.zeta):
+                return modes
+        basis, solver = projected.basis, projected.stability
+        assert basis is not None
+        solver.assemble()
+        damping = np.diag(2 * self.zeta[:basis.size] * np.sqrt(np.maximum(basis.omega2, 0)))
+        values, q = quadratic_eig(basis.project(solver.M), basis.project(solver.C) + damping,
+                                  basis.project(solver.K))
+        modes = [Mode(value=complex(v), residual=float("nan"), accurate=True,
+                      vector=basis.phi @ q[:, i])
+                 for i, v in enumerate(values) if v.imag >= 0 and abs(v) <= max_modulus]
+        return sorted(modes, key=lambda m: abs(m.value))
 
 
 def growth_rate(time: np.ndarray, amplitude: np.ndarray) -> float:
@@ -197,17 +242,42 @@ def _progress(k: int, count: int, name: str, row: dict) -> str:
     return f"step {k:3d}/{count - 1}  {name}={row[name]:.6g}  {forces}"
 
 
+def eigensolver(case: Case, model: CaseModel, prefix: str = "stability_") -> BandSolver:
+    """The eigensolver of ``[cea]``: the full quadratic eigenproblem
+    (:class:`~fenicsfriction.stability.StabilitySolver`, with its friction switches) or its
+    projection on the real modes of the frictionless problem
+    (:class:`~fenicsfriction.cea.coupling_map.ProjectedStability`, with the modal damping), in
+    the band."""
+    from fenicsfriction.stability import StabilitySolver
+
+    cea = case.cea
+    assert cea is not None
+    full = StabilitySolver(model.residual, prefix=prefix,
+                           friction_stiffness=cea["friction_stiffness"],
+                           friction_damping=cea["friction_damping"])
+    if cea["method"] == "full":
+        return BandSolver(full, cea["band"])
+    return BandSolver(ModallyDamped(full, cea["modes"], cea["modal_damping"],
+                                    prefix=f"{prefix}basis_"), cea["band"])
+
+
 def _cea(case: Case, model: CaseModel, solver: typing.Any, outcome: Outcome, out: pathlib.Path,
          stop: typing.Any, log: logging.Logger, summary: typing.Callable[[str], None]) -> None:
-    from fenicsfriction.stability import Loci, StabilitySolver
+    from fenicsfriction.stability import Loci
 
     cea = case.cea
     assert cea is not None and case.steady is not None
     name, values = case.parameter, case.steady["values"]
-    band = BandSolver(StabilitySolver(model.residual, prefix="stability_"), cea["band"])
+    band = eigensolver(case, model)
     loci = Loci(solver, band, model.parameters[name], band.max_modulus, cea["growth_tol"])
     transitions: list[tuple[float, float, list]] = []
     previous: dict[str, typing.Any] = {}
+    bodies = None
+    if cea["contributions"] is not None:
+        from fenicsfriction.cea.contributions import FreeInterfaceModes
+        bodies = FreeInterfaceModes(model.residual, model.body_cells(), model.interface_tags,
+                                    modes=cea["contributions"])
+    contributions: list = []
     with results.CsvRows(out / "cea.csv", comm=model.msh.comm) as table, \
             results.CsvRows(out / "steady.csv", comm=model.msh.comm) as steady_table, \
             DisplacementWriter(out / "steady.xdmf", model) as fields, \
@@ -230,14 +300,26 @@ def _cea(case: Case, model: CaseModel, solver: typing.Any, outcome: Outcome, out
             if previous and growing and not loci.unstable(previous["modes"]):
                 transitions.append((previous["value"], value, previous["modes"]))
             if growing:
-                shapes.write(max(growing, key=lambda m: m.value.real), value)
+                worst = max(growing, key=lambda m: m.value.real)
+                shapes.write(worst, value)
+                if bodies is not None:
+                    contributions.append((value, bodies.contributions(worst)))
             previous.update(value=value, modes=modes)
             log.info(f"{_progress(k, len(values), name, row)}  {len(modes)} modes  max Re λ="
                      f"{record['max_re']:.4g}  growing: {[m.ident for m in growing]}")
             summary("in progress")
             stop.check(f"{name} = {value:.6g} (step {k} of {len(values) - 1})")
 
-        loci.follow(values, on_step=on_step)
+        try:
+            loci.follow(values, on_step=on_step)
+        finally:
+            if contributions:
+                from fenicsfriction.cea.contributions import plot_contributions
+                results.write_json(out / "contributions.json",
+                                   [{name: v, **c.to_json()} for v, c in contributions],
+                                   model.msh.comm)
+                plot_contributions([c for _, c in contributions], out / "contributions.png",
+                                   model.msh.comm)
     for stable, unstable, reference in transitions:
         onset = loci.onset(stable, unstable, cea["onset_tol"], reference=reference)
         outcome.onsets.append(onset)
@@ -250,7 +332,7 @@ def _cea(case: Case, model: CaseModel, solver: typing.Any, outcome: Outcome, out
 def _transient(case: Case, model: CaseModel, solver: typing.Any, outcome: Outcome,
                out: pathlib.Path, stop: typing.Any, log: logging.Logger) -> None:
     from fenicsfriction.dynamics import DynamicsSolver
-    from fenicsfriction.stability import StabilitySolver, is_unstable
+    from fenicsfriction.stability import is_unstable
     from fenicsfriction.steady import continuation
 
     tr, cea = case.transient, case.cea
@@ -258,7 +340,7 @@ def _transient(case: Case, model: CaseModel, solver: typing.Any, outcome: Outcom
     comm = model.msh.comm
     name = case.parameter
     continuation(solver, model.parameters[name], [tr["at"]])
-    band = BandSolver(StabilitySolver(model.residual, prefix="transient_pep_"), cea["band"])
+    band = eigensolver(case, model, prefix="transient_pep_")
     modes = band.solve(band.max_modulus)
     growing = [m for m in modes if is_unstable(m, cea["growth_tol"])]
     if not growing:

@@ -41,9 +41,12 @@ from fenicsfriction.forms import (
     NodalSpring,
     Residual,
     body_force,
+    centrifugal_softening,
+    centripetal_load,
     elastic_support,
     elasticity,
     friction,
+    gyroscopic,
     inertia,
     normal_compliance,
     normal_damping,
@@ -217,6 +220,11 @@ class CaseModel:
             if body["rayleigh_beta"] > 0:
                 terms.append(body["rayleigh_beta"] * elasticity(u_dot, v, E, nu, dxb,
                                                                  plane_stress))
+            if body["rotating"]:  # Eulerian: the mesh stays, the material turns through it
+                w = self.rotation.velocity(self.X)
+                terms.append(gyroscopic(rho, w, u_dot, v, dxb)
+                             + centrifugal_softening(rho, w, u, v, dxb)
+                             + centripetal_load(rho, w, v, dxb))
         bcs, self.springs = self._supports(terms, u, v)
         self._loads(terms, v)
         self.contacts: dict[str, dict[str, typing.Any]] = {}
@@ -227,9 +235,14 @@ class CaseModel:
             else:
                 self._bodies_contact(contact, u, u_dot)
         form = sum(terms[1:], terms[0])
+        # the friction terms are linear in μ when μ is the law's constant coefficient: the
+        # stability solver's friction switch sets it to 0 to drop their part of K̄ and C
+        linear_in_mu = self.with_friction and law.friction_coefficient is None and not \
+            isinstance(law.slip_rule, laws.EllipticSlipRule)
         self.residual = Residual(form=constant(self.thickness) * form, u=u, u_dot=u_dot,
                                  u_ddot=u_ddot, v=v, bcs=bcs, springs=self.springs,
-                                 couplings=list(self.node_to_segment))
+                                 couplings=list(self.node_to_segment),
+                                 friction=self.parameters["mu"] if linear_in_mu else None)
 
     # --- tags -------------------------------------------------------------------------------
     def _group(self, group: typing.Any, dim: int) -> int:
@@ -249,6 +262,18 @@ class CaseModel:
         nodes = _compat.cell_dofs(self.V, self.cell_tags.find(self.body_tags[name]))
         bs = self.V.dofmap.index_map_bs
         return (nodes[:, None] * bs + np.arange(bs)).ravel()
+
+    def body_cells(self) -> dict[str, np.ndarray]:
+        """Each body's cells on this rank (local indices), by name: the bodies of
+        :class:`fenicsfriction.cea.contributions.FreeInterfaceModes`."""
+        return {name: self.cell_tags.find(tag) for name, tag in self.body_tags.items()}
+
+    @property
+    def interface_tags(self) -> list[int]:
+        """The facet tags of the contacts with rigid foundations: their integrals are the
+        interface, left out of a body's own stiffness."""
+        return [self.surface_tag(c["surface"]) for c in self.case.contacts
+                if c["kind"] == "foundation"]
 
     def _surface_bodies(self, tag: int) -> list[str]:
         """The bodies whose cells touch the facets tagged ``tag`` (on every rank)."""

@@ -195,8 +195,7 @@ def _parameter_value(case: Case, name: str) -> float:
 
 TOP_KEYS = ("title", "model", "mesh", "bodies", "supports", "loads", "law", "contacts", "motion",
             *ANALYSES)
-MATERIAL_KEYS = ("E", "nu", "rho", "rayleigh_alpha", "rayleigh_beta", "modal_damping",
-                 "rotating")
+MATERIAL_KEYS = ("E", "nu", "rho", "rayleigh_alpha", "rayleigh_beta", "rotating")
 SHAPE_KEYS = ("shape", "origin", "size", "divisions", "x", "y", "z", "nodes_at")
 LAW_KEYS = ("c_n", "m_n", "mu", "m_T", "b_n", "l_n", "g", "eps", "regularisation",
             "friction_coefficient", "slip_rule")
@@ -272,11 +271,6 @@ def read_case(path: str | pathlib.Path, make_mesh: bool = True) -> Case:
         case.steady = _steady(c, c.table(data.get("steady", {}), "steady"), case)
     if "cea" in data:
         case.cea = _cea(c, c.table(data["cea"], "cea"), case)
-    damped = [n for n, b in bodies.items() if b["modal_damping"] is not None]
-    if damped and (case.cea is None or case.cea["method"] != "projection"):
-        c.fail(f"bodies.{damped[0]}.modal_damping", bodies[damped[0]]["modal_damping"],
-               "modal damping is defined on the modal basis of cea.method = 'projection' "
-               "only (use rayleigh_alpha/rayleigh_beta for the full problem)")
     if "transient" in data:
         if case.cea is None:
             c.fail("transient", "<table>", "needs a [cea] table: it starts from the steady "
@@ -338,16 +332,6 @@ def _body(c: _Checker, t: Table, where: str, model: Table) -> Table:
         "rayleigh_alpha": c.number(t, "rayleigh_alpha", where, 0.0, low=0),
         "rayleigh_beta": c.number(t, "rayleigh_beta", where, 0.0, low=0),
         "rotating": c.choice(t, "rotating", where, (False, True), default=False)}
-    zeta = t.get("modal_damping")
-    if zeta is not None:
-        values = zeta if isinstance(zeta, list) else [zeta]
-        if not values or not all(isinstance(z, (int, float)) and not isinstance(z, bool)
-                                 and math.isfinite(z) and 0 <= z < 1 for z in values):
-            c.fail(f"{where}.modal_damping", zeta,
-                   "must be a damping ratio ζ in [0, 1), or a list of them (one per mode)")
-        body["modal_damping"] = [float(z) for z in values]
-    else:
-        body["modal_damping"] = None
     if ("group" in t) == ("shape" in t):
         c.fail(where, "<table>", "give either group (a physical group of mesh.file) or shape "
                "(a generated rectangle or box)")
@@ -667,7 +651,9 @@ def _check_parameter(c: _Checker, case: Case, name: str, value: float,
 
 
 def _cea(c: _Checker, t: Table, case: Case) -> Table:
-    c.keys(t, "cea", ("method", "band", "modes", "growth_tol", "onset_tol"), required=("band",))
+    c.keys(t, "cea", ("method", "band", "modes", "modal_damping", "friction_stiffness",
+                      "friction_damping", "contributions", "growth_tol", "onset_tol"),
+           required=("band",))
     band = c.vector(t, "band", "cea", None, length=2)
     assert band is not None
     if not 0 <= band[0] < band[1]:
@@ -677,9 +663,34 @@ def _cea(c: _Checker, t: Table, case: Case) -> Table:
     onset_tol = c.number(t, "onset_tol", "cea", 1e-4, low=0, strict_low=True)
     if len(values) > 1 and onset_tol >= abs(values[-1] - values[0]):
         c.fail("cea.onset_tol", onset_tol, "must be smaller than the continuation's range")
-    return {"method": method, "band": band,
-            "modes": c.number(t, "modes", "cea", 40 if method == "projection" else None, low=1,
-                              integer=True),
+    for key in ("modes", "modal_damping"):
+        if key in t and method != "projection":
+            c.fail(f"cea.{key}", t[key], "is for cea.method = 'projection' only (the modal "
+                   "basis); use the bodies' rayleigh_alpha/rayleigh_beta with the full method")
+    zeta = t.get("modal_damping", 0.0)
+    ratios = zeta if isinstance(zeta, list) else [zeta]
+    if not ratios or not all(isinstance(z, (int, float)) and not isinstance(z, bool)
+                             and math.isfinite(z) and 0 <= z < 1 for z in ratios):
+        c.fail("cea.modal_damping", zeta,
+               "must be a damping ratio ζ in [0, 1), or a list of them (one per basis mode)")
+    modes = c.number(t, "modes", "cea", 40 if method == "projection" else None, low=1,
+                     integer=True)
+    if isinstance(zeta, list) and len(ratios) != modes:
+        c.fail("cea.modal_damping", zeta, f"must have one ratio per basis mode (cea.modes = "
+               f"{modes})")
+    switches = {key: c.choice(t, key, "cea", (True, False), default=True)
+                for key in ("friction_stiffness", "friction_damping")}
+    law = case.law
+    linear_in_mu = law["friction_coefficient"] is None and (
+        law["slip_rule"] is None or law["slip_rule"]["type"] == "coulomb")
+    for key, kept in switches.items():
+        if not kept and not linear_in_mu:
+            c.fail(f"cea.{key}", False, "dropping the friction part needs friction linear in "
+                   "law.mu (no friction_coefficient law, Coulomb's slip rule)")
+    return {"method": method, "band": band, "modes": modes,
+            "modal_damping": [float(z) for z in ratios] if method == "projection" else None,
+            **switches,
+            "contributions": c.number(t, "contributions", "cea", None, low=1, integer=True),
             "growth_tol": c.number(t, "growth_tol", "cea", 1e-6, low=0, strict_low=True),
             "onset_tol": onset_tol}
 
