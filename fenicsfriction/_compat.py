@@ -228,18 +228,35 @@ def model_to_mesh(model: typing.Any, comm: MPI.Comm, rank: int,
 def read_msh(path: str, comm: MPI.Comm, rank: int,
              gdim: int) -> tuple[mesh.Mesh, mesh.MeshTagsMetaClass, mesh.MeshTagsMetaClass]:
     """A gmsh ``.msh`` file (read on ``rank``) as a distributed mesh with its cell and facet
-    tags: ``read_from_msh`` of ``dolfinx.io.gmshio`` up to 0.9 (a tuple) and of
-    ``dolfinx.io.gmsh`` from 0.10 (a ``MeshData``)."""
+    tags. dolfinx 0.10's ``dolfinx.io.gmsh.read_from_msh``; before it, the file merged into a
+    gmsh model on ``rank`` and :func:`model_to_mesh` (0.5.2's ``gmshio.read_from_msh`` returns
+    an undefined name on the reading rank)."""
     import importlib
     try:
-        reader = importlib.import_module("dolfinx.io.gmsh")  # dolfinx >= 0.10
-    except ImportError:
-        reader = importlib.import_module("dolfinx.io.gmshio")
-    data = reader.read_from_msh(path, comm, rank, gdim=gdim)
-    if hasattr(data, "mesh"):
+        data = importlib.import_module("dolfinx.io.gmsh").read_from_msh(path, comm, rank,
+                                                                         gdim=gdim)
         return data.mesh, data.cell_tags, data.facet_tags
-    msh, cell_tags, facet_tags = data
-    return msh, cell_tags, facet_tags
+    except ImportError:
+        pass
+    model, error = None, None
+    if comm.rank == rank:
+        import gmsh
+        gmsh.initialize(readConfigFiles=False)
+        gmsh.option.setNumber("General.Terminal", 0)
+        try:
+            gmsh.model.add("fenicsfriction-msh")
+            gmsh.merge(str(path))
+            model = gmsh.model
+        except Exception as e:  # broadcast: the other ranks must not wait for the mesh
+            error = f"reading {path} with gmsh failed: {e}"
+    try:
+        error = comm.bcast(error, root=rank)
+        if error is not None:
+            raise RuntimeError(error)
+        return model_to_mesh(model, comm, rank, gdim)
+    finally:
+        if comm.rank == rank:
+            gmsh.finalize()
 
 
 def form(expr: ufl.Form, cache_dir: str | None = None) -> fem.FormMetaClass:

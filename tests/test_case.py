@@ -232,3 +232,64 @@ def test_a_complete_modal_basis_gives_the_full_eigenvalues_and_modal_damping_its
     for mode in solver.solve(solver.max_modulus):
         deviation = abs(mode.value.real / (-0.02 * abs(mode.value)) - 1)
         assert deviation < 1e-5
+
+
+#: a gmsh script of the convention of meshes/*.py (``--out FILE``): the block's 4 × 3 grid of
+#: quadrilaterals with named physical groups
+GMSH_SCRIPT = '''
+import argparse
+import gmsh
+out = argparse.ArgumentParser()
+out.add_argument("--out")
+path = out.parse_args().out
+gmsh.initialize(readConfigFiles=False)
+gmsh.option.setNumber("General.Terminal", 0)
+gmsh.model.add("block")
+L, H = 48.8, 30.5
+gmsh.model.occ.addRectangle(0, 0, 0, L, H)
+gmsh.model.occ.synchronize()
+names = {}
+for _, curve in gmsh.model.getEntities(1):
+    x, y, _ = gmsh.model.occ.getCenterOfMass(1, curve)
+    horizontal = abs(y) < 1e-9 or abs(y - H) < 1e-9
+    gmsh.model.mesh.setTransfiniteCurve(curve, 5 if horizontal else 4)
+    name = ("bottom" if y < 1e-9 else "top") if horizontal else ("left" if x < 1e-9 else "right")
+    names.setdefault(name, []).append(curve)
+gmsh.model.mesh.setTransfiniteSurface(1)
+gmsh.model.mesh.setRecombine(2, 1)
+gmsh.model.setPhysicalName(2, gmsh.model.addPhysicalGroup(2, [1]), "block")
+for name, curves in names.items():  # (gmsh 4.8 has no name= argument)
+    gmsh.model.setPhysicalName(1, gmsh.model.addPhysicalGroup(1, curves), name)
+gmsh.model.mesh.generate(2)
+gmsh.write(path)
+gmsh.finalize()
+'''
+
+
+def test_a_gmsh_mesh_made_by_its_script_gives_the_generated_block(shared_tmp_path):
+    """The block case on a .msh written by its mesh.script (the file missing at first), bodies
+    and surfaces named by physical group: the same mesh as the generated one, so the same
+    eigenvalues at μ = 0.5 (to the PEP's tolerance, as above)."""
+    pytest.importorskip("gmsh")
+    text = (ROOT / "cases" / "block-on-belt.toml").read_text()
+    text = text.replace("[bodies.block]", '[mesh]\nfile = "block.msh"\nscript = "block.py"\n\n'
+                        "[bodies.block]")
+    text = "\n".join(line for line in text.splitlines()
+                     if not line.startswith(("shape =", "origin =", "size =", "divisions =")))
+    text = text.replace("nodes_at = [[0.0, 15.25]]", 'group = "block"')
+    text = text.replace('"block.ymin"', '"bottom"')
+    write_case(shared_tmp_path, "block.py", GMSH_SCRIPT)
+    path = write_case(shared_tmp_path, "gmsh.toml", text)
+    case = read_case(path) if COMM.rank == 0 else None  # rank 0 runs the script
+    case = COMM.bcast(case, root=0)
+    assert (shared_tmp_path / "block.msh").is_file()
+    model = CaseModel(case, COMM)
+    model.initial_guess()
+    slide(model.residual, model.parameters["mu"], [0.0, 0.25, 0.5], "gmsh_")
+    generated = CaseModel(read_case(ROOT / "cases" / "block-on-belt.toml"), COMM)
+    generated.initial_guess()
+    slide(generated.residual, generated.parameters["mu"], [0.0, 0.25, 0.5], "generated_")
+    ours, theirs = spectrum(model.residual, "gmsh_pep_"), spectrum(generated.residual,
+                                                                   "generated_pep_")
+    assert len(ours) == 6
+    assert np.abs(ours - theirs).max() <= 1e-8 * np.abs(theirs).max(), (ours, theirs)
