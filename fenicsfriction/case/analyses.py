@@ -83,11 +83,11 @@ class BandSolver:
     bisects is the band's modes only.
 
     Args:
-        solver: the quadratic eigensolver.
+        solver: the quadratic eigensolver (full, or projected: :class:`ModallyDamped`).
         band: [fmin, fmax] [Hz]; the disc |λ| <= 2π fmax is solved.
     """
 
-    def __init__(self, solver: StabilitySolver, band: typing.Sequence[float]):
+    def __init__(self, solver: StabilitySolver | ModallyDamped, band: typing.Sequence[float]):
         self.solver, self.comm = solver, solver.comm
         self.fmin, self.fmax = band
         self.max_modulus = 2 * math.pi * self.fmax

@@ -192,7 +192,7 @@ class CaseModel:
         self.motion: typing.Any = None
         if case.motion is not None and case.motion["type"] == "translation":
             velocity = np.asarray(case.motion["velocity"])
-            self.parameters["speed"] = constant(np.linalg.norm(velocity))
+            self.parameters["speed"] = constant(float(np.linalg.norm(velocity)))
             self.motion = self.parameters["speed"] * ufl.as_vector(
                 velocity / np.linalg.norm(velocity))
         elif case.motion is not None:

@@ -276,7 +276,7 @@ def read_case(path: str | pathlib.Path, make_mesh: bool = True) -> Case:
             c.fail("transient", "<table>", "needs a [cea] table: it starts from the steady "
                    "state perturbed by the most unstable mode")
         case.transient = _transient(c, c.table(data["transient"], "transient"), case)
-    if case.motion is not None and motion["type"] == "translation" and law["eps"] >= math.hypot(
+    if motion is not None and motion["type"] == "translation" and law["eps"] >= math.hypot(
             *motion["velocity"]) and contacts:
         c.fail("law.eps", law["eps"], f"must be smaller than the sliding speed "
                f"|motion.velocity| = {math.hypot(*motion['velocity']):g} (ε is the width of the "
