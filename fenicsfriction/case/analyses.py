@@ -177,6 +177,7 @@ def run_case(case: Case, out: pathlib.Path, comm: MPI.Comm = MPI.COMM_WORLD,
     from fenicsfriction.signals import Interrupted, StopSignals
     from fenicsfriction.stability import EigenSolveError
     from fenicsfriction.steady import ContinuationError, SteadySolver
+    from fenicsfriction.timestepping import DynamicsError
 
     log = log or results.get_logger(comm)
     t_start = time.perf_counter()
@@ -193,22 +194,26 @@ def run_case(case: Case, out: pathlib.Path, comm: MPI.Comm = MPI.COMM_WORLD,
             "case": str(case.path), "title": case.title, "status": where,
             **outcome.to_json(), "wall_time_s": time.perf_counter() - t_start}, comm)
 
-    try:
-        with StopSignals(comm) as stop:
+    with StopSignals(comm) as stop:  # held to the last file: a late signal waits for it
+        try:
             if case.cea is None:
                 _steady(case, model, solver, outcome, out, stop, log)
             else:
                 _cea(case, model, solver, outcome, out, stop, log, summary)
                 if case.transient is not None and outcome.cea:
                     _transient(case, model, solver, outcome, out, stop, log)
-    except (ContinuationError, EigenSolveError) as err:
-        value = float(model.parameters[case.parameter].value)
-        outcome.failure = f"at {case.parameter} = {value:.6g}: {err}"
-        outcome.exit_code = 1
-    except Interrupted as err:
-        outcome.interrupted, outcome.exit_code = str(err), err.exit_code
-    _figures(case, outcome, out, comm)
-    summary("done" if outcome.exit_code == 0 else "stopped")
+        except (ContinuationError, EigenSolveError, DynamicsError) as err:
+            value = float(model.parameters[case.parameter].value)
+            outcome.failure = f"at {case.parameter} = {value:.6g}: {err}"
+            outcome.exit_code = 1
+        except Interrupted as err:
+            outcome.interrupted, outcome.exit_code = str(err), err.exit_code
+        _figures(case, outcome, out, comm)
+        signum = comm.allreduce(stop.received, op=MPI.MAX)
+        if signum and outcome.interrupted is None:  # after the last step: all is written
+            outcome.interrupted = str(Interrupted(signum, "the last step"))
+            outcome.exit_code = 128 + signum
+        summary("done" if outcome.exit_code == 0 else "stopped")
     comm.Barrier()
     return outcome
 
@@ -326,6 +331,7 @@ def _cea(case: Case, model: CaseModel, solver: typing.Any, outcome: Outcome, out
         log.info(f"onset at {name} = {onset.mu_crit:.6g}: λ = {onset.value[0]:.4g} + "
                  f"{onset.value[1]:.6g} i ({onset.value[1] / (2 * math.pi):.6g} Hz), modes "
                  f"{[c['mode'] for c in onset.colliding]}")
+        stop.check(f"the onset at {name} = {onset.mu_crit:.6g}")
     outcome.mu_crit = outcome.onsets[0].mu_crit if outcome.onsets else None
 
 
