@@ -8,7 +8,9 @@ steady|stability|dynamics``), :mod:`~fenicsfriction.cli.oscillators` (the reduce
 in contact: ``contact hertz|patch|cattaneo``), :mod:`~fenicsfriction.cli.rolling` (steady
 rolling: ``rolling fastsim|fe|curve``) and :mod:`~fenicsfriction.cli.multicontact` (Braun's
 interface of many contacts: ``multicontact eq|master-equation|stability-map|interaction|fk|
-slider``); :mod:`~fenicsfriction.cli.common` holds what they share once they run. The family
+slider``), and :mod:`~fenicsfriction.cli.run` runs a case file (``run CASE.toml``: one's
+own problem, docs/case-files.md); :mod:`~fenicsfriction.cli.common` holds what they share
+once they run. The family
 modules import MPI, PETSc and dolfinx inside their run functions, after the flags parse, so
 ``--help`` and a flag error answer at once.
 
