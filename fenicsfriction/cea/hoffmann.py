@@ -1,4 +1,4 @@
-"""The two-degree-of-freedom model of mode-coupling instability of Hoffmann, Fischer, Eberhard &
+"""The two-degree-of-freedom model of mode-coupling instability of Hoffmann, Fischer, Allgaier &
 Gaul (2002), "A minimal model for studying properties of the mode-coupling type instability in
 friction induced oscillations", and its flutter onsets in closed form (NumPy only).
 

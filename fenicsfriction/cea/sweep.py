@@ -32,17 +32,21 @@ class Coalescence(Record):
     """Where a tracked mode starts to grow, and the mode it coupled with.
 
     Attributes:
-        modes: the ids of the growing mode and of its partner.
+        growing: the id of the mode that grows past the onset.
+        modes: the ids of the two modes nearest its frequency at the stable end (the pair that
+            coalesces).
         interval: the sweep's values [stable, unstable] around the onset.
         onset: the bisected bracket [stable, unstable] (:meth:`Sweep.refine`), else the interval.
         p_crit: the midpoint of ``onset``.
         value: the growing eigenvalue [re, im] at the unstable end [1/s].
         frequency: its frequency Im λ / 2π [Hz].
-        frequencies: the two modes' frequencies [Hz] at the stable end.
-        gap: relative frequency gap |f_a - f_b| / mean(f) at the stable and the unstable end:
-            it shrinks to 0 as two undamped modes merge.
+        frequencies: the pair's frequencies [Hz] at the stable end.
+        gap: relative frequency gaps |f_a - f_b| / mean(f): of the pair at the stable end, and
+            of the growing mode and the mode nearest it at the unstable end (0 past the merging
+            of two undamped modes; damping keeps them apart).
     """
 
+    growing: int
     modes: list[int]
     interval: list[float]
     onset: list[float]
@@ -110,29 +114,27 @@ class Sweep:
         return [m for m in modes if is_unstable(m, self.growth_tol)]
 
     def coalescences(self) -> list[Coalescence]:
-        """Each step of the records where a tracked mode starts to grow, with its partner."""
+        """Each step of the records where a tracked mode starts to grow, with the pair of modes
+        nearest its frequency just before (the tracking is not relied on there: at a
+        coalescence the two eigenvectors merge and MAC cannot tell them apart)."""
         events = []
         for i in range(len(self.modes) - 1):
             before, after = self.modes[i], self.modes[i + 1]
             grown = {m.ident for m in self.unstable(before)}
             for mode in self.unstable(after):
-                if mode.ident in grown:
+                if mode.ident in grown or len(before) < 2:
                     continue
-                mine = next((m for m in before if m.ident == mode.ident), None)
-                f0 = (mine or mode).value.imag
-                others = [m for m in before if m.ident != mode.ident]
-                if not others:
-                    continue
-                partner = min(others, key=lambda m: abs(m.value.imag - f0))
-                partner_after = next((m for m in after if m.ident == partner.ident), None)
-                f1 = partner_after.value.imag if partner_after is not None else math.nan
+                f = mode.value.imag
+                pair = sorted(before, key=lambda m: abs(m.value.imag - f))[:2]
+                twins = [m.value.imag for m in after if m is not mode]
+                twin = min(twins, key=lambda g: abs(g - f)) if twins else math.nan
                 interval = [self.records[i]["p"], self.records[i + 1]["p"]]
                 events.append(Coalescence(
-                    modes=[mode.ident, partner.ident], interval=interval, onset=list(interval),
-                    p_crit=0.5 * sum(interval), value=[mode.value.real, mode.value.imag],
-                    frequency=mode.value.imag / (2 * math.pi),
-                    frequencies=[f0 / (2 * math.pi), partner.value.imag / (2 * math.pi)],
-                    gap=[_gap(f0, partner.value.imag), _gap(mode.value.imag, f1)]))
+                    growing=mode.ident, modes=[m.ident for m in pair], interval=interval,
+                    onset=list(interval), p_crit=0.5 * sum(interval),
+                    value=[mode.value.real, f], frequency=f / (2 * math.pi),
+                    frequencies=[m.value.imag / (2 * math.pi) for m in pair],
+                    gap=[_gap(pair[0].value.imag, pair[1].value.imag), _gap(f, twin)]))
         return events
 
     def refine(self, event: Coalescence, tol: float) -> Coalescence:
