@@ -99,7 +99,7 @@ def run(h: float, args, comm: MPI.Comm, say) -> dict:
         brake.solve_steady(mu)
         return solver.solve(*brake.pencil(), band, nev=32)
 
-    sweep = cea.Sweep(solve_at, comm)
+    sweep = cea.Sweep(solve_at, comm, growth_tol=args.growth_tol)
     sweep.follow(args.mu)
     frequencies = [m.value.imag / (2 * math.pi) for m in sweep.modes[0]][:args.count]
     events = sweep.coalescences()
@@ -167,6 +167,8 @@ def main(argv=None) -> None:
                         help="band's top [Hz] (default 3000: the n = 2 doublet and below)")
     parser.add_argument("--tol", type=float, default=0.0025, help="μ_crit's bracket width")
     parser.add_argument("--count", type=int, default=10, help="frequencies compared")
+    parser.add_argument("--growth-tol", type=float, default=1e-6,
+                        help="a mode grows when Re λ > growth_tol |λ| (default: %(default)s)")
     args = parser.parse_args(argv)
     logging.getLogger("ffcx").setLevel(logging.WARNING)
     logging.getLogger().addFilter(lambda record: record.levelno >= logging.WARNING)
@@ -196,7 +198,8 @@ def main(argv=None) -> None:
             print(f"\norder from meshes {k + 1}-{k + 3}: "
                   + ", ".join(f"{x:.2f}" for x in p))
     write_summary(args.out / "brake_convergence.json",
-                  {"fmax": args.fmax, "mu": args.mu, "tol": args.tol, "runs": runs,
+                  {"fmax": args.fmax, "mu": args.mu, "tol": args.tol,
+                   "growth_tol": args.growth_tol, "runs": runs,
                    "orders": rates, "total_s": time.perf_counter() - start}, comm)
     say(f"wrote {args.out / 'brake_convergence.json'} ({time.perf_counter() - start:.0f} s)")
 
