@@ -230,19 +230,20 @@ def form(expr: ufl.Form, cache_dir: str | None = None) -> fem.FormMetaClass:
 
 
 def create_mesh_from_arrays(comm: MPI.Comm, cells: np.ndarray, x: np.ndarray,
-                            cell_type: str) -> mesh.Mesh:
-    """A mesh of degree-1 cells of ``cell_type`` ("triangle", "quadrilateral", "tetrahedron",
-    "hexahedron") from arrays (given on any ranks, e.g. all on rank 0 and empty elsewhere),
-    partitioned by dolfinx. Quadrilateral and hexahedron vertices are in dolfinx's
-    tensor-product order (a quadrilateral's 0, 1, 2, 3 at (0,0), (1,0), (0,1), (1,1)), not
-    counter-clockwise. The coordinate element is a UFL ``VectorElement`` up to 0.6 and a
-    Basix element from 0.7."""
+                            cell_type: str, degree: int = 1) -> mesh.Mesh:
+    """A mesh of cells of ``cell_type`` ("triangle", "quadrilateral", "tetrahedron",
+    "hexahedron") and geometric ``degree`` from arrays (given on any ranks, e.g. all on rank 0
+    and empty elsewhere), partitioned by dolfinx. Nodes are in dolfinx's order: quadrilateral
+    and hexahedron vertices in tensor-product order (a quadrilateral's 0, 1, 2, 3 at (0,0),
+    (1,0), (0,1), (1,1)), not counter-clockwise; then, for degree 2, the edge midpoints in the
+    order of the reference cell's edges and the interior node. The coordinate element is a UFL
+    ``VectorElement`` up to 0.6 and a Basix element from 0.7."""
     gdim = x.shape[1]
     try:
         import basix.ufl
-        element = basix.ufl.element("Lagrange", cell_type, 1, shape=(gdim,))
+        element = basix.ufl.element("Lagrange", cell_type, degree, shape=(gdim,))
     except (ImportError, AttributeError):
-        element = ufl.VectorElement("Lagrange", cell_type, 1)
+        element = ufl.VectorElement("Lagrange", cell_type, degree)
     return mesh.create_mesh(comm, cells.astype(np.int64), x, ufl.Mesh(element))
 
 
