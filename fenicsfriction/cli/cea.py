@@ -282,8 +282,8 @@ def run_matrices(args: argparse.Namespace, log: logging.Logger) -> int:
             plot_coupling_map(sweep.records, out / f"coupling_map_{method}.png",
                               events.get(method, []), args.param_name)
         for e in events.get(method, []):
-            log.info(f"{method}: mode {e.growing} grows past {args.param_name} = {e.p_crit:.6g} "
-                     f"(bracket {e.onset[0]:.6g}-{e.onset[1]:.6g}) at {e.frequency:.6g} Hz, "
+            log.info(f"{method}: mode {e.growing} grows past {args.param_name} = {e.p_crit:.8g} "
+                     f"(bracket {e.onset[0]:.8g} to {e.onset[1]:.8g}) at {e.frequency:.6g} Hz, "
                      f"modes {e.modes} at relative frequency gap {e.gap[0]:.3g} -> "
                      f"{e.gap[1]:.3g}")
     comm.Barrier()
