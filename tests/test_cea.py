@@ -110,6 +110,26 @@ def test_band_solve_by_pep_agrees_with_dense_qz():
     assert all(band.contains(m.value) for m in pep)
 
 
+def test_band_solve_by_pep_agrees_with_dense_qz_on_a_random_sparse_pencil():
+    """n = 240, K an unsymmetric sparse random matrix made positive by its diagonal, C random
+    sparse, M a random positive diagonal: no structure for either solver to rely on."""
+    rng = np.random.default_rng(11)
+    n = 240
+    noise = scipy.sparse.random(n, n, density=0.02, random_state=rng)
+    K = (noise + scipy.sparse.diags(4.0 + rng.random(n))).tocsr() * 1e3
+    C = scipy.sparse.random(n, n, density=0.01, random_state=rng).tocsr()
+    M = scipy.sparse.diags(0.5 + rng.random(n)).tocsr()
+    band = Band(8.0, 9.0)  # the lowest 33 eigenvalues
+    solver = BandSolver(COMM, prefix=prefix("random"), dense_below=0)
+    pep = solver.solve(*(from_array(A, COMM) for A in (M, C, K)), band)
+    qz = dense_modes(M.toarray(), C.toarray(), K.toarray(), band)
+    assert len(pep) == len(qz) > 5
+    qz_values = values(qz)
+    nearest = qz_values[np.abs(values(pep)[:, None] - qz_values[None, :]).argmin(axis=1)]
+    assert np.allclose(values(pep), nearest, rtol=1e-8, atol=0)
+    assert max(m.residual for m in pep) < 1e-10
+
+
 def test_band_solve_on_a_mid_size_pencil_agrees_with_arpack():
     """n = 2000: SLEPc's PEP against ARPACK (scipy) on the companion pencil with a complex shift
     at the band's centre, an independent method and arithmetic."""

@@ -91,7 +91,8 @@ class ModalBasis:
         request = min(modes or 16, n)
         limit = math.inf if max_frequency is None else (2 * math.pi * max_frequency) ** 2
         while True:
-            self.eps.setDimensions(nev=request)
+            # ncv and mpd given each time: slepc4py >= 3.20 keeps the previous ones otherwise
+            self.eps.setDimensions(nev=request, ncv=PETSc.DECIDE, mpd=PETSc.DECIDE)
             self.eps.solve()
             count = self.eps.getConverged()
             values = sorted(self.eps.getEigenvalue(i).real for i in range(count))
