@@ -197,11 +197,16 @@ def run_matrices(args: argparse.Namespace, log: logging.Logger) -> int:
         solvers["full"] = lambda p: full.solve(*pencil.at(p), band)
     if "projection" in methods:
         t0 = time.perf_counter()
-        stiffness = symmetric_part(pencil.K0)
-        basis = ModalBasis(stiffness, pencil.M,
-                           modes=None if args.basis_frequency else min(args.modes or 40,
-                                                                       pencil.size),
-                           max_frequency=args.basis_frequency, prefix="cea_basis_")
+        try:
+            basis = ModalBasis(symmetric_part(pencil.K0), pencil.M,
+                               modes=None if args.basis_frequency
+                               else min(args.modes or 40, pencil.size),
+                               max_frequency=args.basis_frequency, prefix="cea_basis_")
+        except EigenSolveError as err:
+            results.write_summary(out / "summary.json", {"failure": f"modal basis: {err}"},
+                                  comm)
+            stop_line(f"modal basis: {err}")
+            return 1
         basis_time = time.perf_counter() - t0
         log.info(f"modal basis: {basis.size} modes of (sym K, M), {basis.frequencies[0]:.4g}-"
                  f"{basis.frequencies[-1]:.4g} Hz, in {basis_time:.3g} s")
