@@ -98,7 +98,7 @@ def test_companion_qz_gives_the_undamped_frequencies_in_closed_form():
 def test_band_solve_by_pep_agrees_with_dense_qz():
     """SLEPc's TOAR (forced even on a small system) and LAPACK's QZ find the same eigenvalues in
     the band, each with a small residual, and nothing outside it."""
-    parts = chain(150)
+    parts = chain(100)
     band = Band(2.0, 12.0)
     solver = BandSolver(COMM, prefix=prefix("pep"), dense_below=0)
     pep = solver.solve(*petsc(parts, 0.4), band)
@@ -111,10 +111,10 @@ def test_band_solve_by_pep_agrees_with_dense_qz():
 
 
 def test_band_solve_by_pep_agrees_with_dense_qz_on_a_random_sparse_pencil():
-    """n = 240, K an unsymmetric sparse random matrix made positive by its diagonal, C random
+    """n = 160, K an unsymmetric sparse random matrix made positive by its diagonal, C random
     sparse, M a random positive diagonal: no structure for either solver to rely on."""
     rng = np.random.default_rng(11)
-    n = 240
+    n = 160
     noise = scipy.sparse.random(n, n, density=0.02, random_state=rng)
     K = (noise + scipy.sparse.diags(4.0 + rng.random(n))).tocsr() * 1e3
     C = scipy.sparse.random(n, n, density=0.01, random_state=rng).tocsr()
