@@ -69,6 +69,14 @@ def chain(n: int, seed: int = 0) -> dict[str, scipy.sparse.csr_matrix]:
             "C0": scipy.sparse.diags(0.02 * masses).tocsr()}
 
 
+def sparse_random(n: int, density: float, rng: np.random.Generator) -> scipy.sparse.csr_matrix:
+    """An n × n matrix with about density·n² entries uniform in [0, 1) at random places
+    (scipy.sparse.random's seeding keyword differs between SciPy versions)."""
+    count = int(density * n * n)
+    rows, cols = rng.integers(0, n, count), rng.integers(0, n, count)
+    return scipy.sparse.csr_matrix((rng.random(count), (rows, cols)), shape=(n, n))
+
+
 def at(parts: dict, mu: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return (parts["M"].toarray(), parts["C0"].toarray(),
             (parts["K0"] + mu * parts["K1"]).toarray())
@@ -115,9 +123,9 @@ def test_band_solve_by_pep_agrees_with_dense_qz_on_a_random_sparse_pencil():
     sparse, M a random positive diagonal: no structure for either solver to rely on."""
     rng = np.random.default_rng(11)
     n = 160
-    noise = scipy.sparse.random(n, n, density=0.02, random_state=rng)
+    noise = sparse_random(n, 0.02, rng)
     K = (noise + scipy.sparse.diags(4.0 + rng.random(n))).tocsr() * 1e3
-    C = scipy.sparse.random(n, n, density=0.01, random_state=rng).tocsr()
+    C = sparse_random(n, 0.01, rng)
     M = scipy.sparse.diags(0.5 + rng.random(n)).tocsr()
     band = Band(8.0, 9.0)  # the lowest 33 eigenvalues
     solver = BandSolver(COMM, prefix=prefix("random"), dense_below=0)
@@ -225,7 +233,7 @@ def _write_on_rank0(write) -> None:
 
 
 def test_readers_round_trip_matrix_market_matlab_and_petsc_binary(shared_tmp_path):
-    A = scipy.sparse.random(9, 9, density=0.3, random_state=2, format="csr") + scipy.sparse.eye(9)
+    A = (sparse_random(9, 0.3, np.random.default_rng(2)) + scipy.sparse.eye(9)).tocsr()
     B = np.arange(81.0).reshape(9, 9)
     _write_on_rank0(lambda: scipy.io.mmwrite(str(shared_tmp_path / "A.mtx"), A))
     _write_on_rank0(lambda: scipy.io.savemat(str(shared_tmp_path / "one.mat"), {"K": A}))
