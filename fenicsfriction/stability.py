@@ -48,8 +48,8 @@ from fenicsfriction.numerics import bisect
 from fenicsfriction.petsc_options import options_with_defaults
 from fenicsfriction.results import Record
 
-__all__ = ["EigenSolveError", "Loci", "Mode", "Onset", "StabilitySolver", "mac", "track",
-           "unstable_intervals"]
+__all__ = ["EigenSolveError", "Loci", "Mode", "Onset", "StabilitySolver", "mac",
+           "relative_residual", "track", "unstable_intervals"]
 
 DEFAULT_OPTIONS = {
     "pep_type": "toar",
@@ -90,6 +90,45 @@ def mac(a: np.ndarray, b: np.ndarray, comm: MPI.Comm) -> float:
     """Modal assurance criterion ``|a^H b|² / ((a^H a)(b^H b))`` of distributed complex vectors."""
     ab, aa, bb = comm.allreduce(np.array([np.vdot(a, b), np.vdot(a, a), np.vdot(b, b)]))
     return float(abs(ab) ** 2 / (aa.real * bb.real))
+
+
+def relative_residual(operators: tuple[PETSc.Mat, PETSc.Mat, PETSc.Mat],
+                      norms: tuple[float, float, float], lam: complex, xr: PETSc.Vec,
+                      xi: PETSc.Vec) -> float:
+    """Relative residual of the eigenpair (λ, xr + i xi) of (λ²M + λC + K) w = 0 (module
+    docstring), in real arithmetic.
+
+    Args:
+        operators: the PETSc matrices ``(K, C, M)``.
+        norms: their infinity norms ``(‖K‖∞, ‖C‖∞, ‖M‖∞)``.
+        lam: the eigenvalue.
+        xr, xi: the real and imaginary parts of the eigenvector.
+    """
+    K, C, M = operators
+    a, b = lam.real, lam.imag
+    r_re, r_im, tmp = xr.duplicate(), xr.duplicate(), xr.duplicate()
+    # (λ² M + λ C + K)(xr + i xi) with λ = a + ib, split into real and imaginary parts
+    K.mult(xr, r_re)
+    K.mult(xi, r_im)
+    C.mult(xr, tmp)
+    r_re.axpy(a, tmp)
+    r_im.axpy(b, tmp)
+    C.mult(xi, tmp)
+    r_re.axpy(-b, tmp)
+    r_im.axpy(a, tmp)
+    M.mult(xr, tmp)
+    r_re.axpy(a * a - b * b, tmp)
+    r_im.axpy(2 * a * b, tmp)
+    M.mult(xi, tmp)
+    r_re.axpy(-2 * a * b, tmp)
+    r_im.axpy(a * a - b * b, tmp)
+    nK, nC, nM = norms
+    modulus = abs(lam)
+    scale = (modulus**2 * nM + modulus * nC + nK) * np.hypot(xr.norm(), xi.norm())
+    value = np.hypot(r_re.norm(), r_im.norm()) / scale
+    for v in (r_re, r_im, tmp):
+        v.destroy()
+    return float(value)
 
 
 class StabilitySolver:
@@ -181,30 +220,7 @@ class StabilitySolver:
         self._norms = tuple(A.norm(PETSc.NormType.INFINITY) for A in (self.K, self.C, self.M))
 
     def _relative_residual(self, lam: complex, xr: PETSc.Vec, xi: PETSc.Vec) -> float:
-        a, b = lam.real, lam.imag
-        r_re, r_im, tmp = xr.duplicate(), xr.duplicate(), xr.duplicate()
-        # (λ² M + λ C + K)(xr + i xi) with λ = a + ib, split into real and imaginary parts
-        self.K.mult(xr, r_re)
-        self.K.mult(xi, r_im)
-        self.C.mult(xr, tmp)
-        r_re.axpy(a, tmp)
-        r_im.axpy(b, tmp)
-        self.C.mult(xi, tmp)
-        r_re.axpy(-b, tmp)
-        r_im.axpy(a, tmp)
-        self.M.mult(xr, tmp)
-        r_re.axpy(a * a - b * b, tmp)
-        r_im.axpy(2 * a * b, tmp)
-        self.M.mult(xi, tmp)
-        r_re.axpy(-2 * a * b, tmp)
-        r_im.axpy(a * a - b * b, tmp)
-        nK, nC, nM = self._norms
-        modulus = abs(lam)
-        scale = (modulus**2 * nM + modulus * nC + nK) * np.hypot(xr.norm(), xi.norm())
-        value = np.hypot(r_re.norm(), r_im.norm()) / scale
-        for v in (r_re, r_im, tmp):
-            v.destroy()
-        return float(value)
+        return relative_residual((self.K, self.C, self.M), self._norms, lam, xr, xi)
 
     def solve(self, max_modulus: float, nev: int = 8, max_nev: int = 400,
               shift: float | None = None) -> list[Mode]:
