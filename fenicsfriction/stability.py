@@ -29,7 +29,9 @@ at the same steady state with the friction constant of the residual
 terms are linear in it, so the result is exactly the operator less its friction part, for the
 integrals and for node-to-segment couplings alike. An instability that survives without the
 friction stiffness is not mode coupling; one that disappears without the friction damping is
-negative damping (the distinction of Abaqus's and ANSYS's complex eigenvalue analyses).
+negative damping (the distinction of Abaqus's and ANSYS's complex eigenvalue analyses);
+beware that a small non-proportional damping can itself destabilise a coupling pair below its
+coalescence (Hoffmann & Gaul 2003), so the onset with the damping may lie below both.
 """
 
 from __future__ import annotations

@@ -26,6 +26,8 @@ at the current state with the nodal springs and the Dirichlet rows, whose dofs a
 the bodies. A body without enough supports (the block held only by its driver spring) keeps its
 rigid-body modes, at zero frequency, as free-interface modes: they take part in the coupled
 modes like any other (the shift-and-invert target is negative, so K_b - σ M_b stays regular).
+Modes that share one frequency (the rigid ones) are an arbitrary basis of their eigenspace:
+only the sum of their contributions means something.
 """
 
 from __future__ import annotations
