@@ -29,16 +29,31 @@ _EXPORTS: dict[str, str] = {
     "ParametricPencil": "matrices", "read_matrix": "matrices", "from_array": "matrices",
     "to_dense": "matrices",
     "dense_modes": "dense", "quadratic_eig": "dense",
+    "Sweep": "sweep", "Coalescence": "sweep",
+    "HoffmannModel": "hoffmann",
+    "plot_coupling_map": "figures",
 }
 
-_SUBMODULES = ("band", "dense", "full", "matrices", "projection")
+_SUBMODULES = ("band", "dense", "figures", "full", "hoffmann", "matrices", "projection", "sweep")
 
 __getattr__, __dir__, __all__ = attach(__name__, _EXPORTS, _SUBMODULES)
 
 if typing.TYPE_CHECKING:
-    from fenicsfriction.cea import band, dense, full, matrices, projection
+    from fenicsfriction.cea import (
+        band,
+        dense,
+        figures,
+        full,
+        hoffmann,
+        matrices,
+        projection,
+        sweep,
+    )
     from fenicsfriction.cea.band import Band
     from fenicsfriction.cea.dense import dense_modes, quadratic_eig
+    from fenicsfriction.cea.figures import plot_coupling_map
     from fenicsfriction.cea.full import BandSolver
+    from fenicsfriction.cea.hoffmann import HoffmannModel
     from fenicsfriction.cea.matrices import ParametricPencil, from_array, read_matrix, to_dense
     from fenicsfriction.cea.projection import ModalBasis, symmetric_part
+    from fenicsfriction.cea.sweep import Coalescence, Sweep

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import dataclasses
 import pathlib
+import typing
 
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -182,8 +183,9 @@ class ParametricPencil:
         return {n: getattr(self, n) for n in names if getattr(self, n) is not None}
 
     @classmethod
-    def read(cls, paths: dict[str, str | pathlib.Path], comm: MPI.Comm = MPI.COMM_WORLD,
-             flags: dict[str, str] | None = None) -> ParametricPencil:
+    def read(cls, paths: typing.Mapping[str, str | pathlib.Path],
+             comm: MPI.Comm = MPI.COMM_WORLD, flags: dict[str, str] | None = None
+             ) -> ParametricPencil:
         """The pencil from files (:func:`read_matrix`), ``paths`` keyed by part name (``M``,
         ``K0``, ...); ``flags[name]`` names a part in errors (default: the part's name)."""
         flags = flags or {}
