@@ -157,6 +157,33 @@ def test_the_friction_damping_destabilises_before_the_coupling():
         assert (growth > 1e-5) == grows, (kept, growth)
 
 
+def test_the_switch_drops_the_friction_of_node_to_segment_contact():
+    """On the block on an elastic slab the friction is in the node-to-segment coupling, not in
+    the integrals; at μ = 0.3, past its onset (0.2-0.25), K̄ is unsymmetric by 1.2 % of its
+    largest entry and the pair grows at 259 s⁻¹. Without the friction stiffness K̄ is
+    symmetric to round-off (measured 6e-17; tolerance 100 u_mach: frictionless contact derives
+    from a potential) and, C being zero (no damping, no friction damping in 2D), every
+    eigenvalue is on the imaginary axis to round-off (measured |Re λ| ≤ 1e-11 |λ|; tolerance
+    1e-9)."""
+    model = ff.BlockOnSlab().build(COMM, with_friction=True)
+    model.initial_guess()
+    steady = ff.SteadySolver(model.residual, prefix=prefix("slab"),
+                             options=model.solver_options())
+    ff.continuation(steady, model.mu, np.linspace(0.05, 0.3, 6))
+    assert model.residual.friction is model.mu
+    for kept in (True, False):
+        solver = StabilitySolver(model.residual, prefix=prefix("slabpep"),
+                                 friction_stiffness=kept)
+        modes = solver.solve(MAX_MODULUS)
+        K = dense(solver.K)
+        asymmetry = abs(K - K.T).max() / abs(K).max()
+        growth = max(abs(m.value.real) / abs(m.value) for m in modes)
+        if kept:
+            assert asymmetry > 1e-3 and growth > 1e-2
+        else:
+            assert asymmetry < 100 * EPS_MACH and growth < 1e-9
+
+
 def test_dropping_friction_needs_a_friction_constant():
     """A residual without a friction constant (a frictionless model) refuses the switch."""
     model = ff.BlockOnBelt(refine=1).build(COMM, with_friction=False)
