@@ -164,6 +164,8 @@ class StabilitySolver:
     Attributes:
         pep: the SLEPc PEP, exposed for inspection or further configuration.
         K, C, M: the assembled PETSc matrices (after :meth:`assemble`).
+        frictionless: the names ("K", "C") of the operators assembled without their friction
+            part.
     """
 
     def __init__(self, residual: Residual, prefix: str = "stability_",
@@ -177,7 +179,6 @@ class StabilitySolver:
                              "linear in (Residual.friction), and this residual has none")
         self.residual = residual
         self.residual_tol = residual_tol
-        #: the operators assembled with the residual's friction constant set to 0
         self.frictionless = {name for name, kept in (("K", friction_stiffness),
                                                      ("C", friction_damping)) if not kept}
         self.comm = residual.V.mesh.comm
