@@ -133,7 +133,8 @@ def coupling_map(loci: Loci, values: typing.Sequence[float], tol: float = 1e-3) 
         tol: width of each onset's bisection interval.
 
     Returns:
-        The map; the steady state is left at the last value solved.
+        The map; the steady state is left where it was last solved: at the unstable end of
+        the last onset's bisection, else at the last value.
     """
     from fenicsfriction.steady import continuation
     check("values", list(values), len(values) >= 2 and bool(np.all(np.diff(values) > 0)),
