@@ -299,6 +299,11 @@ class Residual:
         couplings: terms between two points of the mesh that no integral of ``form`` holds,
             e.g. two-body contact (:class:`fenicsfriction.contact.NodeToSegment`): UFL forms
             of their own, chained into R and its derivatives by the solvers.
+        friction: the ``fem.Constant`` that every friction term of ``form`` and of
+            ``couplings`` is linear in, 0 meaning no friction (a model's constant μ); None
+            when no such constant exists. The stability solver assembles K̄ and C with it set
+            to 0 to drop their friction parts (``friction_stiffness``/``friction_damping`` of
+            :class:`fenicsfriction.stability.StabilitySolver`).
     """
 
     form: ufl.Form
@@ -309,6 +314,7 @@ class Residual:
     bcs: list = dataclasses.field(default_factory=list)
     springs: list = dataclasses.field(default_factory=list)
     couplings: list = dataclasses.field(default_factory=list)
+    friction: fem.Constant | None = None
 
     @property
     def V(self) -> fem.FunctionSpace:

@@ -93,6 +93,11 @@ class BlockModel:
             the one law of the residual's terms and of the tractions read off a state.
         ds_contact: measure on Γ_C with the fixed quadrature degree used everywhere.
         spring: the driver's :class:`~fenicsfriction.forms.NodalSpring`.
+        friction_factor: the ``fem.Constant`` the friction terms are linear in
+            (:attr:`fenicsfriction.forms.Residual.friction`): ``mu`` when the friction bound is
+            μ c_n, else a factor of value 1 multiplying the friction term (a friction
+            coefficient law, an elliptic slip rule), which the stability solver alone sets to
+            0 while it assembles the parts it drops; None without friction.
     """
 
     CONTACT = CONTACT
@@ -149,6 +154,7 @@ class BlockModel:
         self.gravity = fem.Constant(msh, -s.weight / volume * e_y)
         self.top_traction = fem.Constant(msh, -s.top_pressure * e_y)
         self.normal = ufl.FacetNormal(msh)
+        self.friction_factor = self._friction_factor()
 
         u, u_dot, u_ddot = fem.Function(V, name="displacement"), fem.Function(V), fem.Function(V)
         v = ufl.TestFunction(V)
@@ -170,7 +176,8 @@ class BlockModel:
             bcs.append(fem.dirichletbc(zero, mid, V.sub(2)))
         bcs += self._supports()
         self.residual = Residual(form=self.thickness * terms, u=u, u_dot=u_dot, u_ddot=u_ddot,
-                                 v=v, bcs=bcs, springs=[self.spring], couplings=couplings)
+                                 v=v, bcs=bcs, springs=[self.spring], couplings=couplings,
+                                 friction=self.friction_factor)
         self._functionals: dict = {}
         self._contact_y = self._contact_dofs()
 
@@ -211,6 +218,16 @@ class BlockModel:
         """The volume measure of the block (the whole mesh here)."""
         return ufl.Measure("dx", domain=self.msh)
 
+    def _friction_factor(self) -> fem.Constant | None:
+        """The constant the friction terms are linear in (see ``friction_factor``)."""
+        if not self.with_friction:
+            return None
+        law = self.scene.law
+        if law.friction_coefficient is None \
+                and not isinstance(law.slip_rule, laws.EllipticSlipRule):
+            return self.mu
+        return fem.Constant(self.msh, np.float64(1.0))
+
     def _interface(self, u: fem.Function, u_dot: fem.Function, u_ddot: fem.Function,
                    v: ufl.Argument) -> tuple[ufl.Form | None, list]:
         """(UFL terms per unit breadth, couplings) of the contact and of any other body: here
@@ -220,7 +237,8 @@ class BlockModel:
         if law.b_n > 0:
             terms += normal_damping(u, u_dot, v, n, law, ds_c)
         if self.with_friction:
-            terms += friction(u, u_dot, v, n, law, self.belt_velocity, ds_c)
+            term = friction(u, u_dot, v, n, law, self.belt_velocity, ds_c)
+            terms += term if self.friction_factor is self.mu else self.friction_factor * term
         return terms, []
 
     def _supports(self) -> list[fem.DirichletBC]:
