@@ -9,9 +9,9 @@ frequency band (:class:`~fenicsfriction.cea.band.Band`) is computed on the full 
 (:mod:`~fenicsfriction.cea.full`: SLEPc PEP, or QZ when small, :mod:`~fenicsfriction.cea.dense`)
 or on a modal basis (:mod:`~fenicsfriction.cea.projection`), read as each body's
 free-interface modes' shares (:mod:`~fenicsfriction.cea.contributions`), swept in p with modes
-tracked and their coalescence located (:mod:`~fenicsfriction.cea.sweep`), drawn as a mode-coupling map
-(:mod:`~fenicsfriction.cea.figures`) and checked against the two-degree-of-freedom model of
-Hoffmann et al. (2002) (:mod:`~fenicsfriction.cea.hoffmann`).
+tracked and their coalescence located (:mod:`~fenicsfriction.cea.sweep`), drawn as a
+mode-coupling map (:mod:`~fenicsfriction.cea.figures`) and checked against the
+two-degree-of-freedom model of Hoffmann et al. (2002) (:mod:`~fenicsfriction.cea.hoffmann`).
 
 The names are loaded on first use (``import fenicsfriction.cea`` imports no PETSc).
 """
