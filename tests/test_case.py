@@ -227,7 +227,10 @@ def test_a_complete_modal_basis_gives_the_full_eigenvalues_and_modal_damping_its
     solver = eigensolver(case, model, prefix="complete_projected_")
     projected = sorted((m.value for m in solver.solve(solver.max_modulus)),
                        key=lambda z: (round(z.imag, 3), z.real))
-    assert np.abs(np.array(projected) - full).max() <= 1e-8 * np.abs(full).max()
+    # to 1e-6 of the spectrum: the 126 modes of one shift-and-invert EPS solve are complete and
+    # M-orthonormal to its tolerance only (measured 1e-11 serially, 3e-7 on 2 ranks); a basis
+    # of 20 modes is off by 1e-3 (μ_crit 0.3723 against 0.3703)
+    assert np.abs(np.array(projected) - full).max() <= 1e-6 * np.abs(full).max()
     case, model = block_at(shared_tmp_path, 0.0,
                            'method = "projection"\nmodes = 126\nmodal_damping = 0.02')
     solver = eigensolver(case, model, prefix="complete_damped_")
