@@ -218,9 +218,10 @@ def test_a_complete_modal_basis_gives_the_full_eigenvalues_and_modal_damping_its
     """Projected on all 126 real modes the quadratic eigenproblem is the full one (Galerkin
     with a complete basis): the same eigenvalues at μ = 0.5, to the PEP's tolerance. At μ = 0
     K̄ is symmetric and C = 0, so the basis modes are the modes: with modal damping ζ each
-    eigenvalue is ω(-ζ + i sqrt(1 - ζ²)), Re λ = -ζ |λ|: to 1e-5, as Φᵀ K̄ Φ is diagonal to
+    eigenvalue is ω(-ζ + i sqrt(1 - ζ²)), Re λ = -ζ |λ|: to 1e-4, as Φᵀ K̄ Φ is diagonal to
     the basis's EPS tolerance only (1e-10 of ‖K̄‖, the complete basis reaching far above the
-    band; measured 1e-7, and 3e-6 for the driver spring's 5 rad/s mode). Each rank solves
+    band; measured 1e-7, and 3e-6 to 2e-5 for the driver spring's 5 rad/s mode, depending on
+    the EPS's subspace size). Each rank solves
     alone: a shift-and-invert EPS asked for all 126 modes at once does not always return a
     complete basis on 2 ranks (measured: the unstable pair off by 2e-5 in one run of three)."""
     from fenicsfriction.case.analyses import eigensolver
@@ -239,7 +240,7 @@ def test_a_complete_modal_basis_gives_the_full_eigenvalues_and_modal_damping_its
     solver = eigensolver(case, model, prefix="complete_damped_")
     for mode in solver.solve(solver.max_modulus):
         deviation = abs(mode.value.real / (-0.02 * abs(mode.value)) - 1)
-        assert deviation < 1e-5
+        assert deviation < 1e-4
 
 
 #: a gmsh script of the convention of meshes/*.py (``--out FILE``): the block's 4 × 3 grid of
