@@ -38,6 +38,7 @@ __all__ = [
     "model_to_mesh",
     "nodal_quadrature",
     "petsc_vec",
+    "read_msh",
     "scalar_function_space",
     "vector_function_space",
     "write_meshtags",
@@ -222,6 +223,40 @@ def model_to_mesh(model: typing.Any, comm: MPI.Comm, rank: int,
         return data.mesh, data.cell_tags, data.facet_tags
     msh, cell_tags, facet_tags = data
     return msh, cell_tags, facet_tags
+
+
+def read_msh(path: str, comm: MPI.Comm, rank: int,
+             gdim: int) -> tuple[mesh.Mesh, mesh.MeshTagsMetaClass, mesh.MeshTagsMetaClass]:
+    """A gmsh ``.msh`` file (read on ``rank``) as a distributed mesh with its cell and facet
+    tags. dolfinx 0.10's ``dolfinx.io.gmsh.read_from_msh``; before it, the file merged into a
+    gmsh model on ``rank`` and :func:`model_to_mesh` (0.5.2's ``gmshio.read_from_msh`` returns
+    an undefined name on the reading rank)."""
+    import importlib
+    try:
+        data = importlib.import_module("dolfinx.io.gmsh").read_from_msh(path, comm, rank,
+                                                                         gdim=gdim)
+        return data.mesh, data.cell_tags, data.facet_tags
+    except ImportError:
+        pass
+    model, error = None, None
+    if comm.rank == rank:
+        import gmsh
+        gmsh.initialize(readConfigFiles=False)
+        gmsh.option.setNumber("General.Terminal", 0)
+        try:
+            gmsh.model.add("fenicsfriction-msh")
+            gmsh.merge(str(path))
+            model = gmsh.model
+        except Exception as e:  # broadcast: the other ranks must not wait for the mesh
+            error = f"reading {path} with gmsh failed: {e}"
+    try:
+        error = comm.bcast(error, root=rank)
+        if error is not None:
+            raise RuntimeError(error)
+        return model_to_mesh(model, comm, rank, gdim)
+    finally:
+        if comm.rank == rank:
+            gmsh.finalize()
 
 
 def form(expr: ufl.Form, cache_dir: str | None = None) -> fem.FormMetaClass:

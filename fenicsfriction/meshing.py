@@ -19,7 +19,7 @@ import numpy as np
 from fenicsfriction import _compat
 from fenicsfriction.laws import check
 
-__all__ = ["annulus", "gmsh_mesh"]
+__all__ = ["annulus", "gmsh_mesh", "vertex_rows"]
 
 _model_numbers = itertools.count()
 
@@ -77,6 +77,28 @@ def gmsh_mesh(comm: MPI.Comm, name: str, gdim: int,
             else:
                 session.model.remove()
     return msh, cell_tags, facet_tags
+
+
+def vertex_rows(n_rows: int, degree: int, H: float, target: float) -> np.ndarray:
+    """Heights of the n_rows+1 vertex rows of a grid on [0, H]: uniform, except shifted so
+    that a row of nodes of the degree-``degree`` Lagrange space lies at height ``target`` (a
+    nodal spring's node): the row of cells holding it slides, or else the nearest vertex row
+    moves there."""
+    rows = np.linspace(0.0, H, n_rows + 1)
+    nodes = np.linspace(0.0, H, degree * n_rows + 1)
+    k = int(np.argmin(np.abs(nodes - target)))
+    if np.isclose(nodes[k], target, rtol=0, atol=1e-12 * H):
+        return rows
+    spacing = H / n_rows
+    j, fraction = divmod(k, degree)
+    if fraction:  # a row inside cell row j: slide that cell row so the node row hits target
+        low = target - fraction / degree * spacing
+        if 0 < j < n_rows - 1 and low > 0 and low + spacing < H:
+            return np.concatenate([np.linspace(0.0, low, j + 1),
+                                   np.linspace(low + spacing, H, n_rows - j)])
+    j = min(max(int(round(target / spacing)), 1), n_rows - 1)  # move the nearest vertex row
+    return np.concatenate([np.linspace(0.0, target, j + 1)[:-1],
+                           np.linspace(target, H, n_rows - j + 1)])
 
 
 def annulus(comm: MPI.Comm, r_in: float, r_out: float, n_radial: int, n_around: int

@@ -8,7 +8,9 @@ steady|stability|dynamics``), :mod:`~fenicsfriction.cli.oscillators` (the reduce
 in contact: ``contact hertz|patch|cattaneo``), :mod:`~fenicsfriction.cli.rolling` (steady
 rolling: ``rolling fastsim|fe|curve``) and :mod:`~fenicsfriction.cli.multicontact` (Braun's
 interface of many contacts: ``multicontact eq|master-equation|stability-map|interaction|fk|
-slider``); :mod:`~fenicsfriction.cli.common` holds what they share once they run. The family
+slider``), and :mod:`~fenicsfriction.cli.run` runs a case file (``run CASE.toml``: one's
+own problem, docs/case-files.md); :mod:`~fenicsfriction.cli.common` holds what they share
+once they run. The family
 modules import MPI, PETSc and dolfinx inside their run functions, after the flags parse, so
 ``--help`` and a flag error answer at once.
 
@@ -23,13 +25,13 @@ from __future__ import annotations
 import logging
 import sys
 
-from fenicsfriction.cli import block, cea, contact, multicontact, oscillators, rolling
+from fenicsfriction.cli import block, cea, contact, multicontact, oscillators, rolling, run
 from fenicsfriction.cli.arguments import Parser
 
 __all__ = ["main"]
 
 #: the families, in the order ``--help`` lists them
-FAMILIES = (block, oscillators, contact, rolling, multicontact, cea)
+FAMILIES = (block, oscillators, contact, rolling, multicontact, cea, run)
 
 #: the first words of the old grammar (``COMMAND SCENE``) -> the new spelling of each scene
 #: (None: any scene, kept as the study)

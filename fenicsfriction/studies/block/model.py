@@ -30,6 +30,7 @@ from fenicsfriction.forms import (
     tangential_part,
 )
 from fenicsfriction.laws import check
+from fenicsfriction.meshing import vertex_rows
 from fenicsfriction.studies.block import observables
 from fenicsfriction.studies.block.data import CONTACT, LEFT, QUADRATURE, RIGHT, TOP, BlockOnBelt
 
@@ -56,27 +57,6 @@ class _FixedParameter(fem.Constant):
     def value(self, v: typing.Any) -> None:
         if np.any(np.asarray(v) != self._cpp_object.value):
             raise ValueError(f"{self._name}={v!r} is invalid: {self._reason}")
-
-
-def _vertex_rows(n_rows: int, degree: int, H: float, target: float) -> np.ndarray:
-    """Heights of the n_rows+1 vertex rows: uniform, except shifted so that a row of nodes of
-    the degree-``degree`` Lagrange space lies at height ``target`` (the spring's node)."""
-    rows = np.linspace(0.0, H, n_rows + 1)
-    nodes = np.linspace(0.0, H, degree * n_rows + 1)
-    k = int(np.argmin(np.abs(nodes - target)))
-    if np.isclose(nodes[k], target, rtol=0, atol=1e-12 * H):
-        return rows
-    spacing = H / n_rows
-    j, fraction = divmod(k, degree)
-    if fraction:  # a row inside cell row j: slide that cell row so the node row hits target
-        low = target - fraction / degree * spacing
-        if 0 < j < n_rows - 1 and low > 0 and low + spacing < H:
-            return np.concatenate([np.linspace(0.0, low, j + 1),
-                                   np.linspace(low + spacing, H, n_rows - j)])
-    j = min(max(int(round(target / spacing)), 1), n_rows - 1)  # move the nearest vertex row
-    return np.concatenate([np.linspace(0.0, target, j + 1)[:-1],
-                           np.linspace(target, H, n_rows - j + 1)])
-
 
 
 class BlockModel:
@@ -192,7 +172,7 @@ class BlockModel:
         else:
             msh = _compat.create_box(comm, (0.0, 0.0, 0.0), (s.L, s.H, s.B0),
                                      (nx, ny, s.nz * s.refine))
-        rows = _vertex_rows(ny, s.degree, s.H, s.spring_height)
+        rows = vertex_rows(ny, s.degree, s.H, s.spring_height)
         msh.geometry.x[:, 1] = np.interp(msh.geometry.x[:, 1], np.linspace(0, s.H, ny + 1), rows)
         fdim = msh.topology.dim - 1
         tol = 1e-10 * max(s.L, s.H)

@@ -31,8 +31,9 @@ from fenicsfriction import _compat, laws
 from fenicsfriction.contact import NodeToSegment
 from fenicsfriction.contact.pairing import surface_coordinates
 from fenicsfriction.forms import elasticity, inertia
+from fenicsfriction.meshing import vertex_rows
 from fenicsfriction.studies.block.data import CONTACT, LEFT, RIGHT, TOP
-from fenicsfriction.studies.block.model import BlockModel, _vertex_rows
+from fenicsfriction.studies.block.model import BlockModel
 from fenicsfriction.studies.block.slab import (
     BLOCK,
     SLAB,
@@ -64,7 +65,7 @@ def slab_arrays(scene: BlockOnSlab) -> tuple[np.ndarray, np.ndarray, int]:
     nx, ny = 4 * s.refine, 3 * s.refine
     h = s.L / nx
     x_block = np.linspace(0.0, s.L, nx + 1)
-    rows = _vertex_rows(ny, 1, s.H, s.spring_height)
+    rows = vertex_rows(ny, 1, s.H, s.spring_height)
     overhang = (s.slab_length - s.L) / 2
     n_side = max(1, int(np.ceil(overhang / (2 * h))))
     left = np.linspace(-overhang, 0.0, n_side + 1)
