@@ -32,8 +32,8 @@ holder holds the x and y components (a case file can say so), while the disc's a
 :attr:`Pin.disc_axis` = (0, -sin α, cos α) through the origin.
 
 For another scene on the same disc (the brake's pads), call :func:`add_disc` in the gmsh
-model being built (the disc frame), tag its volume and faces with :func:`disc_groups`, and size the mesh with
-:func:`refine_near`; :class:`Disc` holds the disc's dimensions with the defaults of a small
+model being built (the disc frame), tag its volume and faces with :func:`disc_groups`, and
+size the mesh with :func:`refine_near`; :class:`Disc` holds the disc's dimensions with the defaults of a small
 steel brake disc.
 """
 
@@ -324,15 +324,15 @@ def pin_on_disc(comm: MPI.Comm, disc: Disc = Disc(), pin: Pin = Pin(), h_far: fl
         turn = np.array([[1, 0, 0], [0, math.cos(angle), -math.sin(angle)],
                          [0, math.sin(angle), math.cos(angle)]])
 
-        def key(face: int, rotation: np.ndarray) -> np.ndarray:
+        def signature(face: int, rotation: np.ndarray) -> np.ndarray:
             centre = rotation @ gmsh.model.occ.getCenterOfMass(2, face)
             return np.append(centre, math.sqrt(gmsh.model.occ.getMass(2, face)))
 
-        keys = {face: key(face, turn) for faces in groups.values() for face in faces}
+        keys = {face: signature(face, turn) for faces in groups.values() for face in faces}
         gmsh.model.occ.rotate([(3, v) for v in (disc_volume, *pin_volumes)],
                               0, 0, 0, 1, 0, 0, angle)
         gmsh.model.occ.synchronize()
-        now = [(face, key(face, np.eye(3))) for _, face in gmsh.model.getEntities(2)]
+        now = [(face, signature(face, np.eye(3))) for _, face in gmsh.model.getEntities(2)]
         renamed = {old: min(now, key=lambda f: float(np.linalg.norm(f[1] - k)))[0]
                    for old, k in keys.items()}
         add_groups(gmsh, 3, {DISC: [disc_volume], PIN: pin_volumes})

@@ -181,7 +181,6 @@ def stability_study(model: PinOnDiscModel, mus: typing.Sequence[float],
         weights = overlap_with(M, mode.vector, model.comm, basis)[0]
         pair.append(next(int(i) for i in np.argsort(weights)[::-1] if int(i) not in pair))
     pair.sort()
-    chosen = [basis[i] for i in pair]
     projected = {}
     for value in (mu1 / 2, mu1):
         continuation(steady, model.mu, [value])

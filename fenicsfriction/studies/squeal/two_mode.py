@@ -71,7 +71,7 @@ def coalescence(K0: np.ndarray, B: np.ndarray) -> tuple[float, float]:
 
 def modal_onset(K0: np.ndarray, B: np.ndarray, C1: np.ndarray, upper: float,
                 tol: float = 1e-6, points: int = 200) -> float:
-    """The first μ in (0, ``upper``] where the projected pencil
+    r"""The first μ in (0, ``upper``] where the projected pencil
     :math:`\lambda^2 I + \lambda\mu C_1 + K_0 + \mu B` has an eigenvalue with Re λ > 0
     (any number of modes; the friction's damping μ C₁ is linear in μ): a scan of ``points``
     values, then bisection to ``tol``. ``nan`` if none."""
