@@ -30,7 +30,7 @@ _EXPORTS: dict[str, str] = {
     "InterfaceLaw": "laws", "ConstantFriction": "laws", "PiecewiseLinearFriction": "laws",
     "StribeckFriction": "laws", "CoulombSlipRule": "laws", "EllipticSlipRule": "laws",
     # the one residual
-    "Residual": "forms", "NodalSpring": "forms",
+    "Residual": "forms", "NodalSpring": "forms", "RigidRotation": "rotation",
     # solvers on the finite element residual
     "SteadySolver": "steady", "SolveError": "steady", "SolveReport": "steady",
     "ContinuationError": "steady", "continuation": "steady", "epsilon_sequence": "steady",
@@ -78,8 +78,8 @@ _EXPORTS: dict[str, str] = {
 }
 
 _SUBMODULES = ("contact", "dynamics", "events", "forms", "io", "laws", "meshing", "mollification",
-               "numerics", "panagiotopoulos", "plotting", "results", "signals", "stability",
-               "statistics", "steady", "studies", "timestepping")
+               "numerics", "panagiotopoulos", "plotting", "results", "rotation", "signals",
+               "stability", "statistics", "steady", "studies", "timestepping")
 
 __getattr__, __dir__, __all__ = attach(__name__, _EXPORTS, _SUBMODULES)
 __all__.append("__version__")  # the same list __dir__ returns
@@ -99,6 +99,7 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers and IDEs
         panagiotopoulos,
         plotting,
         results,
+        rotation,
         signals,
         stability,
         statistics,
@@ -122,6 +123,7 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers and IDEs
     from fenicsfriction.numerics import bisect, dense_eigenvalues
     from fenicsfriction.panagiotopoulos import PanagiotopoulosSolver, ProcessError, ProcessReport
     from fenicsfriction.results import CsvRows, Record, get_logger, write_json
+    from fenicsfriction.rotation import RigidRotation
     from fenicsfriction.signals import Interrupted, StopSignals
     from fenicsfriction.stability import (
         EigenSolveError,

@@ -38,6 +38,7 @@ __all__ = [
     "model_to_mesh",
     "nodal_quadrature",
     "petsc_vec",
+    "read_msh",
     "scalar_function_space",
     "vector_function_space",
     "write_meshtags",
@@ -224,25 +225,60 @@ def model_to_mesh(model: typing.Any, comm: MPI.Comm, rank: int,
     return msh, cell_tags, facet_tags
 
 
+def read_msh(path: str, comm: MPI.Comm, rank: int,
+             gdim: int) -> tuple[mesh.Mesh, mesh.MeshTagsMetaClass, mesh.MeshTagsMetaClass]:
+    """A gmsh ``.msh`` file (read on ``rank``) as a distributed mesh with its cell and facet
+    tags. dolfinx 0.10's ``dolfinx.io.gmsh.read_from_msh``; before it, the file merged into a
+    gmsh model on ``rank`` and :func:`model_to_mesh` (0.5.2's ``gmshio.read_from_msh`` returns
+    an undefined name on the reading rank)."""
+    import importlib
+    try:
+        data = importlib.import_module("dolfinx.io.gmsh").read_from_msh(path, comm, rank,
+                                                                         gdim=gdim)
+        return data.mesh, data.cell_tags, data.facet_tags
+    except ImportError:
+        pass
+    model, error = None, None
+    if comm.rank == rank:
+        import gmsh
+        gmsh.initialize(readConfigFiles=False)
+        gmsh.option.setNumber("General.Terminal", 0)
+        try:
+            gmsh.model.add("fenicsfriction-msh")
+            gmsh.merge(str(path))
+            model = gmsh.model
+        except Exception as e:  # broadcast: the other ranks must not wait for the mesh
+            error = f"reading {path} with gmsh failed: {e}"
+    try:
+        error = comm.bcast(error, root=rank)
+        if error is not None:
+            raise RuntimeError(error)
+        return model_to_mesh(model, comm, rank, gdim)
+    finally:
+        if comm.rank == rank:
+            gmsh.finalize()
+
+
 def form(expr: ufl.Form, cache_dir: str | None = None) -> fem.FormMetaClass:
     """Compile a UFL form with the package's JIT options (``cache_dir``: where FFCx caches)."""
     return fem.form(expr, **jit_options(cache_dir))
 
 
 def create_mesh_from_arrays(comm: MPI.Comm, cells: np.ndarray, x: np.ndarray,
-                            cell_type: str) -> mesh.Mesh:
-    """A mesh of degree-1 cells of ``cell_type`` ("triangle", "quadrilateral", "tetrahedron",
-    "hexahedron") from arrays (given on any ranks, e.g. all on rank 0 and empty elsewhere),
-    partitioned by dolfinx. Quadrilateral and hexahedron vertices are in dolfinx's
-    tensor-product order (a quadrilateral's 0, 1, 2, 3 at (0,0), (1,0), (0,1), (1,1)), not
-    counter-clockwise. The coordinate element is a UFL ``VectorElement`` up to 0.6 and a
-    Basix element from 0.7."""
+                            cell_type: str, degree: int = 1) -> mesh.Mesh:
+    """A mesh of cells of ``cell_type`` ("triangle", "quadrilateral", "tetrahedron",
+    "hexahedron") and geometric ``degree`` from arrays (given on any ranks, e.g. all on rank 0
+    and empty elsewhere), partitioned by dolfinx. Nodes are in dolfinx's order: quadrilateral
+    and hexahedron vertices in tensor-product order (a quadrilateral's 0, 1, 2, 3 at (0,0),
+    (1,0), (0,1), (1,1)), not counter-clockwise; then, for degree 2, the edge midpoints in the
+    order of the reference cell's edges and the interior node. The coordinate element is a UFL
+    ``VectorElement`` up to 0.6 and a Basix element from 0.7."""
     gdim = x.shape[1]
     try:
         import basix.ufl
-        element = basix.ufl.element("Lagrange", cell_type, 1, shape=(gdim,))
+        element = basix.ufl.element("Lagrange", cell_type, degree, shape=(gdim,))
     except (ImportError, AttributeError):
-        element = ufl.VectorElement("Lagrange", cell_type, 1)
+        element = ufl.VectorElement("Lagrange", cell_type, degree)
     return mesh.create_mesh(comm, cells.astype(np.int64), x, ufl.Mesh(element))
 
 

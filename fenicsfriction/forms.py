@@ -34,9 +34,13 @@ __all__ = [
     "NodalSpring",
     "Residual",
     "body_force",
+    "centrifugal_softening",
+    "centripetal_load",
+    "convective_derivative",
     "elastic_support",
     "elasticity",
     "friction",
+    "gyroscopic",
     "inertia",
     "normal_compliance",
     "normal_damping",
@@ -131,6 +135,79 @@ def friction(u: Field, u_dot: Field, v: Field, n: Field, law: laws.InterfaceLaw,
     return -ufl.inner(law.friction_traction(d, w), tangential_part(v, n)) * ds
 
 
+# --- a body spinning rigidly, described at fixed points in space (Eulerian) --------------------
+# The mesh does not rotate: material flows through it with the rigid velocity w = ω a × (x - p)
+# (:meth:`fenicsfriction.rotation.RigidRotation.velocity`) and u(x, t) is the displacement of
+# the material point passing through x. Its acceleration is
+#     ü + 2 (w·∇)u̇ + (w·∇)(w·∇)u + (w·∇)w
+# exactly (the terms are linear in u). The three terms below are its virtual power beyond
+# :func:`inertia`, with the convective ones integrated by parts; this is exact when ρ is uniform,
+# div w = 0 (any rigid rotation) and w·n = 0 on the whole boundary: a body of revolution about
+# the axis of rotation (a disc, a ring, a drum), supports and contact included, since a
+# surface term on a part of the boundary does not change w·n.
+
+def convective_derivative(w: Field, u: Field) -> Field:
+    """:math:`(w\\cdot\\nabla)u = (\\nabla u)\\,w`, the rate of change of u seen by a material
+    point moving with velocity w through fixed space."""
+    return ufl.dot(ufl.grad(u), w)
+
+
+def gyroscopic(rho: Value, w: Field, u_dot: Field, v: Field, dx: ufl.Measure) -> ufl.Form:
+    """Gyroscopic (Coriolis) term of the Eulerian description, in skew form.
+
+    .. math::
+        \\rho\\langle(\\nabla\\dot u)\\,w, v\\rangle
+        - \\rho\\langle\\dot u, (\\nabla v)\\,w\\rangle
+
+    It equals :math:`2\\rho\\langle(w\\cdot\\nabla)\\dot u, v\\rangle` when ρ is uniform,
+    div w = 0 and w·n = 0 on the boundary (a body of revolution spinning about its axis of
+    symmetry); otherwise the integration by parts drops
+    :math:`\\int_{\\partial\\Omega}\\rho\\,(w\\cdot n)\\,\\dot u\\cdot v` and
+    :math:`\\int_\\Omega \\mathrm{div}(\\rho w)\\,\\dot u\\cdot v`. In this form the discrete
+    matrix :math:`G = \\partial R/\\partial\\dot u` is skew, :math:`G = -G^T`, on any mesh and
+    with any element: it does no work, as the Coriolis force does not.
+
+    Args:
+        rho: mass density [kg/m³].
+        w: the rigid velocity field [m/s] (``RigidRotation.velocity(SpatialCoordinate)``).
+        u_dot: the displacement's time derivative at a fixed point in space [m/s].
+        v: the test function.
+        dx: the body's volume measure.
+    """
+    return rho * (ufl.inner(convective_derivative(w, u_dot), v)
+                  - ufl.inner(u_dot, convective_derivative(w, v))) * dx
+
+
+def centrifugal_softening(rho: Value, w: Field, u: Field, v: Field, dx: ufl.Measure) -> ufl.Form:
+    """Convective term :math:`\\rho\\langle(w\\cdot\\nabla)(w\\cdot\\nabla)u, v\\rangle`,
+    integrated by parts:
+
+    .. math:: -\\rho\\langle(\\nabla u)\\,w, (\\nabla v)\\,w\\rangle
+
+    Its matrix :math:`-K_c` is symmetric negative semi-definite and needs only first
+    derivatives (valid with P1 elements). The integration by parts is exact under the
+    conditions of :func:`gyroscopic`; otherwise it drops
+    :math:`\\int_{\\partial\\Omega}\\rho\\,(w\\cdot n)\\,((w\\cdot\\nabla)u)\\cdot v` and
+    :math:`\\int_\\Omega \\mathrm{div}(\\rho w)\\,((w\\cdot\\nabla)u)\\cdot v`. It is the
+    Eulerian form of the centrifugal softening :math:`\\rho\\,\\omega\\times(\\omega\\times u)`
+    of the co-rotating frame; the stiffening by the centrifugal prestress is not in it (it
+    comes from the geometric stiffness of the stress :func:`centripetal_load` causes).
+    """
+    return -rho * ufl.inner(convective_derivative(w, u), convective_derivative(w, v)) * dx
+
+
+def centripetal_load(rho: Value, w: Field, v: Field, dx: ufl.Measure) -> ufl.Form:
+    """The rigid motion's own acceleration :math:`\\rho\\langle(w\\cdot\\nabla)w, v\\rangle`.
+
+    For a rigid rotation :math:`(w\\cdot\\nabla)w = \\omega\\times(\\omega\\times r)
+    = -\\omega^2 r_\\perp` (:math:`r_\\perp` the distance vector from the axis): in the residual
+    (internal minus external) it is the centrifugal body force
+    :math:`\\rho\\,\\omega^2 r_\\perp` as a load, a steady term independent of u whose static
+    response is the centrifugal prestress. No integration by parts: valid for any body.
+    """
+    return rho * ufl.inner(convective_derivative(w, w), v) * dx
+
+
 # --- nodal springs (point loads are not UFL integrals in dolfinx 0.5) ----------------------------
 
 @dataclasses.dataclass
@@ -208,6 +285,11 @@ class Residual:
         couplings: terms between two points of the mesh that no integral of ``form`` holds,
             e.g. two-body contact (:class:`fenicsfriction.contact.NodeToSegment`): UFL forms
             of their own, chained into R and its derivatives by the solvers.
+        friction: the ``fem.Constant`` that every friction term of ``form`` and of
+            ``couplings`` is linear in, 0 meaning no friction (a model's constant μ); None
+            when no such constant exists. The stability solver assembles K̄ and C with it set
+            to 0 to drop their friction parts (``friction_stiffness``/``friction_damping`` of
+            :class:`fenicsfriction.stability.StabilitySolver`).
     """
 
     form: ufl.Form
@@ -218,6 +300,7 @@ class Residual:
     bcs: list = dataclasses.field(default_factory=list)
     springs: list = dataclasses.field(default_factory=list)
     couplings: list = dataclasses.field(default_factory=list)
+    friction: fem.Constant | None = None
 
     @property
     def V(self) -> fem.FunctionSpace:

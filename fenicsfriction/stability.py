@@ -18,10 +18,23 @@ eigenpair carries its relative residual
 and is flagged when that exceeds ``residual_tol``. Dirichlet dofs have 1 on the diagonal of
 :math:`\bar K` and 0 in M and C, so their eigenvalues are infinite and never near the shift.
 PETSc/SLEPc options live under the prefix (default ``stability_``).
+
+**The friction switch** of complex eigenvalue analysis: ``friction_stiffness=False`` drops the
+friction part of :math:`\bar K` (the derivative of the friction force with respect to the
+displacement, which couples normal displacement into tangential force and alone makes
+:math:`\bar K` unsymmetric), ``friction_damping=False`` the friction part of C (the derivative
+with respect to the velocity, negative where μ falls with the slip speed). Both are assembled
+at the same steady state with the friction constant of the residual
+(:attr:`fenicsfriction.forms.Residual.friction`, e.g. the constant μ) set to zero: the friction
+terms are linear in it, so the result is exactly the operator less its friction part, for the
+integrals and for node-to-segment couplings alike. An instability that survives without the
+friction stiffness is not mode coupling; one that disappears without the friction damping is
+negative damping (the distinction of Abaqus's and ANSYS's complex eigenvalue analyses).
 """
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import functools
 import typing
@@ -48,8 +61,8 @@ from fenicsfriction.numerics import bisect
 from fenicsfriction.petsc_options import options_with_defaults
 from fenicsfriction.results import Record
 
-__all__ = ["EigenSolveError", "Loci", "Mode", "Onset", "StabilitySolver", "mac", "track",
-           "unstable_intervals"]
+__all__ = ["EigenSolveError", "Eigensolver", "Loci", "Mode", "Onset", "StabilitySolver", "mac",
+           "relative_residual", "track", "unstable_intervals"]
 
 DEFAULT_OPTIONS = {
     "pep_type": "toar",
@@ -92,6 +105,45 @@ def mac(a: np.ndarray, b: np.ndarray, comm: MPI.Comm) -> float:
     return float(abs(ab) ** 2 / (aa.real * bb.real))
 
 
+def relative_residual(operators: tuple[PETSc.Mat, PETSc.Mat, PETSc.Mat],
+                      norms: tuple[float, float, float], lam: complex, xr: PETSc.Vec,
+                      xi: PETSc.Vec) -> float:
+    """Relative residual of the eigenpair (λ, xr + i xi) of (λ²M + λC + K) w = 0 (module
+    docstring), in real arithmetic.
+
+    Args:
+        operators: the PETSc matrices ``(K, C, M)``.
+        norms: their infinity norms ``(‖K‖∞, ‖C‖∞, ‖M‖∞)``.
+        lam: the eigenvalue.
+        xr, xi: the real and imaginary parts of the eigenvector.
+    """
+    K, C, M = operators
+    a, b = lam.real, lam.imag
+    r_re, r_im, tmp = xr.duplicate(), xr.duplicate(), xr.duplicate()
+    # (λ² M + λ C + K)(xr + i xi) with λ = a + ib, split into real and imaginary parts
+    K.mult(xr, r_re)
+    K.mult(xi, r_im)
+    C.mult(xr, tmp)
+    r_re.axpy(a, tmp)
+    r_im.axpy(b, tmp)
+    C.mult(xi, tmp)
+    r_re.axpy(-b, tmp)
+    r_im.axpy(a, tmp)
+    M.mult(xr, tmp)
+    r_re.axpy(a * a - b * b, tmp)
+    r_im.axpy(2 * a * b, tmp)
+    M.mult(xi, tmp)
+    r_re.axpy(-2 * a * b, tmp)
+    r_im.axpy(a * a - b * b, tmp)
+    nK, nC, nM = norms
+    modulus = abs(lam)
+    scale = (modulus**2 * nM + modulus * nC + nK) * np.hypot(xr.norm(), xi.norm())
+    value = np.hypot(r_re.norm(), r_im.norm()) / scale
+    for v in (r_re, r_im, tmp):
+        v.destroy()
+    return float(value)
+
+
 class StabilitySolver:
     """Quadratic eigenproblem of the linearisation of a :class:`Residual` at its current state.
 
@@ -100,6 +152,12 @@ class StabilitySolver:
         prefix: PETSc options prefix of the PEP (and its ST/KSP/PC).
         options: defaults over :data:`DEFAULT_OPTIONS` (user options in the database win).
         residual_tol: eigenpairs with a larger relative residual are flagged inaccurate.
+        friction_stiffness: keep the friction part of K̄ (see the module docstring).
+        friction_damping: keep the friction part of C.
+
+    Raises:
+        ValueError: a friction part is dropped but the residual has no friction constant
+            (``Residual.friction`` is None).
 
     Attributes:
         pep: the SLEPc PEP, exposed for inspection or further configuration.
@@ -107,10 +165,19 @@ class StabilitySolver:
     """
 
     def __init__(self, residual: Residual, prefix: str = "stability_",
-                 options: dict | None = None, residual_tol: float = 1e-8):
+                 options: dict | None = None, residual_tol: float = 1e-8,
+                 friction_stiffness: bool = True, friction_damping: bool = True):
         check("residual_tol", residual_tol, residual_tol > 0, "must be > 0")
+        dropped = [name for name, kept in (("friction_stiffness", friction_stiffness),
+                                           ("friction_damping", friction_damping)) if not kept]
+        if dropped and residual.friction is None:
+            raise ValueError(f"{dropped[0]}=False needs a friction constant the friction is "
+                             "linear in (Residual.friction), and this residual has none")
         self.residual = residual
         self.residual_tol = residual_tol
+        #: the operators assembled with the residual's friction constant set to 0
+        self.frictionless = {name for name, kept in (("K", friction_stiffness),
+                                                     ("C", friction_damping)) if not kept}
         self.comm = residual.V.mesh.comm
         M, C, K = residual.linearisation()
         operators = (("K", K), ("C", C), ("M", M))
@@ -164,47 +231,41 @@ class StabilitySolver:
             integrals.zeroEntries()
             integrals.assemble()
 
+    @contextlib.contextmanager
+    def _friction_for(self, name: str) -> typing.Iterator[None]:
+        """The residual's friction constant set to 0 while ``name`` is assembled, if that
+        operator's friction part is dropped."""
+        constant = self.residual.friction
+        if name not in self.frictionless or constant is None:
+            yield
+            return
+        saved = np.array(constant.value, copy=True)
+        constant.value = 0.0
+        try:
+            yield
+        finally:
+            constant.value = saved
+
     def assemble(self) -> None:
-        """Assemble K̄ (nodal springs included), C and M at the residual's current state."""
+        """Assemble K̄ (nodal springs included), C and M at the residual's current state
+        (without the friction parts dropped, see the module docstring)."""
         bcs = self.residual.bcs
         for name in ("M", "K", "C"):
-            watcher = self._watchers.get(name)
-            if watcher is None:
-                self._assemble(name)
-            else:
-                watcher.refresh()
-            coupled = self._coupled.get(name)
-            if coupled is not None and coupled.assemble(self._couplings[name], bcs):
-                # the spectral transformation's factorisation is set up anew
-                self.pep.setOperators([self.K, self.C, self.M])
-                self.pep.getST().getKSP().getPC().reset()
+            with self._friction_for(name):
+                watcher = self._watchers.get(name)
+                if watcher is None:
+                    self._assemble(name)
+                else:
+                    watcher.refresh()
+                coupled = self._coupled.get(name)
+                if coupled is not None and coupled.assemble(self._couplings[name], bcs):
+                    # the spectral transformation's factorisation is set up anew
+                    self.pep.setOperators([self.K, self.C, self.M])
+                    self.pep.getST().getKSP().getPC().reset()
         self._norms = tuple(A.norm(PETSc.NormType.INFINITY) for A in (self.K, self.C, self.M))
 
     def _relative_residual(self, lam: complex, xr: PETSc.Vec, xi: PETSc.Vec) -> float:
-        a, b = lam.real, lam.imag
-        r_re, r_im, tmp = xr.duplicate(), xr.duplicate(), xr.duplicate()
-        # (λ² M + λ C + K)(xr + i xi) with λ = a + ib, split into real and imaginary parts
-        self.K.mult(xr, r_re)
-        self.K.mult(xi, r_im)
-        self.C.mult(xr, tmp)
-        r_re.axpy(a, tmp)
-        r_im.axpy(b, tmp)
-        self.C.mult(xi, tmp)
-        r_re.axpy(-b, tmp)
-        r_im.axpy(a, tmp)
-        self.M.mult(xr, tmp)
-        r_re.axpy(a * a - b * b, tmp)
-        r_im.axpy(2 * a * b, tmp)
-        self.M.mult(xi, tmp)
-        r_re.axpy(-2 * a * b, tmp)
-        r_im.axpy(a * a - b * b, tmp)
-        nK, nC, nM = self._norms
-        modulus = abs(lam)
-        scale = (modulus**2 * nM + modulus * nC + nK) * np.hypot(xr.norm(), xi.norm())
-        value = np.hypot(r_re.norm(), r_im.norm()) / scale
-        for v in (r_re, r_im, tmp):
-            v.destroy()
-        return float(value)
+        return relative_residual((self.K, self.C, self.M), self._norms, lam, xr, xi)
 
     def solve(self, max_modulus: float, nev: int = 8, max_nev: int = 400,
               shift: float | None = None) -> list[Mode]:
@@ -281,6 +342,17 @@ def track(previous: list[Mode], current: list[Mode], comm: MPI.Comm,
     return next_ident
 
 
+class Eigensolver(typing.Protocol):
+    """What :class:`Loci` asks of its eigensolver: :class:`StabilitySolver`, or one that
+    projects it on a modal basis (:class:`fenicsfriction.cea.coupling_map.ProjectedStability`).
+    """
+
+    comm: MPI.Comm
+
+    def solve(self, max_modulus: float) -> list[Mode]:
+        """Every eigenvalue with |λ| <= ``max_modulus`` (Im λ >= 0), sorted by |λ|."""
+
+
 @dataclasses.dataclass
 class Onset(Record):
     """Where a mode starts to grow along a continuation (see :meth:`Loci.onset`).
@@ -316,13 +388,14 @@ class Loci:
 
     Args:
         steady: steady solver of the problem (its ``u`` is moved along the continuation).
-        stability: quadratic eigensolver of the same residual.
+        stability: quadratic eigensolver of the same residual (a :class:`StabilitySolver`
+            or any :class:`Eigensolver`).
         parameter: the ``fem.Constant`` continued.
         max_modulus: every eigenvalue with |λ| <= max_modulus is computed at each step.
         growth_tol: a mode is unstable when Re λ > growth_tol |λ|.
     """
 
-    def __init__(self, steady: typing.Any, stability: StabilitySolver, parameter: typing.Any,
+    def __init__(self, steady: typing.Any, stability: Eigensolver, parameter: typing.Any,
                  max_modulus: float,
                  growth_tol: float = 1e-6):
         check("growth_tol", growth_tol, growth_tol > 0, "must be > 0")

@@ -62,6 +62,9 @@ def _argv(line: str, out: pathlib.Path) -> list[str]:
                                         ["python3", "-m", "fenicsfriction"]) else words[1:]
     assert "--out" in words, f"a documented command without --out: {line}"
     words[words.index("--out") + 1] = str(out)
+    # a case file is named relative to the repository (the command runs in a temporary folder)
+    words = [str(ROOT / w) if w.endswith(".toml") and not pathlib.Path(w).is_absolute() else w
+             for w in words]
     return [sys.executable, "-m", "fenicsfriction", *words]
 
 

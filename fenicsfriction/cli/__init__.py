@@ -23,13 +23,13 @@ from __future__ import annotations
 import logging
 import sys
 
-from fenicsfriction.cli import block, contact, multicontact, oscillators, rolling
+from fenicsfriction.cli import block, cea, contact, multicontact, oscillators, rolling, run
 from fenicsfriction.cli.arguments import Parser
 
 __all__ = ["main"]
 
 #: the families, in the order ``--help`` lists them
-FAMILIES = (block, oscillators, contact, rolling, multicontact)
+FAMILIES = (block, oscillators, contact, rolling, multicontact, cea, run)
 
 #: the first words of the old grammar (``COMMAND SCENE``) -> the new spelling of each scene
 #: (None: any scene, kept as the study)

@@ -30,6 +30,7 @@ from fenicsfriction.forms import (
     tangential_part,
 )
 from fenicsfriction.laws import check
+from fenicsfriction.meshing import vertex_rows
 from fenicsfriction.studies.block import observables
 from fenicsfriction.studies.block.data import CONTACT, LEFT, QUADRATURE, RIGHT, TOP, BlockOnBelt
 
@@ -58,27 +59,6 @@ class _FixedParameter(fem.Constant):
             raise ValueError(f"{self._name}={v!r} is invalid: {self._reason}")
 
 
-def _vertex_rows(n_rows: int, degree: int, H: float, target: float) -> np.ndarray:
-    """Heights of the n_rows+1 vertex rows: uniform, except shifted so that a row of nodes of
-    the degree-``degree`` Lagrange space lies at height ``target`` (the spring's node)."""
-    rows = np.linspace(0.0, H, n_rows + 1)
-    nodes = np.linspace(0.0, H, degree * n_rows + 1)
-    k = int(np.argmin(np.abs(nodes - target)))
-    if np.isclose(nodes[k], target, rtol=0, atol=1e-12 * H):
-        return rows
-    spacing = H / n_rows
-    j, fraction = divmod(k, degree)
-    if fraction:  # a row inside cell row j: slide that cell row so the node row hits target
-        low = target - fraction / degree * spacing
-        if 0 < j < n_rows - 1 and low > 0 and low + spacing < H:
-            return np.concatenate([np.linspace(0.0, low, j + 1),
-                                   np.linspace(low + spacing, H, n_rows - j)])
-    j = min(max(int(round(target / spacing)), 1), n_rows - 1)  # move the nearest vertex row
-    return np.concatenate([np.linspace(0.0, target, j + 1)[:-1],
-                           np.linspace(target, H, n_rows - j + 1)])
-
-
-
 class BlockModel:
     """A built block scene: mesh, function space, the residual and post-processing.
 
@@ -93,6 +73,10 @@ class BlockModel:
             the one law of the residual's terms and of the tractions read off a state.
         ds_contact: measure on Γ_C with the fixed quadrature degree used everywhere.
         spring: the driver's :class:`~fenicsfriction.forms.NodalSpring`.
+        friction_factor: the ``fem.Constant`` the friction terms are linear in
+            (:attr:`fenicsfriction.forms.Residual.friction`): ``mu`` when the friction bound is
+            μ c_n, else a factor of value 1 multiplying the friction term (a friction
+            coefficient law, an elliptic slip rule); None without friction.
     """
 
     CONTACT = CONTACT
@@ -149,6 +133,7 @@ class BlockModel:
         self.gravity = fem.Constant(msh, -s.weight / volume * e_y)
         self.top_traction = fem.Constant(msh, -s.top_pressure * e_y)
         self.normal = ufl.FacetNormal(msh)
+        self.friction_factor = self._friction_factor()
 
         u, u_dot, u_ddot = fem.Function(V, name="displacement"), fem.Function(V), fem.Function(V)
         v = ufl.TestFunction(V)
@@ -170,7 +155,8 @@ class BlockModel:
             bcs.append(fem.dirichletbc(zero, mid, V.sub(2)))
         bcs += self._supports()
         self.residual = Residual(form=self.thickness * terms, u=u, u_dot=u_dot, u_ddot=u_ddot,
-                                 v=v, bcs=bcs, springs=[self.spring], couplings=couplings)
+                                 v=v, bcs=bcs, springs=[self.spring], couplings=couplings,
+                                 friction=self.friction_factor)
         self._functionals: dict = {}
         self._contact_y = self._contact_dofs()
 
@@ -185,7 +171,7 @@ class BlockModel:
         else:
             msh = _compat.create_box(comm, (0.0, 0.0, 0.0), (s.L, s.H, s.B0),
                                      (nx, ny, s.nz * s.refine))
-        rows = _vertex_rows(ny, s.degree, s.H, s.spring_height)
+        rows = vertex_rows(ny, s.degree, s.H, s.spring_height)
         msh.geometry.x[:, 1] = np.interp(msh.geometry.x[:, 1], np.linspace(0, s.H, ny + 1), rows)
         fdim = msh.topology.dim - 1
         tol = 1e-10 * max(s.L, s.H)
@@ -211,6 +197,16 @@ class BlockModel:
         """The volume measure of the block (the whole mesh here)."""
         return ufl.Measure("dx", domain=self.msh)
 
+    def _friction_factor(self) -> fem.Constant | None:
+        """The constant the friction terms are linear in (see ``friction_factor``)."""
+        if not self.with_friction:
+            return None
+        law = self.scene.law
+        if law.friction_coefficient is None \
+                and not isinstance(law.slip_rule, laws.EllipticSlipRule):
+            return self.mu
+        return fem.Constant(self.msh, np.float64(1.0))
+
     def _interface(self, u: fem.Function, u_dot: fem.Function, u_ddot: fem.Function,
                    v: ufl.Argument) -> tuple[ufl.Form | None, list]:
         """(UFL terms per unit breadth, couplings) of the contact and of any other body: here
@@ -220,7 +216,8 @@ class BlockModel:
         if law.b_n > 0:
             terms += normal_damping(u, u_dot, v, n, law, ds_c)
         if self.with_friction:
-            terms += friction(u, u_dot, v, n, law, self.belt_velocity, ds_c)
+            term = friction(u, u_dot, v, n, law, self.belt_velocity, ds_c)
+            terms += term if self.friction_factor is self.mu else self.friction_factor * term
         return terms, []
 
     def _supports(self) -> list[fem.DirichletBC]:

@@ -31,8 +31,9 @@ from fenicsfriction import _compat, laws
 from fenicsfriction.contact import NodeToSegment
 from fenicsfriction.contact.pairing import surface_coordinates
 from fenicsfriction.forms import elasticity, inertia
+from fenicsfriction.meshing import vertex_rows
 from fenicsfriction.studies.block.data import CONTACT, LEFT, RIGHT, TOP
-from fenicsfriction.studies.block.model import BlockModel, _vertex_rows
+from fenicsfriction.studies.block.model import BlockModel
 from fenicsfriction.studies.block.slab import (
     BLOCK,
     SLAB,
@@ -64,7 +65,7 @@ def slab_arrays(scene: BlockOnSlab) -> tuple[np.ndarray, np.ndarray, int]:
     nx, ny = 4 * s.refine, 3 * s.refine
     h = s.L / nx
     x_block = np.linspace(0.0, s.L, nx + 1)
-    rows = _vertex_rows(ny, 1, s.H, s.spring_height)
+    rows = vertex_rows(ny, 1, s.H, s.spring_height)
     overhang = (s.slab_length - s.L) / 2
     n_side = max(1, int(np.ceil(overhang / (2 * h))))
     left = np.linspace(-overhang, 0.0, n_side + 1)
@@ -130,6 +131,12 @@ class SlabModel(BlockModel):
     def dx_slab(self) -> ufl.Measure:
         """The volume measure of the slab."""
         return ufl.Measure("dx", domain=self.msh, subdomain_data=self.cell_tags)(SLAB)
+
+    def _friction_factor(self) -> fem.Constant | None:
+        """μ when the contact's friction bound is μ c_n; None otherwise (the contact's
+        friction has no factor of its own)."""
+        factor = super()._friction_factor()
+        return factor if factor is self.mu else None
 
     def _interface(self, u: fem.Function, u_dot: fem.Function, u_ddot: fem.Function,
                    v: ufl.Argument) -> tuple[ufl.Form, list]:
