@@ -6,12 +6,14 @@ The measured numbers and their mesh convergence are in docs/brake-squeal.md.
 """
 
 import math
+import pathlib
 
 from mpi4py import MPI
 
 import numpy as np
 import pytest
 
+from fenicsfriction.case import CaseModel, read_case
 from fenicsfriction.stability import StabilitySolver
 from fenicsfriction.steady import SteadySolver, continuation
 from fenicsfriction.studies.squeal import geometry
@@ -19,6 +21,7 @@ from fenicsfriction.studies.squeal.model import PinOnDiscModel
 from fenicsfriction.studies.squeal.study import stability_study, transient_growth
 from fenicsfriction.studies.squeal.two_mode import coalescence
 
+ROOT = pathlib.Path(__file__).resolve().parents[1]
 MUS = [0.0, 0.3, 0.45]  # μ_crit = 0.371 on the coarse mesh
 MAX_MODULUS = 2 * math.pi * 5000  # [1/s]: the band of the study (stability_study's default)
 
@@ -97,6 +100,27 @@ def test_the_flutter_mode_grows_at_the_rate_of_its_eigenvalue(studied):
     assert omega == pytest.approx(np.angle(z) / dt, rel=1e-3)
     assert a == pytest.approx(lam.real, rel=1.5e-2)
     assert omega == pytest.approx(lam.imag, rel=1e-2)
+
+
+def test_the_case_file_is_the_same_model(studied, shared_tmp_path):
+    """cases/pin-on-disc.toml, its mesh written by its script, run to μ = 0.45: the same
+    growing eigenvalue as the Python scene's (Newton to 1e-10 of the load, the PEP to 1e-10)."""
+    model, _ = studied
+    text = (ROOT / "cases" / "pin-on-disc.toml").read_text().replace(
+        '"../meshes/pin_on_disc.py"', f'"{ROOT / "meshes" / "pin_on_disc.py"}"')
+    path = shared_tmp_path / "pin-on-disc.toml"
+    if MPI.COMM_WORLD.rank == 0:
+        path.write_text(text)
+    case = read_case(path) if MPI.COMM_WORLD.rank == 0 else None  # rank 0 runs the script
+    case = MPI.COMM_WORLD.bcast(case, root=0)
+    from_file = CaseModel(case, MPI.COMM_WORLD)
+    from_file.initial_guess()
+    steady = SteadySolver(from_file.residual, prefix="test_pod_case_", linear_solver="lu")
+    continuation(steady, from_file.parameters["mu"], MUS)
+    growing = [max((m.value for m in StabilitySolver(residual, prefix=f"test_pod_{name}_pep_")
+                    .solve(MAX_MODULUS)), key=lambda v: v.real)
+               for name, residual in (("case", from_file.residual), ("scene", model.residual))]
+    assert growing[0] == pytest.approx(growing[1], rel=1e-7)
 
 
 @pytest.mark.mpi(min_size=2)

@@ -33,8 +33,8 @@ holder holds the x and y components (a case file can say so), while the disc's a
 
 For another scene on the same disc (the brake's pads), call :func:`add_disc` in the gmsh
 model being built (the disc frame), tag its volume and faces with :func:`disc_groups`, and
-size the mesh with :func:`refine_near`; :class:`Disc` holds the disc's dimensions with the defaults of a small
-steel brake disc.
+size the mesh with :func:`refine_near`; :class:`Disc` holds the disc's dimensions with the
+defaults of a small steel brake disc.
 """
 
 from __future__ import annotations
