@@ -149,6 +149,11 @@ class PinOnDiscModel:
         self._pin_dofs = _compat.cell_dofs(V, geometry.cell_tags.find(PIN))
 
     @property
+    def msh(self) -> typing.Any:
+        """The mesh (both bodies)."""
+        return self.geometry.mesh
+
+    @property
     def dofs(self) -> int:
         """The number of displacement unknowns."""
         return self.V.dofmap.index_map.size_global * self.V.dofmap.index_map_bs
