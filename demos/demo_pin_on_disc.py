@@ -44,7 +44,6 @@
 # %%
 import json
 import logging
-import math
 import os
 import pathlib
 
@@ -120,7 +119,7 @@ if comm.rank == 0:
         for record in study.loci:
             for m in record["modes"]:
                 curves.setdefault(m["mode"], []).append((record["mu"], m["im"], m["re"]))
-        for ident, points in sorted(curves.items()):
+        for _, points in sorted(curves.items()):
             mu_, im, re = np.array(points).T
             line, = freq.plot(mu_, im / (2 * np.pi), ".-", lw=1)
             growth.plot(mu_, re, ".-", lw=1, color=line.get_color())

@@ -71,9 +71,26 @@ __all__ = [
     "refine_near",
 ]
 
-DISC, PIN = 1, 2
-DISC_HUB, DISC_TOP, DISC_BOTTOM, DISC_RIM = 10, 11, 12, 13
-PIN_FACE, PIN_TOP, PIN_SIDE, PIN_HELD = 20, 21, 22, 23
+#: cell tag of the disc
+DISC = 1
+#: cell tag of the pin
+PIN = 2
+#: facet tag of the disc's inner rim (the hub, clamped)
+DISC_HUB = 10
+#: facet tag of the disc's top face (the master surface)
+DISC_TOP = 11
+#: facet tag of the disc's bottom face
+DISC_BOTTOM = 12
+#: facet tag of the disc's outer rim
+DISC_RIM = 13
+#: facet tag of the pin's end pressed on the disc (the slave surface)
+PIN_FACE = 20
+#: facet tag of the pin's top (loaded)
+PIN_TOP = 21
+#: facet tag of the pin's free side
+PIN_SIDE = 22
+#: facet tag of the pin's side in its holder
+PIN_HELD = 23
 
 #: the physical groups' names, by tag
 NAMES = {DISC: "disc", PIN: "pin", DISC_HUB: "disc-hub", DISC_TOP: "disc-top",

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import typing
 
 from mpi4py import MPI
 
