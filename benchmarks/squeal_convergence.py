@@ -4,8 +4,8 @@ The pin-on-disc scene (``fenicsfriction.studies.squeal``: a steel pin inclined 2
 sliding direction, held in a rigid sleeve and pressed with 48 N on a steel disc clamped at its
 hub, linear normal compliance 1e11 N/m³, ε = 1e-3 m/s ≪ ω R_p = 0.65 m/s) is meshed with
 tetrahedra at decreasing sizes (every size times ``--scales``; 1 is h = 8 mm in the disc,
-2 mm at the contact and in the pin). On each mesh: steady sliding and the eigenvalue loci on a μ grid, the
-onset μ_crit bisected to ``--tol``, the two real modes of the frictionless problem that carry
+2 mm at the contact and in the pin). On each mesh: steady sliding and the eigenvalue loci on
+a μ grid, the onset μ_crit bisected to ``--tol``, the two real modes of the frictionless problem that carry
 the flutter mode (their frequencies: the coupling frequencies) and the onset μ_c of the
 two-mode model built from them (:mod:`fenicsfriction.studies.squeal.two_mode`).
 
