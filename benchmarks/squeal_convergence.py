@@ -3,11 +3,11 @@ r"""Mesh convergence of the pin on the disc: the coupling frequencies and the fl
 The pin-on-disc scene (``fenicsfriction.studies.squeal``: a steel pin inclined 20° towards the
 sliding direction, held in a rigid sleeve and pressed with 48 N on a steel disc clamped at its
 hub, linear normal compliance 1e11 N/m³, ε = 1e-3 m/s ≪ ω R_p = 0.65 m/s) is meshed with
-tetrahedra at decreasing sizes (every size times ``--scales``; 1 is h = 8 mm in the disc,
-2 mm at the contact and in the pin). On each mesh: steady sliding and the eigenvalue loci on
-a μ grid, the onset μ_crit bisected to ``--tol``, the two real modes of the frictionless problem that carry
-the flutter mode (their frequencies: the coupling frequencies) and the onset μ_c of the
-two-mode model built from them (:mod:`fenicsfriction.studies.squeal.two_mode`).
+tetrahedra at decreasing sizes (every size times ``--scales``; 1 is h = 8 mm in the disc, 2 mm
+at the contact and in the pin). On each mesh: steady sliding and the eigenvalue loci on a μ
+grid, the onset μ_crit bisected to ``--tol``, the two real modes of the frictionless problem
+that carry the flutter mode (their frequencies: the coupling frequencies) and the onset μ_c of
+the two-mode model built from them (:mod:`fenicsfriction.studies.squeal.two_mode`).
 
 Observed rates from three successive meshes (h_{k+1}/h_k = r): p = log(|q_k - q_{k+1}| /
 |q_{k+1} - q_{k+2}|) / log(1/r), in the mesh size h.
