@@ -7,7 +7,8 @@ tetrahedra at decreasing sizes (every size times ``--scales``; 1 is h = 8 mm in 
 at the contact and in the pin). On each mesh: steady sliding and the eigenvalue loci on a μ
 grid, the onset μ_crit bisected to ``--tol``, the two real modes of the frictionless problem
 that carry the flutter mode (their frequencies: the coupling frequencies) and the onset μ_c of
-the two-mode model built from them (:mod:`fenicsfriction.studies.squeal.two_mode`).
+the two-mode model built from them (:mod:`fenicsfriction.studies.squeal.two_mode`), and the
+onset of the pencil projected on the 12 lowest real modes.
 
 Observed rates from three successive meshes (h_{k+1}/h_k = r): p = log(|q_k - q_{k+1}| /
 |q_{k+1} - q_{k+2}|) / log(1/r), in the mesh size h.
