@@ -73,6 +73,7 @@ benchmark: setup
 	        --no-install-recommends $(BENCH_PACKAGES))
 	$(PY) benchmarks/bench_steady.py --out $(OUT)/benchmarks
 	$(PY) benchmarks/bench_stability.py --out $(OUT)/benchmarks
+	$(PY) benchmarks/bench_cea.py --out $(OUT)/benchmarks
 	$(PY) benchmarks/bench_dynamics.py --out $(OUT)/benchmarks
 	$(PY) benchmarks/bench_oscillators.py --out $(OUT)/benchmarks
 	$(PY) benchmarks/bench_scaling.py --out $(OUT)/benchmarks

@@ -40,6 +40,7 @@ __all__ = [
     "elastic_support",
     "elasticity",
     "friction",
+    "geometric_stiffness",
     "gyroscopic",
     "inertia",
     "normal_compliance",
@@ -207,6 +208,19 @@ def centripetal_load(rho: Value, w: Field, v: Field, dx: ufl.Measure) -> ufl.For
     """
     return rho * ufl.inner(convective_derivative(w, w), v) * dx
 
+
+
+def geometric_stiffness(sigma0: Field, u: Field, v: Field, dx: ufl.Measure) -> ufl.Form:
+    """Stiffness of a prestress :math:`\\sigma_0`:
+    :math:`\\int_\\Omega \\sigma_0 : (\\nabla u)^T\\nabla v = \\langle(\\nabla u)\\sigma_0,
+    \\nabla v\\rangle`.
+
+    The linearisation of the Green-Lagrange strain's quadratic part about a stressed state
+    (small strain, σ0 symmetric). For a spinning body, σ0 = σ(u_c) with u_c the static
+    response to :func:`centripetal_load`: the centrifugal stiffening that, added to
+    :func:`centrifugal_softening`, makes a free body's rigid rotation neutral again.
+    """
+    return ufl.inner(ufl.dot(ufl.grad(u), sigma0), ufl.grad(v)) * dx
 
 # --- nodal springs (point loads are not UFL integrals in dolfinx 0.5) ----------------------------
 

@@ -15,14 +15,15 @@ import os
 import pathlib
 import platform
 import re
+import sys
 import typing
 
 from mpi4py import MPI
 
 import numpy as np
 
-__all__ = ["CsvRows", "Record", "blas_library", "environment", "get_logger", "to_plain",
-           "write_json", "write_summary"]
+__all__ = ["CsvRows", "Record", "StderrHandler", "blas_library", "environment", "get_logger",
+           "to_plain", "write_json", "write_summary"]
 
 
 def to_plain(value: typing.Any) -> typing.Any:
@@ -57,11 +58,25 @@ class Record:
         return to_plain(self)
 
 
+class StderrHandler(logging.StreamHandler):
+    """A handler writing to ``sys.stderr`` as it is when a record comes, not as it was when
+    the handler was made (a test's captured stream is closed once the test ends)."""
+
+    @property
+    def stream(self) -> typing.Any:
+        """The current ``sys.stderr``."""
+        return sys.stderr
+
+    @stream.setter
+    def stream(self, value: typing.Any) -> None:
+        pass
+
+
 def get_logger(comm: MPI.Comm = MPI.COMM_WORLD) -> logging.Logger:
     """The package logger: INFO on rank 0, warnings only elsewhere."""
     logger = logging.getLogger("fenicsfriction")
     if not logger.handlers:
-        handler = logging.StreamHandler()
+        handler = StderrHandler()
         handler.setFormatter(logging.Formatter("%(message)s"))
         logger.addHandler(handler)
         logger.propagate = False

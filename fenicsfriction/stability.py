@@ -29,7 +29,9 @@ at the same steady state with the friction constant of the residual
 terms are linear in it, so the result is exactly the operator less its friction part, for the
 integrals and for node-to-segment couplings alike. An instability that survives without the
 friction stiffness is not mode coupling; one that disappears without the friction damping is
-negative damping (the distinction of Abaqus's and ANSYS's complex eigenvalue analyses).
+negative damping (the distinction of Abaqus's and ANSYS's complex eigenvalue analyses);
+beware that a small non-proportional damping can itself destabilise a coupling pair below its
+coalescence (Hoffmann & Gaul 2003), so the onset with the damping may lie below both.
 """
 
 from __future__ import annotations
@@ -162,6 +164,8 @@ class StabilitySolver:
     Attributes:
         pep: the SLEPc PEP, exposed for inspection or further configuration.
         K, C, M: the assembled PETSc matrices (after :meth:`assemble`).
+        frictionless: the names ("K", "C") of the operators assembled without their friction
+            part.
     """
 
     def __init__(self, residual: Residual, prefix: str = "stability_",
@@ -175,7 +179,6 @@ class StabilitySolver:
                              "linear in (Residual.friction), and this residual has none")
         self.residual = residual
         self.residual_tol = residual_tol
-        #: the operators assembled with the residual's friction constant set to 0
         self.frictionless = {name for name, kept in (("K", friction_stiffness),
                                                      ("C", friction_damping)) if not kept}
         self.comm = residual.V.mesh.comm

@@ -5,6 +5,7 @@ closed-form friction torque; a transient from the unstable mode grows at Re λ."
 import json
 import math
 import pathlib
+import zlib
 
 from mpi4py import MPI
 
@@ -186,15 +187,17 @@ def test_a_transient_from_the_unstable_mode_grows_at_re_lambda(shared_tmp_path):
     assert (shared_tmp_path / "out" / "transient.csv").stat().st_size > 0
 
 
-def block_at(folder: pathlib.Path, mu: float, cea: str) -> tuple:
-    """The block case at ``mu`` with the [cea] table's extra lines ``cea``, solved steady."""
+def block_at(folder: pathlib.Path, mu: float, cea: str, comm: MPI.Comm = COMM) -> tuple:
+    """The block case at ``mu`` with the [cea] table's extra lines ``cea``, solved steady on
+    ``comm``."""
     text = (ROOT / "cases" / "block-on-belt.toml").read_text().replace(
         "onset_tol = 1e-4", "onset_tol = 1e-4\n" + cea)
-    case = read_case(write_case(folder, f"case-{abs(hash(cea))}.toml", text))
-    model = CaseModel(case, COMM)
+    key = zlib.crc32(cea.encode())  # not hash(): it differs between the ranks' interpreters
+    case = read_case(write_case(folder, f"case-{key}.toml", text))
+    model = CaseModel(case, comm)
     model.initial_guess()
     slide(model.residual, model.parameters["mu"], [0.0, mu][:1 + (mu > 0)],
-          f"switch_{abs(hash(cea))}_")
+          f"switch_{key}_")
     return case, model
 
 
@@ -205,7 +208,7 @@ def test_the_friction_stiffness_alone_makes_the_block_flutter(shared_tmp_path):
     for extra, grows in (("", True), ("friction_stiffness = false", False),
                          ("friction_damping = false", True)):
         case, model = block_at(shared_tmp_path, 0.5, extra)
-        solver = eigensolver(case, model, prefix=f"switch_pep_{abs(hash(extra))}_")
+        solver = eigensolver(case, model, prefix=f"switch_pep_{zlib.crc32(extra.encode())}_")
         largest = max(m.value.real for m in solver.solve(solver.max_modulus))
         assert (largest > 100) == grows, (extra, largest)
 
@@ -215,23 +218,29 @@ def test_a_complete_modal_basis_gives_the_full_eigenvalues_and_modal_damping_its
     """Projected on all 126 real modes the quadratic eigenproblem is the full one (Galerkin
     with a complete basis): the same eigenvalues at μ = 0.5, to the PEP's tolerance. At μ = 0
     K̄ is symmetric and C = 0, so the basis modes are the modes: with modal damping ζ each
-    eigenvalue is ω(-ζ + i sqrt(1 - ζ²)), Re λ = -ζ |λ|: to 1e-5, as Φᵀ K̄ Φ is diagonal to
+    eigenvalue is ω(-ζ + i sqrt(1 - ζ²)), Re λ = -ζ |λ|: to 1e-4, as Φᵀ K̄ Φ is diagonal to
     the basis's EPS tolerance only (1e-10 of ‖K̄‖, the complete basis reaching far above the
-    band; measured 1e-7, and 3e-6 for the driver spring's 5 rad/s mode)."""
+    band; measured 1e-7, and 3e-6 to 2e-5 for the driver spring's 5 rad/s mode, depending on
+    the EPS's subspace size). Each rank solves
+    alone: a shift-and-invert EPS asked for all 126 modes at once does not always return a
+    complete basis on 2 ranks (measured: the unstable pair off by 2e-5 in one run of three)."""
     from fenicsfriction.case.analyses import eigensolver
-    case, model = block_at(shared_tmp_path, 0.5, "")
+    case, model = block_at(shared_tmp_path, 0.5, "", MPI.COMM_SELF)
     full = spectrum(model.residual, "complete_full_")
-    case, model = block_at(shared_tmp_path, 0.5, 'method = "projection"\nmodes = 126')
+    case, model = block_at(shared_tmp_path, 0.5, 'method = "projection"\nmodes = 126',
+                           MPI.COMM_SELF)
     solver = eigensolver(case, model, prefix="complete_projected_")
     projected = sorted((m.value for m in solver.solve(solver.max_modulus)),
                        key=lambda z: (round(z.imag, 3), z.real))
+    # to the PEP's tolerance (a basis of 20 modes is off by 1e-3: μ_crit 0.3723 against 0.3703)
     assert np.abs(np.array(projected) - full).max() <= 1e-8 * np.abs(full).max()
     case, model = block_at(shared_tmp_path, 0.0,
-                           'method = "projection"\nmodes = 126\nmodal_damping = 0.02')
+                           'method = "projection"\nmodes = 126\nmodal_damping = 0.02',
+                           MPI.COMM_SELF)
     solver = eigensolver(case, model, prefix="complete_damped_")
     for mode in solver.solve(solver.max_modulus):
         deviation = abs(mode.value.real / (-0.02 * abs(mode.value)) - 1)
-        assert deviation < 1e-5
+        assert deviation < 1e-4
 
 
 #: a gmsh script of the convention of meshes/*.py (``--out FILE``): the block's 4 × 3 grid of

@@ -69,6 +69,14 @@ def chain(n: int, seed: int = 0) -> dict[str, scipy.sparse.csr_matrix]:
             "C0": scipy.sparse.diags(0.02 * masses).tocsr()}
 
 
+def sparse_random(n: int, density: float, rng: np.random.Generator) -> scipy.sparse.csr_matrix:
+    """An n × n matrix with about density·n² entries uniform in [0, 1) at random places
+    (scipy.sparse.random's seeding keyword differs between SciPy versions)."""
+    count = int(density * n * n)
+    rows, cols = rng.integers(0, n, count), rng.integers(0, n, count)
+    return scipy.sparse.csr_matrix((rng.random(count), (rows, cols)), shape=(n, n))
+
+
 def at(parts: dict, mu: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return (parts["M"].toarray(), parts["C0"].toarray(),
             (parts["K0"] + mu * parts["K1"]).toarray())
@@ -98,7 +106,7 @@ def test_companion_qz_gives_the_undamped_frequencies_in_closed_form():
 def test_band_solve_by_pep_agrees_with_dense_qz():
     """SLEPc's TOAR (forced even on a small system) and LAPACK's QZ find the same eigenvalues in
     the band, each with a small residual, and nothing outside it."""
-    parts = chain(150)
+    parts = chain(100)
     band = Band(2.0, 12.0)
     solver = BandSolver(COMM, prefix=prefix("pep"), dense_below=0)
     pep = solver.solve(*petsc(parts, 0.4), band)
@@ -108,6 +116,26 @@ def test_band_solve_by_pep_agrees_with_dense_qz():
     assert np.allclose(values(pep), values(qz), rtol=1e-8, atol=0)
     assert max(m.residual for m in pep + qz) < 1e-10
     assert all(band.contains(m.value) for m in pep)
+
+
+def test_band_solve_by_pep_agrees_with_dense_qz_on_a_random_sparse_pencil():
+    """n = 160, K an unsymmetric sparse random matrix made positive by its diagonal, C random
+    sparse, M a random positive diagonal: no structure for either solver to rely on."""
+    rng = np.random.default_rng(11)
+    n = 160
+    noise = sparse_random(n, 0.02, rng)
+    K = (noise + scipy.sparse.diags(4.0 + rng.random(n))).tocsr() * 1e3
+    C = sparse_random(n, 0.01, rng)
+    M = scipy.sparse.diags(0.5 + rng.random(n)).tocsr()
+    band = Band(8.0, 9.0)  # the lowest 33 eigenvalues
+    solver = BandSolver(COMM, prefix=prefix("random"), dense_below=0)
+    pep = solver.solve(*(from_array(A, COMM) for A in (M, C, K)), band)
+    qz = dense_modes(M.toarray(), C.toarray(), K.toarray(), band)
+    assert len(pep) == len(qz) > 5
+    qz_values = values(qz)
+    nearest = qz_values[np.abs(values(pep)[:, None] - qz_values[None, :]).argmin(axis=1)]
+    assert np.allclose(values(pep), nearest, rtol=1e-8, atol=0)
+    assert max(m.residual for m in pep) < 1e-10
 
 
 def test_band_solve_on_a_mid_size_pencil_agrees_with_arpack():
@@ -205,7 +233,7 @@ def _write_on_rank0(write) -> None:
 
 
 def test_readers_round_trip_matrix_market_matlab_and_petsc_binary(shared_tmp_path):
-    A = scipy.sparse.random(9, 9, density=0.3, random_state=2, format="csr") + scipy.sparse.eye(9)
+    A = (sparse_random(9, 0.3, np.random.default_rng(2)) + scipy.sparse.eye(9)).tocsr()
     B = np.arange(81.0).reshape(9, 9)
     _write_on_rank0(lambda: scipy.io.mmwrite(str(shared_tmp_path / "A.mtx"), A))
     _write_on_rank0(lambda: scipy.io.savemat(str(shared_tmp_path / "one.mat"), {"K": A}))

@@ -105,7 +105,9 @@ def test_interaction_response_falls_like_r_minus_3_beyond_the_correlation_length
     (["eq", "--coupling", "0.1"], "--N"),
     (["stability-map", "--N", "100", "--couplings", "0.1", "--K", "3"], "--K"),
     (["stability-map"], "--K"),
-    (["stability-map", "--N", "144", "--couplings", "-0.1"], "--couplings")])
+    (["stability-map", "--N", "144", "--couplings", "-0.1"], "--couplings"),
+    # a lattice too small to reach the far law's range r > 3 λ_c
+    (["interaction", "--n", "32"], "--n")])
 def test_bad_value_is_one_line_naming_the_parameter_and_exit_2(shared_tmp_path, capsys, argv,
                                                                 name):
     code = main(["multicontact", *argv, "--out", str(shared_tmp_path / "bad")])

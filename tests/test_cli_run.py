@@ -149,5 +149,6 @@ def test_a_good_case_runs_and_writes_its_files(shared_tmp_path):
     for mu, row in zip((0.0, 0.1, 0.2), summary["steady"], strict=True):
         assert row["contact0_normal_force"] == pytest.approx(2.0, rel=1e-8)
         assert row["contact0_friction_force_x"] == pytest.approx(mu * 2.0, rel=1e-8, abs=1e-12)
-    for name in ("steady.csv", "cea.csv", "steady.xdmf", "loci.png", "continuation.png"):
+    for name in ("steady.csv", "cea.csv", "steady.xdmf", "loci.png", "coupling_map.png",
+                 "continuation.png"):
         assert (out / name).stat().st_size > 0, name

@@ -54,7 +54,8 @@ def slab_at_0_2():
     model, steady = sliding(ff.BlockOnSlab(), 0.2)
     solver = StabilitySolver(model.residual, prefix=prefix("pep"))
     modes = solver.solve(MAX_MODULUS)
-    fim = FreeInterfaceModes(model.residual, slab_bodies(model), prefix=prefix("fim"))
+    fim = FreeInterfaceModes(model.residual, slab_bodies(model), modes=None,
+                             prefix=prefix("fim"))
     return model, steady, solver, modes, fim
 
 
@@ -96,6 +97,11 @@ def test_a_truncated_basis_leaves_the_rest_unexplained(slab_at_0_2):
             assert total == pytest.approx(1.0, abs=1e-12)
             assert -1e-8 < record.unexplained < 1.0
         unexplained[count] = np.array([r.unexplained for r in records])
+    by_frequency = FreeInterfaceModes(model.residual, slab_bodies(model), max_frequency=5000.0,
+                                      prefix=prefix("fmax"))
+    # the block's modes below 5 kHz: 0, 0, 0.79, 3140, 3990, 4360 Hz; the slab's first: 6451
+    assert [b.basis.size for b in by_frequency.bodies] == [6, 0]
+    assert by_frequency.contributions(modes[1]).unexplained < 3e-3
     assert np.all(unexplained[3][1:3] < 3e-3)
     assert np.all(unexplained[3][3:] > 0.99)
     assert np.all(unexplained[10] < 1e-3)
@@ -129,9 +135,10 @@ def test_the_blocks_free_modes_are_the_same_on_the_belt_and_on_the_slab():
     relative; tolerance 1e-8)."""
     belt, _ = sliding(ff.BlockOnBelt(degree=1, contact_quadrature="nodal"), 0.1)
     on_belt = FreeInterfaceModes(belt.residual, {"block": all_cells(belt)}, interface=[CONTACT],
-                                 prefix=prefix("belt"))
+                                 modes=None, prefix=prefix("belt"))
     slab = ff.BlockOnSlab().build(COMM, with_friction=True)
-    on_slab = FreeInterfaceModes(slab.residual, slab_bodies(slab), prefix=prefix("slab"))
+    on_slab = FreeInterfaceModes(slab.residual, slab_bodies(slab), modes=None,
+                                 prefix=prefix("slab"))
     a, b = on_belt.bodies[0].basis.omega2, on_slab.bodies[0].basis.omega2
     assert len(a) == len(b) == 40
     assert np.all(abs(a[:2]) < 1e-9 * a[-1]) and np.all(abs(b[:2]) < 1e-9 * b[-1])

@@ -12,7 +12,7 @@ import pytest
 from test_stability import dense_operators, sensitivity
 
 import fenicsfriction as ff
-from fenicsfriction.cea.coupling_map import ProjectedStability, coupling_map, plot_coupling_map
+from fenicsfriction.cea.coupling_map import ProjectedStability, coupling_map
 from fenicsfriction.stability import Loci, StabilitySolver
 
 COMM = MPI.COMM_WORLD
@@ -47,23 +47,23 @@ def full_map():
 def test_the_map_finds_the_known_onset_and_its_two_modes(full_map, shared_tmp_path):
     """The onset bisected between the grid's last stable (0.3) and first unstable (0.4) value
     is the known 0.370 (to the 1e-3 the mesh's value is known to; measured 0.3703), the
-    colliding pair is the two tracked modes at 815 and 971 Hz at μ = 0 (the normal/rotation pair),
-    each drawn as a curve over every μ, and the map is JSON and a PNG."""
-    onset = full_map.onset
-    assert onset.mu_crit == pytest.approx(0.370, abs=1e-3)
-    assert 0.3 <= onset.interval[0] < onset.interval[1] <= 0.4
-    colliding = {c["mode"] for c in onset.colliding}
-    curves = {c["mode"]: c for c in full_map.modes}
-    assert len(colliding) == 2 and colliding <= set(curves)
-    for mode in colliding:
-        assert len(curves[mode]["mu"]) >= 4  # one branch each up to the coalescence at least
-        assert 800 < curves[mode]["frequency"][0] < 1000  # Hz: 815 and 971 at μ = 0
-    growing = [max(c["growth_rate"]) for c in curves.values()]
-    assert max(growing) > 100  # the branch past the onset grows at a few hundred 1/s
+    colliding pair is the two tracked modes at 815 and 971 Hz at μ = 0 (the normal/rotation
+    pair), each a curve over the values up to the coalescence, and the map is JSON and a PNG."""
+    assert len(full_map.coalescences) == 1
+    event = full_map.coalescences[0]
+    assert event.p_crit == pytest.approx(0.370, abs=1e-3)
+    assert 0.3 <= event.onset[0] < event.onset[1] <= 0.4
+    assert event.onset[1] - event.onset[0] <= 1e-4
+    assert len(set(event.modes)) == 2 and event.growing in event.modes
+    first = {m["mode"]: m for m in full_map.records[0]["modes"]}
+    for mode in event.modes:
+        assert 800 < first[mode]["frequency"] < 1000  # Hz: 815 and 971 at μ = 0
+        assert all(mode in {m["mode"] for m in r["modes"]} for r in full_map.records[:4])
+    assert max(r["max_re"] for r in full_map.records) > 100  # a few hundred 1/s past it
     data = full_map.to_json()
-    assert data["projection"] is None and data["onset"]["mu_crit"] == onset.mu_crit
+    assert data["projection"] is None and data["coalescences"][0]["p_crit"] == event.p_crit
     path = shared_tmp_path / "map.png"
-    plot_coupling_map(full_map, path, max_frequency=1500.0)
+    full_map.plot(path, max_frequency=1500.0)
     COMM.Barrier()
     assert path.read_bytes()[:4] == b"\x89PNG"
 
@@ -79,7 +79,7 @@ def test_the_projected_onset_approaches_the_full_one_as_modes_are_added(full_map
     for modes in (3, 12, 40):
         projected = coupling_map(loci(modes), [0.0, 0.35, 0.4], tol=1e-4)
         assert projected.projection == modes
-        errors.append(projected.onset.mu_crit - full_map.onset.mu_crit)
+        errors.append(projected.coalescences[0].p_crit - full_map.coalescences[0].p_crit)
     assert 0 < errors[2] < errors[1] < errors[0] < 0.012, errors
     assert errors[2] < 2e-3
 

@@ -14,7 +14,6 @@ from mpi4py import MPI
 import dolfinx.fem.petsc
 import numpy as np
 import pytest
-import ufl
 
 import fenicsfriction as ff
 from fenicsfriction import _compat
@@ -157,6 +156,33 @@ def test_the_friction_damping_destabilises_before_the_coupling():
         assert (growth > 1e-5) == grows, (kept, growth)
 
 
+def test_the_switch_drops_the_friction_of_node_to_segment_contact():
+    """On the block on an elastic slab the friction is in the node-to-segment coupling, not in
+    the integrals; at μ = 0.3, past its onset (0.2-0.25), K̄ is unsymmetric by 1.2 % of its
+    largest entry and the pair grows at 259 s⁻¹. Without the friction stiffness K̄ is
+    symmetric to round-off (measured 6e-17; tolerance 100 u_mach: frictionless contact derives
+    from a potential) and, C being zero (no damping, no friction damping in 2D), every
+    eigenvalue is on the imaginary axis to round-off (measured |Re λ| ≤ 1e-11 |λ|; tolerance
+    1e-9)."""
+    model = ff.BlockOnSlab().build(COMM, with_friction=True)
+    model.initial_guess()
+    steady = ff.SteadySolver(model.residual, prefix=prefix("slab"),
+                             options=model.solver_options())
+    ff.continuation(steady, model.mu, np.linspace(0.05, 0.3, 6))
+    assert model.residual.friction is model.mu
+    for kept in (True, False):
+        solver = StabilitySolver(model.residual, prefix=prefix("slabpep"),
+                                 friction_stiffness=kept)
+        modes = solver.solve(MAX_MODULUS)
+        K = dense(solver.K)
+        asymmetry = abs(K - K.T).max() / abs(K).max()
+        growth = max(abs(m.value.real) / abs(m.value) for m in modes)
+        if kept:
+            assert asymmetry > 1e-3 and growth > 1e-2
+        else:
+            assert asymmetry < 100 * EPS_MACH and growth < 1e-9
+
+
 def test_dropping_friction_needs_a_friction_constant():
     """A residual without a friction constant (a frictionless model) refuses the switch."""
     model = ff.BlockOnBelt(refine=1).build(COMM, with_friction=False)
@@ -165,20 +191,53 @@ def test_dropping_friction_needs_a_friction_constant():
         StabilitySolver(model.residual, prefix=prefix("refused"), friction_stiffness=False)
 
 
-def test_a_friction_coefficient_law_gets_a_factor_of_its_own():
-    """With μ(v) a law, the block's friction term carries a factor of value 1
-    (``friction_factor``): K̄ without it is symmetric, and the factor is 1 again after."""
-    law = ff.InterfaceLaw(friction_coefficient=ff.laws.StribeckFriction(
-        mu_s=0.4, mu_k=0.3, v_s=0.5))
-    model = ff.BlockOnBelt(refine=1, law=law).build(COMM)
+STRIBECK = ff.InterfaceLaw(friction_coefficient=ff.laws.StribeckFriction(
+    mu_s=0.4, mu_k=0.2, v_s=0.5))  # μ(0.287 cm/s) = 0.313, falling: dμ/dv = -0.225 s/cm
+
+
+def steady_with_law(scene):
+    model = scene.build(COMM)
     model.initial_guess()
-    ff.SteadySolver(model.residual, prefix=prefix("law"),
-                    options=model.solver_options()).solve()
+    ff.SteadySolver(model.residual, prefix=prefix("law"), options=model.solver_options()).solve()
+    return model
+
+
+def test_a_falling_friction_law_is_negative_damping_not_coupling():
+    """With μ(v) a law the block's friction term carries a factor of value 1 of its own
+    (``friction_factor``), which the switch sets to 0. Stribeck's law falls through μ = 0.313
+    at the belt speed, below the coupling onset 0.370: every mode grows with everything on
+    (measured Re λ from 0.11 to 226 s⁻¹), none without the friction damping, and they still
+    grow without the friction stiffness: negative damping. K̄ without its friction part is
+    symmetric to round-off (tolerance 100 u_mach), and the factor is 1 again afterwards."""
+    model = steady_with_law(ff.BlockOnBelt(refine=1, law=STRIBECK))
     assert model.residual.friction is model.friction_factor is not model.mu
-    solver = StabilitySolver(model.residual, prefix=prefix("lawpep"), friction_stiffness=False)
-    solver.assemble()
-    K = dense(solver.K)
-    assert abs(K - K.T).max() < 100 * EPS_MACH * abs(K).max()
+    growing = {}
+    for stiffness, damping in ((True, True), (True, False), (False, True)):
+        solver = StabilitySolver(model.residual, prefix=prefix("lawpep"),
+                                 friction_stiffness=stiffness, friction_damping=damping)
+        modes = solver.solve(MAX_MODULUS)
+        growing[stiffness, damping] = [m for m in modes if m.value.real > 1e-6 * abs(m.value)]
+        if not stiffness:
+            K = dense(solver.K)
+            assert abs(K - K.T).max() < 100 * EPS_MACH * abs(K).max()
+    assert len(growing[True, True]) == 6
+    assert not growing[True, False]
+    assert len(growing[False, True]) >= 6
     assert float(model.friction_factor.value) == 1.0
-    ufl_constants = ufl.algorithms.analysis.extract_constants(model.residual.form)
-    assert model.friction_factor in ufl_constants
+
+
+def test_the_slabs_contact_carries_the_factor_of_a_friction_law():
+    """On the slab the friction coefficient law of the node-to-segment contact is multiplied by
+    the factor: without the friction damping C is zero (no normal damping), with it C has the
+    negative damping of the falling law (a negative eigenvalue of C + Cᵀ)."""
+    model = steady_with_law(ff.BlockOnSlab(law=STRIBECK))
+    assert model.residual.friction is model.friction_factor is not None
+    for damping in (True, False):
+        solver = StabilitySolver(model.residual, prefix=prefix("slablaw"),
+                                 friction_damping=damping)
+        solver.assemble()
+        C = dense(solver.C)
+        if damping:
+            assert np.linalg.eigvalsh(C + C.T).min() < 0
+        else:
+            assert abs(C).max() == 0.0

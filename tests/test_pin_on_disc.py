@@ -6,12 +6,14 @@ The measured numbers and their mesh convergence are in docs/brake-squeal.md.
 """
 
 import math
+import pathlib
 
 from mpi4py import MPI
 
 import numpy as np
 import pytest
 
+from fenicsfriction.case import CaseModel, read_case
 from fenicsfriction.stability import StabilitySolver
 from fenicsfriction.steady import SteadySolver, continuation
 from fenicsfriction.studies.squeal import geometry
@@ -19,7 +21,8 @@ from fenicsfriction.studies.squeal.model import PinOnDiscModel
 from fenicsfriction.studies.squeal.study import stability_study, transient_growth
 from fenicsfriction.studies.squeal.two_mode import coalescence
 
-MUS = [0.0, 0.3, 0.45]  # μ_crit ≈ 0.37 on the coarse mesh
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+MUS = [0.0, 0.3, 0.45]  # μ_crit = 0.371 on the coarse mesh
 MAX_MODULUS = 2 * math.pi * 5000  # [1/s]: the band of the study (stability_study's default)
 
 
@@ -29,7 +32,8 @@ def build(comm=MPI.COMM_WORLD) -> PinOnDiscModel:
 
 @pytest.fixture(scope="module")
 def studied():
-    """The coarse model and its study; the model is left in steady sliding at μ = 0.45."""
+    """The coarse model and its study; the model is left in steady sliding at μ = 0.45, where
+    a second pair (two modes of the pin) flutters too."""
     model = build()
     return model, stability_study(model, MUS, tol=2e-3, prefix="test_pod_")
 
@@ -48,34 +52,35 @@ def test_the_closed_form_coalescence_is_where_the_two_frequencies_merge():
     assert np.linalg.eigvals(K)[0] == pytest.approx(omega_c**2, rel=1e-6)
 
 
-def test_flutter_starts_where_two_pin_modes_merge(studied):
-    """The onset lies inside the grid's bracket and the growing mode is a merged pair of the
-    pin's two modes in the sliding plane (most of its kinetic energy in the pin); the modes
-    the two-mode model picks are those two (the pin's, at μ = 0, either side of the onset
-    frequency); the projected K̄ is linear in μ (the steady state enters only through the
-    small geometric terms of the contact)."""
-    model, study = studied
+def test_flutter_starts_where_a_pin_mode_meets_a_disc_mode(studied):
+    """The onset lies inside the grid's bracket; the two modes that merge are a mode of the
+    disc (under 10 % of its kinetic energy in the pin) and one of the pin (over half), and the
+    two-mode model's real modes sit either side of the onset frequency; the projected K̄ is
+    linear in μ (the steady state enters only through the small geometric terms of the
+    contact)."""
+    _, study = studied
     assert MUS[1] < study.mu_crit < MUS[2]
-    assert study.growing["pin_share"] > 0.5
-    two = study.two_mode
-    low, high = two["frequencies_hz"]
+    disc, pin = sorted(study.coupling, key=lambda m: m["pin_share"])
+    assert disc["pin_share"] < 0.1 < 0.5 < pin["pin_share"]
+    low, high = study.two_mode["frequencies_hz"]
     assert low < study.onset_value[1] / (2 * math.pi) < high
     assert study.two_mode_linearity < 1e-4
-    assert len(study.coupling) == 2
-    assert all(mode["overlap"] > 0.3 for mode in study.coupling)
 
 
-def test_the_two_mode_model_brackets_the_onset_from_above(studied):
-    """The two-mode model drops the disc's modes between the pair and the friction's
-    damping: its onset is later than the full model's, by 8 % on the coarse mesh and 6-8 % on
-    every mesh of the convergence study (docs/brake-squeal.md). The test allows 0-15 %."""
+def test_the_projected_onset_converges_to_the_full_one_with_the_modes(studied):
+    """The pencil projected on the two real modes (Hoffmann's model, closed form) flutters
+    later than the full model: it drops the other modes, through which the pin's mode veers
+    faster towards the disc's (32 % on the coarse mesh, docs/brake-squeal.md). Projected on
+    the 12 lowest modes (up to 9.4 kHz, twice the band) its onset is the full model's to
+    within a Galerkin error of the modes left out: 0.6 % measured, 3 % allowed."""
     _, study = studied
-    ratio = study.two_mode["mu_c"] / study.mu_crit
-    assert 1.0 < ratio < 1.15, ratio
+    assert study.two_mode["mu_c"] > study.mu_crit
+    assert study.two_mode["mu_c_damped"] == pytest.approx(study.two_mode["mu_c"], rel=2e-2)
+    assert study.basis_onset == pytest.approx(study.mu_crit, rel=3e-2)
 
 
 def test_the_flutter_mode_grows_at_the_rate_of_its_eigenvalue(studied):
-    """From the steady state at μ = 0.45 plus the growing mode (1 nm at most), the normal
+    """From the steady state at μ = 0.45 plus its fastest growing mode (1 nm at most), the normal
     force oscillates as N₀ + A e^{at} cos(ωt + φ). Generalized-α with ρ∞ = 1 is the
     trapezoidal rule: a mode λ is multiplied by z = (1 + λΔt/2)/(1 - λΔt/2) per step, so the
     fit must give log|z|/Δt and arg z/Δt (0.3 %: the fit of two periods), and so a and ω of
@@ -95,6 +100,29 @@ def test_the_flutter_mode_grows_at_the_rate_of_its_eigenvalue(studied):
     assert omega == pytest.approx(np.angle(z) / dt, rel=1e-3)
     assert a == pytest.approx(lam.real, rel=1.5e-2)
     assert omega == pytest.approx(lam.imag, rel=1e-2)
+
+
+def test_the_case_file_is_the_same_model(studied, shared_tmp_path):
+    """cases/pin-on-disc.toml run to μ = 0.45: the same growing eigenvalue as the Python
+    scene's (Newton to 1e-10 of the load, the PEP to 1e-10). Its mesh is written here by the
+    function its script calls (the case runner's ``python SCRIPT`` cannot start MPI inside an
+    ``mpirun``)."""
+    model, _ = studied
+    path = shared_tmp_path / "pin-on-disc.toml"
+    if MPI.COMM_WORLD.rank == 0:
+        geometry.pin_on_disc(MPI.COMM_SELF, msh_file=str(shared_tmp_path / "pin-on-disc.msh"))
+        path.write_text((ROOT / "cases" / "pin-on-disc.toml").read_text().replace(
+            '"../meshes/pin_on_disc.py"', f'"{ROOT / "meshes" / "pin_on_disc.py"}"'))
+    case = read_case(path) if MPI.COMM_WORLD.rank == 0 else None
+    case = MPI.COMM_WORLD.bcast(case, root=0)
+    from_file = CaseModel(case, MPI.COMM_WORLD)
+    from_file.initial_guess()
+    steady = SteadySolver(from_file.residual, prefix="test_pod_case_", linear_solver="lu")
+    continuation(steady, from_file.parameters["mu"], MUS)
+    growing = [max((m.value for m in StabilitySolver(residual, prefix=f"test_pod_{name}_pep_")
+                    .solve(MAX_MODULUS)), key=lambda v: v.real)
+               for name, residual in (("case", from_file.residual), ("scene", model.residual))]
+    assert growing[0] == pytest.approx(growing[1], rel=1e-7)
 
 
 @pytest.mark.mpi(min_size=2)

@@ -61,6 +61,20 @@ def test_ufl_velocity_equals_numpy_velocity():
     assert COMM.allreduce(fem.assemble_scalar(error)) < 1e-28
 
 
+def test_ufl_velocity_equals_numpy_velocity_about_a_tilted_axis_in_3d():
+    """The 3D UFL cross product, written out, against NumPy's, on a box (P1 interpolation of a
+    linear field is exact)."""
+    msh = _compat.create_box(COMM, (0.0, 0.0, 0.0), (1.0, 2.0, 1.0), (2, 2, 2))
+    rot = RigidRotation(omega=-3.0, axis=(1.0, -2.0, 0.5), point=(0.1, 0.4, -0.3))
+    w = rot.velocity(ufl.SpatialCoordinate(msh))
+    w_h = fem.Function(_compat.vector_function_space(msh, 1))
+    w_h.interpolate(rot.velocity)
+    error = fem.form(ufl.inner(w_h - w, w_h - w) * ufl.dx)
+    norm = fem.form(ufl.inner(w, w) * ufl.dx)
+    assert COMM.allreduce(fem.assemble_scalar(error)) < 1e-28 * COMM.allreduce(
+        fem.assemble_scalar(norm))
+
+
 @pytest.mark.parametrize(("kwargs", "message"), [
     ({"omega": 1.0, "axis": (0.0, 0.0, 0.0)}, "nonzero"),
     ({"omega": 1.0, "axis": (1.0, 0.0)}, "3 finite components"),

@@ -10,8 +10,9 @@ r"""The analyses of a case file, run in order on one built model and written as 
   :math:`|\lambda| \le 2\pi f_{max}`, those with :math:`f = \mathrm{Im}\,\lambda / 2\pi` in
   the band [fmin, fmax] kept), modes tracked by MAC (:class:`~fenicsfriction.stability.Loci`)
   and each onset of instability bisected: ``cea.csv`` one row per mode and step,
-  ``unstable_modes.xdmf`` the most unstable mode shape at each unstable step, ``loci.png`` and
-  ``growth.png``.
+  ``unstable_modes.xdmf`` the most unstable mode shape at each unstable step, ``loci.png``,
+  ``growth.png`` and ``coupling_map.png`` (frequency and growth rate of each tracked mode
+  against the parameter).
 * **transient** — generalized-α integration (:class:`~fenicsfriction.dynamics.DynamicsSolver`)
   from the steady state at ``transient.at`` perturbed by the most unstable mode,
   :math:`u = u_0 + A\,\mathrm{Re}\,\phi`, :math:`\dot u = A\,\mathrm{Re}(\lambda\phi)`
@@ -404,6 +405,11 @@ def _figures(case: Case, outcome: Outcome, out: pathlib.Path, comm: MPI.Comm) ->
         plotting.plot_growth(outcome.cea, [], out / "growth.png", comm)
     if comm.rank != 0:
         return
+    if outcome.cea:  # the map brake-squeal engineers read (the onsets are in summary.json)
+        from fenicsfriction.cea.figures import plot_coupling_map
+        plot_coupling_map([{"p": r["mu"], "modes": [
+            {**m, "frequency": m["im"] / (2 * math.pi)} for m in r["modes"]]}
+            for r in outcome.cea], out / "coupling_map.png", param_name=outcome.parameter)
     if outcome.steady:
         name = outcome.parameter
         keys = [k for k in outcome.steady[0] if k != name and k.endswith(

@@ -781,11 +781,17 @@ def _check_groups(c: _Checker, case: Case, make_mesh: bool) -> dict[tuple[int, s
 
 
 def _run_script(c: _Checker, script: pathlib.Path, file: pathlib.Path) -> None:
-    """``python SCRIPT --out FILE`` (the convention of meshes/*.py), the package on the path."""
+    """``python SCRIPT --out FILE`` (the convention of meshes/*.py), the package on the path.
+
+    The script runs as a process of its own, outside the MPI job that may be reading the case:
+    the launcher's variables (Open MPI's, PMIx's) are left out of its environment, else its
+    ``import mpi4py`` would try to join the job and fail.
+    """
     import os
     root = pathlib.Path(__file__).resolve().parents[2]
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(
-        [str(root), str(script.parent), os.environ.get("PYTHONPATH", "")])}
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_", "PMI_"))}
+    env["PYTHONPATH"] = os.pathsep.join(
+        [str(root), str(script.parent), os.environ.get("PYTHONPATH", "")])
     run = subprocess.run([sys.executable, str(script), "--out", str(file)], env=env,
                          capture_output=True, text=True, cwd=script.parent)
     if run.returncode != 0 or not file.is_file():

@@ -7,10 +7,11 @@ anywhere — the finite element model's :class:`~fenicsfriction.stability.Stabil
 files exported by other codes (:mod:`~fenicsfriction.cea.matrices`) — and every eigenvalue in a
 frequency band (:class:`~fenicsfriction.cea.band.Band`) is computed on the full matrices
 (:mod:`~fenicsfriction.cea.full`: SLEPc PEP, or QZ when small, :mod:`~fenicsfriction.cea.dense`)
-or on a modal basis (:mod:`~fenicsfriction.cea.projection`), swept in p with modes tracked and
-their coalescence located (:mod:`~fenicsfriction.cea.sweep`), drawn as a mode-coupling map
-(:mod:`~fenicsfriction.cea.figures`) and checked against the two-degree-of-freedom model of
-Hoffmann et al. (2002) (:mod:`~fenicsfriction.cea.hoffmann`).
+or on a modal basis (:mod:`~fenicsfriction.cea.projection`), read as each body's
+free-interface modes' shares (:mod:`~fenicsfriction.cea.contributions`), swept in p with modes
+tracked and their coalescence located (:mod:`~fenicsfriction.cea.sweep`), drawn as a
+mode-coupling map (:mod:`~fenicsfriction.cea.figures`) and checked against the
+two-degree-of-freedom model of Hoffmann et al. (2002) (:mod:`~fenicsfriction.cea.hoffmann`).
 
 The names are loaded on first use (``import fenicsfriction.cea`` imports no PETSc).
 """
@@ -32,15 +33,21 @@ _EXPORTS: dict[str, str] = {
     "Sweep": "sweep", "Coalescence": "sweep",
     "HoffmannModel": "hoffmann",
     "plot_coupling_map": "figures",
+    "FreeInterfaceModes": "contributions", "ModeContributions": "contributions",
+    "plot_contributions": "contributions",
+    "ProjectedStability": "coupling_map", "CouplingMap": "coupling_map",
 }
 
-_SUBMODULES = ("band", "dense", "figures", "full", "hoffmann", "matrices", "projection", "sweep")
+_SUBMODULES = ("band", "contributions", "coupling_map", "dense", "figures", "full", "hoffmann",
+               "matrices", "projection", "sweep")
 
 __getattr__, __dir__, __all__ = attach(__name__, _EXPORTS, _SUBMODULES)
 
 if typing.TYPE_CHECKING:
     from fenicsfriction.cea import (
         band,
+        contributions,
+        coupling_map,
         dense,
         figures,
         full,
@@ -50,6 +57,12 @@ if typing.TYPE_CHECKING:
         sweep,
     )
     from fenicsfriction.cea.band import Band
+    from fenicsfriction.cea.contributions import (
+        FreeInterfaceModes,
+        ModeContributions,
+        plot_contributions,
+    )
+    from fenicsfriction.cea.coupling_map import CouplingMap, ProjectedStability
     from fenicsfriction.cea.dense import dense_modes, quadratic_eig
     from fenicsfriction.cea.figures import plot_coupling_map
     from fenicsfriction.cea.full import BandSolver

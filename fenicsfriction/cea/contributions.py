@@ -26,6 +26,8 @@ at the current state with the nodal springs and the Dirichlet rows, whose dofs a
 the bodies. A body without enough supports (the block held only by its driver spring) keeps its
 rigid-body modes, at zero frequency, as free-interface modes: they take part in the coupled
 modes like any other (the shift-and-invert target is negative, so K_b - σ M_b stays regular).
+Modes that share one frequency (the rigid ones) are an arbitrary basis of their eigenspace:
+only the sum of their contributions means something.
 """
 
 from __future__ import annotations
@@ -167,7 +169,10 @@ class FreeInterfaceModes:
             linear in this package, so any state gives the same K_b).
         bodies: each body's name and its cells (this rank's local cell indices).
         interface: facet tags whose integrals are the interface, left out of K_b.
-        modes: how many modes of each body (the lowest); None: all of them.
+        modes: how many modes of each body (the lowest); None: all of them (small bodies).
+        max_frequency: or every mode of each body below this frequency [Hz] (``modes`` is
+            then the first request; CEA practice keeps the body modes up to 1.5-2 times the
+            band's top).
         prefix: PETSc options prefix; body ``b``'s EPS has ``prefix + b + "_"``.
         options: EPS options over :data:`fenicsfriction.cea.projection.DEFAULT_OPTIONS`.
 
@@ -177,8 +182,9 @@ class FreeInterfaceModes:
     """
 
     def __init__(self, residual: Residual, bodies: dict[str, np.ndarray],
-                 interface: typing.Iterable[int] = (), modes: int | None = None,
-                 prefix: str = "cea_fim_", options: dict | None = None):
+                 interface: typing.Iterable[int] = (), modes: int | None = 20,
+                 max_frequency: float | None = None, prefix: str = "cea_fim_",
+                 options: dict | None = None):
         check("bodies", list(bodies), len(bodies) > 0, "give at least one body")
         self.comm: MPI.Comm = residual.V.mesh.comm
         M_form, _, K_form = residual.linearisation()
@@ -195,7 +201,8 @@ class FreeInterfaceModes:
             # a negative target below every mode: K_b - σ M_b is regular with rigid modes
             shift = -1e-6 * K_b.norm(PETSc.NormType.INFINITY) / M_b.norm(PETSc.NormType.INFINITY)
             basis = ModalBasis(K_b, M_b, modes=n if modes is None else min(modes, n),
-                               shift=shift, prefix=f"{prefix}{name}_", options=options)
+                               max_frequency=max_frequency, shift=shift,
+                               prefix=f"{prefix}{name}_", options=options)
             K_b.destroy()
             self.bodies.append(BodyModes(name=name, dofs=dofs, mass=M_b, basis=basis))
 

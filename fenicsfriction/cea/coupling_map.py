@@ -1,13 +1,14 @@
 r"""The mode-coupling map of a finite element model: frequencies and growth rates of its modes
 along the steady-sliding continuation in μ, the coalescence marked.
 
-:class:`~fenicsfriction.stability.Loci` continues the steady state in μ, solves the quadratic
-eigenproblem at each value and tracks each mode by MAC; :func:`coupling_map` keeps its records
-as curves per mode (frequency f = Im λ / 2π in Hz, growth rate Re λ in 1/s), and, when a mode
-grows within the values, bisects the onset between the last stable and the first unstable
-value (:meth:`~fenicsfriction.stability.Loci.onset`), which names the two modes that coalesce.
-:func:`plot_coupling_map` draws the map brake-squeal engineers read: the two branches merging in
-frequency as their growth rates split.
+:func:`coupling_map` continues the steady state of a
+:class:`~fenicsfriction.stability.Loci` over the μ values, solves its quadratic eigenproblem at
+each and runs the matrix-level sweep on it (:class:`~fenicsfriction.cea.sweep.Sweep`: modes
+tracked by MAC, frequency f = Im λ / 2π in Hz and growth rate Re λ in 1/s); each interval where
+a mode starts to grow is bisected, which names the two modes that coalesce
+(:class:`~fenicsfriction.cea.sweep.Coalescence`). :meth:`CouplingMap.plot` draws the map
+brake-squeal engineers read (:func:`fenicsfriction.cea.figures.plot_coupling_map`): the two
+branches merging in frequency as their growth rates split.
 
 **Modal projection** (:class:`ProjectedStability`): instead of the full quadratic eigenproblem
 at each μ, its projection on the m lowest real modes of the symmetric frictionless problem,
@@ -22,7 +23,6 @@ added (Galerkin), and each carries its residual against the full matrices.
 from __future__ import annotations
 
 import dataclasses
-import math
 import typing
 
 from mpi4py import MPI
@@ -31,11 +31,12 @@ from petsc4py import PETSc
 import numpy as np
 
 from fenicsfriction.cea.projection import ModalBasis, symmetric_part
+from fenicsfriction.cea.sweep import Coalescence, Sweep
 from fenicsfriction.laws import check
 from fenicsfriction.results import Record
-from fenicsfriction.stability import Loci, Mode, Onset, StabilitySolver
+from fenicsfriction.stability import Loci, Mode, StabilitySolver
 
-__all__ = ["CouplingMap", "ProjectedStability", "coupling_map", "plot_coupling_map"]
+__all__ = ["CouplingMap", "ProjectedStability", "coupling_map"]
 
 
 class ProjectedStability:
@@ -93,97 +94,59 @@ class ProjectedStability:
 
 @dataclasses.dataclass
 class CouplingMap(Record):
-    """Frequencies and growth rates of the tracked modes along μ, and the onset.
+    """The sweep along μ of a finite element model and where its modes couple.
 
     Attributes:
-        mu: the values of the continuation.
-        modes: per tracked mode ``{"mode": id, "mu": [...], "frequency": [... Hz],
-            "growth_rate": [... 1/s], "residual": [...]}`` (a mode may miss some values).
-        onset: the bisected onset (:class:`~fenicsfriction.stability.Onset`: ``mu_crit``,
-            ``interval``, the growing eigenvalue, the two ``colliding`` modes), or None when no
-            mode grows within the values.
+        records: one per μ (:attr:`Sweep.records <fenicsfriction.cea.sweep.Sweep.records>`):
+            ``p`` (μ), ``modes`` (``mode`` id, ``re``, ``im``, ``frequency`` [Hz],
+            ``residual``, ``accurate``), ``max_re``.
+        coalescences: each onset of growth, bisected, with the pair that coalesces.
         projection: the number of modes of the modal basis, or None (full eigenproblem).
     """
 
-    mu: list[float]
-    modes: list[dict[str, typing.Any]]
-    onset: Onset | None
+    records: list[dict[str, typing.Any]]
+    coalescences: list[Coalescence]
     projection: int | None = None
+
+    def plot(self, path: typing.Any, comm: MPI.Comm = MPI.COMM_WORLD,
+             max_frequency: float | None = None) -> None:
+        """The mode-coupling map as a PNG (:func:`fenicsfriction.cea.figures.plot_coupling_map`,
+        drawn on rank 0), the modes that start above ``max_frequency`` [Hz] left out."""
+        if comm.rank != 0:
+            return
+        from fenicsfriction.cea.figures import plot_coupling_map
+        records = self.records
+        if max_frequency is not None:
+            kept = {m["mode"] for m in records[0]["modes"] if m["frequency"] <= max_frequency}
+            records = [{**r, "modes": [m for m in r["modes"] if m["mode"] in kept]}
+                       for r in records]
+        plot_coupling_map(records, path, self.coalescences, param_name="μ")
 
 
 def coupling_map(loci: Loci, values: typing.Sequence[float], tol: float = 1e-3) -> CouplingMap:
-    """Follow the steady sliding over ``values`` (increasing), and bisect the onset to ``tol``
-    if a mode grows.
+    """Sweep the steady sliding of ``loci`` over ``values`` and bisect each onset to ``tol``.
 
     Args:
-        loci: the loci of the model (its eigensolver full or :class:`ProjectedStability`).
-        values: the μ of the continuation; the first must be stable for an onset to be found.
-        tol: width of the onset's bisection interval.
+        loci: the model's steady solver, eigensolver (full or :class:`ProjectedStability`),
+            continued parameter, disc |λ| <= ``max_modulus`` and growth tolerance.
+        values: the μ of the sweep, increasing from the steady state's.
+        tol: width of each onset's bisection interval.
 
     Returns:
-        The map; the steady state is left at the onset's stable end, else at the last value.
+        The map; the steady state is left where it was last solved: at the unstable end of
+        the last onset's bisection, else at the last value.
     """
+    from fenicsfriction.steady import continuation
     check("values", list(values), len(values) >= 2 and bool(np.all(np.diff(values) > 0)),
           "at least two increasing values")
-    steps: list[tuple[dict, list[Mode]]] = []
-    loci.follow(values, on_step=lambda record, modes: steps.append((record, modes)))
-    curves: dict[int, dict[str, list]] = {}
-    for record, _ in steps:
-        for m in record["modes"]:
-            curve = curves.setdefault(m["mode"], {"mode": m["mode"], "mu": [], "frequency": [],
-                                                  "growth_rate": [], "residual": []})
-            curve["mu"].append(record["mu"])
-            curve["frequency"].append(m["im"] / (2 * math.pi))
-            curve["growth_rate"].append(m["re"])
-            curve["residual"].append(m["residual"])
-    onset = None
-    unstable = [i for i, (_, modes) in enumerate(steps) if loci.unstable(modes)]
-    if unstable and unstable[0] > 0:
-        first = unstable[0]
-        onset = loci.onset(values[first - 1], values[first], tol=tol,
-                           reference=steps[first - 1][1])
+
+    def solve_at(value: float) -> list[Mode]:
+        continuation(loci.steady, loci.parameter, [value])
+        return loci.stability.solve(loci.max_modulus)
+
+    sweep = Sweep(solve_at, loci.comm, loci.growth_tol)
+    sweep.follow(values)
+    events = [sweep.refine(event, tol) for event in sweep.coalescences()]
     projection = loci.stability.modes if isinstance(loci.stability, ProjectedStability) \
         else None
-    return CouplingMap(mu=[float(v) for v in values], modes=list(curves.values()), onset=onset,
-                       projection=projection)
-
-
-def plot_coupling_map(result: CouplingMap, path: typing.Any, comm: MPI.Comm = MPI.COMM_WORLD,
-                      max_frequency: float | None = None) -> None:
-    """Frequency and growth rate against μ, one curve per tracked mode; the two colliding modes
-    in colour, the onset interval shaded (rank 0 draws).
-
-    Args:
-        result: the map.
-        path: the PNG written.
-        comm: the communicator (rank 0 draws).
-        max_frequency: the modes above it [Hz] are left out (None: every mode).
-    """
-    if comm.rank != 0:
-        return
-    from fenicsfriction.plotting import saved_figure
-    colliding = [] if result.onset is None else [c["mode"] for c in result.onset.colliding]
-    with saved_figure(path, ncols=2, figsize=(10.0, 4.0)) as axes:
-        for curve in result.modes:
-            if max_frequency is not None and min(curve["frequency"]) > max_frequency:
-                continue
-            highlighted = curve["mode"] in colliding
-            style = {"color": f"C{colliding.index(curve['mode'])}", "lw": 1.8,
-                     "label": f"mode {curve['mode']}"} if highlighted else \
-                {"color": "0.6", "lw": 0.8}
-            for ax, key in zip(axes, ("frequency", "growth_rate"), strict=True):
-                ax.plot(curve["mu"], curve[key], marker=".", **style)
-        for ax, label in zip(axes, ("frequency [Hz]", "growth rate Re λ [1/s]"), strict=True):
-            ax.set_xlabel("μ")
-            ax.set_ylabel(label)
-            if result.onset is not None:
-                low, high = result.onset.interval
-                ax.axvspan(low, high, color="C3", alpha=0.2, lw=0)
-                ax.axvline(result.onset.mu_crit, color="C3", ls="--", lw=0.8)
-        axes[1].axhline(0.0, color="k", lw=0.5)
-        title = "full" if result.projection is None else f"{result.projection} modes"
-        if result.onset is not None:
-            title += f", μ_crit = {result.onset.mu_crit:.4f}"
-        axes[0].set_title(title, fontsize=9)
-        if colliding:
-            axes[0].legend(fontsize=8)
+    return CouplingMap(records=sweep.records, coalescences=events, projection=projection)

@@ -91,7 +91,8 @@ class ModalBasis:
         request = min(modes or 16, n)
         limit = math.inf if max_frequency is None else (2 * math.pi * max_frequency) ** 2
         while True:
-            self.eps.setDimensions(nev=request)
+            # ncv and mpd given each time: slepc4py >= 3.20 keeps the previous ones otherwise
+            self.eps.setDimensions(nev=request, ncv=PETSc.DECIDE, mpd=PETSc.DECIDE)
             self.eps.solve()
             count = self.eps.getConverged()
             values = sorted(self.eps.getEigenvalue(i).real for i in range(count))
@@ -140,16 +141,16 @@ class ModalBasis:
         return basis
 
     def project(self, A: PETSc.Mat) -> np.ndarray:
-        """:math:`\\Phi^T A \\Phi`, dense m × m, the same on every rank."""
-        x, y = A.createVecs()
-        product = np.empty_like(self.phi)
-        for j in range(self.size):
-            x.setArray(self.phi[:, j])
-            A.mult(x, y)
-            product[:, j] = y.getArray()
-        x.destroy()
-        y.destroy()
-        return self.comm.allreduce(self.phi.T @ product)
+        """:math:`\\Phi^T A \\Phi`, dense m × m, the same on every rank (A Φ in one sparse ×
+        dense product, then this rank's rows of Φᵀ (AΦ), summed over the ranks)."""
+        rows, n = A.getLocalSize()[0], A.getSize()[0]
+        phi = PETSc.Mat().createDense(size=((rows, n), (PETSc.DECIDE, self.size)),
+                                      array=np.asfortranarray(self.phi), comm=A.getComm())
+        product = A.matMult(phi)
+        local = self.phi.T @ product.getDenseArray()
+        for obj in (product, phi):
+            obj.destroy()
+        return self.comm.allreduce(local)
 
     def solve(self, M: PETSc.Mat, C: PETSc.Mat, K: PETSc.Mat, band: Band | None = None,
               residual_tol: float = 1e-8) -> list[Mode]:

@@ -63,10 +63,9 @@ def _old_spelling(argv: list[str]) -> str | None:
     return f"'{old} {second}' is now '{new}'"
 
 
-#: the root logger's handler while a command runs: warnings and errors only
-_WARNINGS_ONLY = logging.StreamHandler()
-_WARNINGS_ONLY.setLevel(logging.WARNING)
-_WARNINGS_ONLY.setFormatter(logging.Formatter("%(levelname)s:%(name)s:%(message)s"))
+#: the root logger's handler while a command runs, warnings and errors only (made at the
+#: first run: its class comes with the MPI-importing results module)
+_WARNINGS_ONLY: list[logging.Handler] = []
 
 
 def _parser() -> Parser:
@@ -100,11 +99,16 @@ def main(argv: list[str] | None = None) -> int:
     # the just-in-time compiler's build (setuptools) configures the root logger at INFO the
     # first time a form is compiled, unless it has a handler already: one that passes only
     # warnings keeps its build lines off the terminal
-    if _WARNINGS_ONLY not in logging.getLogger().handlers:  # once: main() may run many times
-        logging.getLogger().addHandler(_WARNINGS_ONLY)
     from mpi4py import MPI
 
-    from fenicsfriction.results import blas_library, get_logger
+    from fenicsfriction.results import StderrHandler, blas_library, get_logger
+    if not _WARNINGS_ONLY:
+        handler = StderrHandler()
+        handler.setLevel(logging.WARNING)
+        handler.setFormatter(logging.Formatter("%(levelname)s:%(name)s:%(message)s"))
+        _WARNINGS_ONLY.append(handler)
+    if _WARNINGS_ONLY[0] not in logging.getLogger().handlers:  # once: main() runs many times
+        logging.getLogger().addHandler(_WARNINGS_ONLY[0])
     log = get_logger(MPI.COMM_WORLD)
     blas = blas_library()
     if blas["optimized"] is False:

@@ -197,11 +197,16 @@ def run_matrices(args: argparse.Namespace, log: logging.Logger) -> int:
         solvers["full"] = lambda p: full.solve(*pencil.at(p), band)
     if "projection" in methods:
         t0 = time.perf_counter()
-        stiffness = symmetric_part(pencil.K0)
-        basis = ModalBasis(stiffness, pencil.M,
-                           modes=None if args.basis_frequency else min(args.modes or 40,
-                                                                       pencil.size),
-                           max_frequency=args.basis_frequency, prefix="cea_basis_")
+        try:
+            basis = ModalBasis(symmetric_part(pencil.K0), pencil.M,
+                               modes=None if args.basis_frequency
+                               else min(args.modes or 40, pencil.size),
+                               max_frequency=args.basis_frequency, prefix="cea_basis_")
+        except EigenSolveError as err:
+            results.write_summary(out / "summary.json", {"failure": f"modal basis: {err}"},
+                                  comm)
+            stop_line(f"modal basis: {err}")
+            return 1
         basis_time = time.perf_counter() - t0
         log.info(f"modal basis: {basis.size} modes of (sym K, M), {basis.frequencies[0]:.4g}-"
                  f"{basis.frequencies[-1]:.4g} Hz, in {basis_time:.3g} s")
@@ -282,8 +287,8 @@ def run_matrices(args: argparse.Namespace, log: logging.Logger) -> int:
             plot_coupling_map(sweep.records, out / f"coupling_map_{method}.png",
                               events.get(method, []), args.param_name)
         for e in events.get(method, []):
-            log.info(f"{method}: mode {e.growing} grows past {args.param_name} = {e.p_crit:.6g} "
-                     f"(bracket {e.onset[0]:.6g}-{e.onset[1]:.6g}) at {e.frequency:.6g} Hz, "
+            log.info(f"{method}: mode {e.growing} grows past {args.param_name} = {e.p_crit:.8g} "
+                     f"(bracket {e.onset[0]:.8g} to {e.onset[1]:.8g}) at {e.frequency:.6g} Hz, "
                      f"modes {e.modes} at relative frequency gap {e.gap[0]:.3g} -> "
                      f"{e.gap[1]:.3g}")
     comm.Barrier()

@@ -297,11 +297,28 @@ def _run_coupling_map(args: argparse.Namespace, log: logging.Logger, comm: MPI.C
 
 # --- the elastic interaction of contacts --------------------------------------------------------
 
+def _far_bins(n: int, lambda_c: float) -> int:
+    """How many of the response's distance bins lie beyond 3 λ_c (the far law's range)."""
+    import numpy as np
+
+    edges = np.geomspace(1.0, n / 4, 40)
+    return int(np.count_nonzero(np.sqrt(edges[1:] * edges[:-1]) > 3 * lambda_c))
+
+
+def _smallest_n(lambda_c: float) -> int:
+    """The smallest lattice side whose far range holds two bins."""
+    n = 8
+    while _far_bins(n, lambda_c) < 2:
+        n += 1
+    return n
+
+
 def _run_interaction(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
     import numpy as np
 
     from fenicsfriction import results
     from fenicsfriction.cli.common import output_folder, write_rows
+    from fenicsfriction.laws import check
     from fenicsfriction.studies.multicontact import (
         LatticeInteraction,
         figures,
@@ -309,8 +326,12 @@ def _run_interaction(args: argparse.Namespace, log: logging.Logger, comm: MPI.Co
         radial_profile,
     )
 
-    out = output_folder(args.out, comm)
     lam = args.lambda_c
+    edges = np.geomspace(1.0, args.n / 4, 40)
+    check("--n", args.n, _far_bins(args.n, lam) >= 2,
+          f"a lattice reaching past 3 λ_c = {3 * lam:g} spacings, where the far law is "
+          f"fitted (with --lambda-c {lam:g}: --n >= {_smallest_n(lam)})")
+    out = output_folder(args.out, comm)
     lattice = LatticeInteraction(n=args.n, spacing=1.0, E=1.0, nu=args.nu, stiffness=1.0 / lam,
                                  contact_radius=0.5)
     log.info(f"interaction: {args.n} x {args.n} contacts (spacing a = 1, E = 1, ν = "
@@ -318,8 +339,7 @@ def _run_interaction(args: argparse.Namespace, log: logging.Logger, comm: MPI.Co
              "under a uniform shear")
     broken = (args.n // 2) * args.n + args.n // 2
     response = lattice.break_response((1.0, 0.0, 0.0), broken)
-    r, f = radial_profile(lattice.positions, response, broken,
-                          edges=np.geomspace(1.0, args.n / 4, 40))
+    r, f = radial_profile(lattice.positions, response, broken, edges=edges)
     f = f / np.linalg.norm(response[broken])
     near = max(lam / 4, 2.0)  # at least two distance bins for the near law
     fit = fit_power_laws(r, f, near, 3 * lam)

@@ -76,7 +76,8 @@ class BlockModel:
         friction_factor: the ``fem.Constant`` the friction terms are linear in
             (:attr:`fenicsfriction.forms.Residual.friction`): ``mu`` when the friction bound is
             μ c_n, else a factor of value 1 multiplying the friction term (a friction
-            coefficient law, an elliptic slip rule); None without friction.
+            coefficient law, an elliptic slip rule), which the stability solver alone sets to
+            0 while it assembles the parts it drops; None without friction.
     """
 
     CONTACT = CONTACT

@@ -133,10 +133,12 @@ class SlabModel(BlockModel):
         return ufl.Measure("dx", domain=self.msh, subdomain_data=self.cell_tags)(SLAB)
 
     def _friction_factor(self) -> fem.Constant | None:
-        """μ when the contact's friction bound is μ c_n; None otherwise (the contact's
-        friction has no factor of its own)."""
-        factor = super()._friction_factor()
-        return factor if factor is self.mu else None
+        """μ when the contact's friction bound is μ c_n; a factor of the friction coefficient
+        law (see :meth:`_interface`); None with an elliptic slip rule (its bound μ_ref c_n
+        has no factor of its own)."""
+        if isinstance(self.scene.law.slip_rule, laws.EllipticSlipRule):
+            return None
+        return super()._friction_factor()
 
     def _interface(self, u: fem.Function, u_dot: fem.Function, u_ddot: fem.Function,
                    v: ufl.Argument) -> tuple[ufl.Form, list]:
@@ -145,6 +147,11 @@ class SlabModel(BlockModel):
         s = self.scene
         law = self.law if self.with_friction else \
             self.law.replace(mu=0.0, friction_coefficient=None, slip_rule=None)
+        factor, coefficient = self.friction_factor, law.friction_coefficient
+        if factor is not None and coefficient is not None:
+            # the contact's friction linear in friction_factor, the stability's switch
+            law = law.replace(friction_coefficient=lambda speed, pressure:
+                              factor * coefficient(speed, pressure))
         self.rho_slab = fem.Constant(self.msh, np.float64(s.slab_density))
         slab = inertia(self.rho_slab, u_ddot, v, self.dx_slab) \
             + elasticity(u, v, s.slab_E, s.slab_nu, self.dx_slab)

@@ -26,10 +26,15 @@ name                  value  entities
 ``pin-held``          23     the pin's side in its holder (the sleeve at its top)
 ====================  =====  ================================================================
 
+The pin-on-disc mesh is written in the pin's frame: built as above, it is then turned about the
+x axis by the pin's inclination α (:class:`Pin`), so that the pin's axis is e_z and its
+holder holds the x and y components (a case file can say so), while the disc's axis becomes
+:attr:`Pin.disc_axis` = (0, -sin α, cos α) through the origin.
+
 For another scene on the same disc (the brake's pads), call :func:`add_disc` in the gmsh
-model being built, tag its volume and faces with :func:`disc_groups`, and size the mesh with
-:func:`refine_near`; :class:`Disc` holds the disc's dimensions with the defaults of a small
-steel brake disc.
+model being built (the disc frame), tag its volume and faces with :func:`disc_groups`, and
+size the mesh with :func:`refine_near`; :class:`Disc` holds the disc's dimensions with the
+defaults of a small steel brake disc.
 """
 
 from __future__ import annotations
@@ -66,9 +71,26 @@ __all__ = [
     "refine_near",
 ]
 
-DISC, PIN = 1, 2
-DISC_HUB, DISC_TOP, DISC_BOTTOM, DISC_RIM = 10, 11, 12, 13
-PIN_FACE, PIN_TOP, PIN_SIDE, PIN_HELD = 20, 21, 22, 23
+#: cell tag of the disc
+DISC = 1
+#: cell tag of the pin
+PIN = 2
+#: facet tag of the disc's inner rim (the hub, clamped)
+DISC_HUB = 10
+#: facet tag of the disc's top face (the master surface)
+DISC_TOP = 11
+#: facet tag of the disc's bottom face
+DISC_BOTTOM = 12
+#: facet tag of the disc's outer rim
+DISC_RIM = 13
+#: facet tag of the pin's end pressed on the disc (the slave surface)
+PIN_FACE = 20
+#: facet tag of the pin's top (loaded)
+PIN_TOP = 21
+#: facet tag of the pin's free side
+PIN_SIDE = 22
+#: facet tag of the pin's side in its holder
+PIN_HELD = 23
 
 #: the physical groups' names, by tag
 NAMES = {DISC: "disc", PIN: "pin", DISC_HUB: "disc-hub", DISC_TOP: "disc-top",
@@ -110,7 +132,8 @@ class Pin:
     distance ``length`` from the contact point along the axis. Its last ``held`` along the
     axis sits in a holder (a sleeve): that part of its side is tagged apart, so that a model
     can hold it across the axis there, which clamps the pin's bending and leaves its axial
-    motion free.
+    motion free. (All this in the disc's frame; the mesh of :func:`pin_on_disc` is turned
+    into the pin's, where a = e_z and the disc's axis is :attr:`disc_axis`.)
 
     Args:
         radius: the contact point's distance from the disc's axis, R_p [m].
@@ -133,8 +156,14 @@ class Pin:
         laws.check("angle", self.angle, abs(self.angle) < 60, "must lie in (-60, 60) degrees")
 
     @property
+    def disc_axis(self) -> tuple[float, float, float]:
+        """The disc's axis in the pin's frame (the mesh's): (0, -sin α, cos α)."""
+        alpha = math.radians(self.angle)
+        return (0.0, -math.sin(alpha), math.cos(alpha))
+
+    @property
     def axis(self) -> tuple[float, float, float]:
-        """The unit vector a of the pin's axis, towards its top."""
+        """The unit vector a of the pin's axis, towards its top, in the disc's frame."""
         alpha = math.radians(self.angle)
         return (0.0, math.sin(alpha), math.cos(alpha))
 
@@ -252,7 +281,9 @@ def _add_pin(gmsh: typing.Any, pin: Pin) -> list[int]:
 def pin_on_disc(comm: MPI.Comm, disc: Disc = Disc(), pin: Pin = Pin(), h_far: float = 0.008,
                 h_contact: float | None = None, h_pin: float | None = None,
                 refine: int = 0, msh_file: str | None = None) -> PinOnDiscMesh:
-    """A pin pressed on the disc's top face (tetrahedra; tags in the module docstring).
+    """A pin pressed on the disc's top face (tetrahedra; tags in the module docstring), in
+    the pin's frame: the pin's axis is e_z, its face's centre (the contact point) at
+    (radius, 0, 0), the disc's axis :attr:`Pin.disc_axis` through the origin.
 
     Mesh sizes: ``h_contact`` (default pin_radius / 2) within 3 pin radii of the contact
     point, growing by 0.5 per unit distance up to ``h_far`` in the disc; the pin has the size
@@ -289,7 +320,6 @@ def pin_on_disc(comm: MPI.Comm, disc: Disc = Disc(), pin: Pin = Pin(), h_far: fl
         groups = disc_groups(gmsh, disc, disc_volume)
         groups.update({PIN_FACE: [], PIN_TOP: [], PIN_SIDE: [], PIN_HELD: []})
         a = pin.axis
-        top = [pin.radius + pin.length * a[0], pin.length * a[1], pin.length * a[2]]
         boundary = gmsh.model.getBoundary([(3, v) for v in pin_volumes], oriented=False)
         for _, face in boundary:
             box = gmsh.model.getBoundingBox(2, face)
@@ -304,12 +334,30 @@ def pin_on_disc(comm: MPI.Comm, disc: Disc = Disc(), pin: Pin = Pin(), h_far: fl
                 groups[PIN_HELD].append(face)
             else:
                 groups[PIN_SIDE].append(face)
+        # into the pin's frame: a turn by α about the x axis (through the contact point).
+        # OpenCASCADE renumbers the faces it turns: they are found again by their centres
+        # and areas (the hub's and the rim's centres coincide)
+        angle = math.radians(pin.angle)
+        turn = np.array([[1, 0, 0], [0, math.cos(angle), -math.sin(angle)],
+                         [0, math.sin(angle), math.cos(angle)]])
+
+        def signature(face: int, rotation: np.ndarray) -> np.ndarray:
+            centre = rotation @ gmsh.model.occ.getCenterOfMass(2, face)
+            return np.append(centre, math.sqrt(gmsh.model.occ.getMass(2, face)))
+
+        keys = {face: signature(face, turn) for faces in groups.values() for face in faces}
+        gmsh.model.occ.rotate([(3, v) for v in (disc_volume, *pin_volumes)],
+                              0, 0, 0, 1, 0, 0, angle)
+        gmsh.model.occ.synchronize()
+        now = [(face, signature(face, np.eye(3))) for _, face in gmsh.model.getEntities(2)]
+        renamed = {old: min(now, key=lambda f: float(np.linalg.norm(f[1] - k)))[0]
+                   for old, k in keys.items()}
         add_groups(gmsh, 3, {DISC: [disc_volume], PIN: pin_volumes})
-        add_groups(gmsh, 2, groups)
+        add_groups(gmsh, 2, {tag: [renamed[f] for f in faces] for tag, faces in groups.items()})
         # the pin at its own size along its length, the disc refined under it
         field = gmsh.model.mesh.field
         pin_zone = field.add("Ball")
-        middle = [(pin.radius + t) / 2 if i == 0 else t / 2 for i, t in enumerate(top)]
+        middle = [pin.radius, 0.0, pin.length / 2]
         for key, value in (("XCenter", middle[0]), ("YCenter", middle[1]),
                            ("ZCenter", middle[2]), ("Radius", pin.length / 2 + 2 * h_p),
                            ("VIn", h_p), ("VOut", h_f)):

@@ -20,7 +20,12 @@ from fenicsfriction.results import Record
 from fenicsfriction.stability import Loci, Mode, StabilitySolver
 from fenicsfriction.steady import SteadySolver, continuation
 from fenicsfriction.studies.squeal.model import PinOnDiscModel
-from fenicsfriction.studies.squeal.two_mode import TwoModeModel, project, real_modes
+from fenicsfriction.studies.squeal.two_mode import (
+    TwoModeModel,
+    modal_onset,
+    project,
+    real_modes,
+)
 
 __all__ = ["StabilityStudy", "TransientGrowth", "stability_study", "transient_growth"]
 
@@ -40,12 +45,15 @@ class StabilityStudy(Record):
             whose eigenvectors overlap most with the growing mode's in the mass inner product
             (``mode`` id, ``re``, ``im``, ``frequency_hz``, ``pin_share``, ``overlap``). (The
             frequencies alone can name the wrong pair: a mode of the disc or one damped by
-            the friction may sit between the two that merge.)
-        growing: the growing mode at the first unstable grid point (``mu``, ``re``, ``im``,
+            the friction may sit between the two that merge.) The two-mode model's real modes
+            are those nearest to these two, one each.
+        growing: the growing mode at the unstable end of the bracket (``mu``, ``re``, ``im``,
             ``pin_share``).
         two_mode: the two-mode model (:meth:`TwoModeModel.to_json`), its onset ``mu_c``.
         two_mode_linearity: max |B(μ₁/2) - B(μ₁)| / max |B(μ₁)|: how far the projected K̄
             is from linear in μ.
+        basis_frequencies_hz: the real modes computed (μ = 0) [Hz].
+        basis_onset: the onset of the pencil projected on all of them (damping included).
     """
 
     dofs: int
@@ -58,6 +66,8 @@ class StabilityStudy(Record):
     growing: dict
     two_mode: dict
     two_mode_linearity: float
+    basis_frequencies_hz: list[float]
+    basis_onset: float
 
 
 def _row(model: PinOnDiscModel, mode: Mode) -> dict[str, typing.Any]:
@@ -98,8 +108,17 @@ class _MassOverlap:
         self.y.destroy()
 
 
+def overlap_with(M: typing.Any, vector: np.ndarray, comm: typing.Any,
+                 basis: typing.Sequence[typing.Any]) -> tuple[list[float], float]:
+    """The mass overlaps of ``vector`` with each basis vector, and the largest."""
+    overlap = _MassOverlap(M, vector, comm)
+    weights = [overlap(phi.getArray()) for phi in basis]
+    overlap.destroy()
+    return weights, max(weights)
+
+
 def stability_study(model: PinOnDiscModel, mus: typing.Sequence[float],
-                    max_frequency: float = 5000.0, growth_tol: float = 1e-5,
+                    max_frequency: float = 5000.0, growth_tol: float = 1e-4,
                     tol: float = 1e-3, basis_size: int = 12,
                     prefix: str = "pin_on_disc_") -> StabilityStudy:
     """Steady sliding, loci and onset along ``mus`` (increasing from 0), and the two-mode model.
@@ -108,8 +127,9 @@ def stability_study(model: PinOnDiscModel, mus: typing.Sequence[float],
         model: the built scene.
         mus: the grid of friction coefficients (the first one 0).
         max_frequency: every eigenvalue with |λ| <= 2π max_frequency is computed [Hz].
-        growth_tol: a mode grows when Re λ > growth_tol |λ| (1e-5: the disc's modes take
-            Re λ ~ 1e-6 |λ| from the friction's geometric terms, far below the flutter's).
+        growth_tol: a mode grows when Re λ > growth_tol |λ| (1e-4: the disc's modes take
+            Re λ up to 3e-5 |λ| from the friction's geometric terms; a flutter pair's Re λ
+            grows like sqrt(μ - μ_crit), which puts the threshold within 1e-5 of μ_crit).
         tol: the width of the onset's final bracket.
         basis_size: real modes computed for the two-mode model (the pair is picked among them).
         prefix: PETSc options prefix of the solvers.
@@ -141,28 +161,40 @@ def stability_study(model: PinOnDiscModel, mus: typing.Sequence[float],
     if first is None or first == 0:
         raise RuntimeError(f"no onset on the grid {list(mus)}: need stable sliding at the "
                            "first μ and a growing mode at a later one")
-    growing = max(loci.unstable(seen[first]), key=lambda m: m.value.real)
-    growing_row = {"mu": float(mus[first]), **_row(model, growing)}
-    # the two real modes that carry the growing one
-    overlap = _MassOverlap(M, growing.vector, model.comm)
-    weights = [overlap(phi.getArray()) for phi in basis]
-    pair = sorted(int(i) for i in np.argsort(weights)[-2:])
-    chosen = [basis[i] for i in pair]
     mu1 = float(mus[first])
-    projected = {}
-    for value in (mu1 / 2, mu1):
-        continuation(steady, model.mu, [value])
-        stability.assemble()
-        projected[value] = (project(stability.K, chosen), project(stability.C, chosen))
-    k0 = np.diag(omega2[pair])
-    two_mode = TwoModeModel.build(k0, *projected[mu1], mu1, pair)
-    half = (projected[mu1 / 2][0] - k0) / (mu1 / 2)
-    linearity = float(np.abs(half - two_mode.B).max() / np.abs(two_mode.B).max())
     onset = loci.onset(float(mus[first - 1]), mu1, tol=tol, reference=seen[first - 1])
+    # the mode that grows first, just past the onset (the first unstable grid point may have
+    # another), and the two that merge into it: at the grid point before the onset, those
+    # nearest to it (nearer the onset, at the exceptional point, they are one)
+    continuation(steady, model.mu, [onset.interval[1]])
+    just_past = stability.solve(2 * math.pi * max_frequency)
+    growing = max(loci.unstable(just_past), key=lambda m: m.value.real)
+    growing_row = {"mu": onset.interval[1], **_row(model, growing)}
+    overlap = _MassOverlap(M, growing.vector, model.comm)
     before = sorted(seen[first - 1], key=lambda m: overlap(m.vector))[-2:]
     coupling = [{**_row(model, m), "overlap": overlap(m.vector)}
                 for m in sorted(before, key=lambda m: m.value.imag)]
     overlap.destroy()
+    # and the real modes they come from: for each, the basis mode nearest to it
+    pair: list[int] = []
+    for mode in sorted(before, key=lambda m: -overlap_with(M, m.vector, model.comm, basis)[1]):
+        weights = overlap_with(M, mode.vector, model.comm, basis)[0]
+        pair.append(next(int(i) for i in np.argsort(weights)[::-1] if int(i) not in pair))
+    pair.sort()
+    projected = {}
+    for value in (mu1 / 2, mu1):
+        continuation(steady, model.mu, [value])
+        stability.assemble()
+        projected[value] = (project(stability.K, basis), project(stability.C, basis))
+    both = np.ix_(pair, pair)
+    k0 = np.diag(omega2[pair])
+    K1, C1 = projected[mu1]
+    two_mode = TwoModeModel.build(k0, K1[both], C1[both], mu1, pair)
+    half = (projected[mu1 / 2][0][both] - k0) / (mu1 / 2)
+    linearity = float(np.abs(half - two_mode.B).max() / np.abs(two_mode.B).max())
+    # the same projection on the whole basis: what the other modes change
+    all_modes = modal_onset(np.diag(omega2), (K1 - np.diag(omega2)) / mu1, C1 / mu1,
+                            upper=1.5 * mu1)
     continuation(steady, model.mu, [mus[-1]])
     for vec in basis:
         vec.destroy()
@@ -171,7 +203,9 @@ def stability_study(model: PinOnDiscModel, mus: typing.Sequence[float],
     return StabilityStudy(dofs=model.dofs, axial_load=model.axial_load, loci=records,
                           mu_crit=onset.mu_crit, interval=onset.interval,
                           onset_value=onset.value, coupling=coupling, growing=growing_row,
-                          two_mode=two_mode.to_json(), two_mode_linearity=linearity)
+                          two_mode=two_mode.to_json(), two_mode_linearity=linearity,
+                          basis_frequencies_hz=(np.sqrt(omega2) / (2 * math.pi)).tolist(),
+                          basis_onset=all_modes)
 
 
 

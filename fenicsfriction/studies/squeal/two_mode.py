@@ -43,7 +43,7 @@ from fenicsfriction.laws import check
 from fenicsfriction.numerics import bisect, dense_eigenvalues
 from fenicsfriction.petsc_options import options_with_defaults
 
-__all__ = ["TwoModeModel", "coalescence", "real_modes"]
+__all__ = ["TwoModeModel", "coalescence", "modal_onset", "project", "real_modes"]
 
 #: the EPS's defaults: Krylov-Schur, shift-and-invert with a MUMPS LU
 EPS_OPTIONS = {"eps_type": "krylovschur", "eps_tol": 1e-10, "st_type": "sinvert",
@@ -67,6 +67,24 @@ def coalescence(K0: np.ndarray, B: np.ndarray) -> tuple[float, float]:
     mu = real[0]
     K = K0 + mu * B
     return float(mu), math.sqrt((K[0, 0] + K[1, 1]) / 2)
+
+
+def modal_onset(K0: np.ndarray, B: np.ndarray, C1: np.ndarray, upper: float,
+                tol: float = 1e-6, points: int = 200) -> float:
+    r"""The first μ in (0, ``upper``] where the projected pencil
+    :math:`\lambda^2 I + \lambda\mu C_1 + K_0 + \mu B` has an eigenvalue with Re λ > 0
+    (any number of modes; the friction's damping μ C₁ is linear in μ): a scan of ``points``
+    values, then bisection to ``tol``. ``nan`` if none."""
+    def grows(mu: float) -> bool:
+        values = dense_eigenvalues(K0 + mu * B, mu * C1, np.eye(len(K0)))
+        return bool(values.real.max() > 1e-9 * np.abs(values).max())
+
+    grid = np.linspace(0.0, upper, points + 1)[1:]
+    first = next((k for k, mu in enumerate(grid) if grows(mu)), None)
+    if first is None:
+        return math.nan
+    low, high = bisect(grows, 0.0 if first == 0 else grid[first - 1], grid[first], tol)
+    return 0.5 * (low + high)
 
 
 def real_modes(K: PETSc.Mat, M: PETSc.Mat, count: int, prefix: str = "two_mode_eps_",
@@ -147,15 +165,9 @@ class TwoModeModel:
         return coalescence(self.K0, self.B)
 
     def damped_onset(self, upper: float, tol: float = 1e-6) -> float:
-        """The onset of the damped 2 × 2 pencil (the friction's viscous term included),
-        bisected in (0, ``upper``]; ``nan`` if it is stable at ``upper``."""
-        def grows(mu: float) -> bool:
-            return bool(self.eigenvalues(mu).real.max() > 0)
-
-        if not grows(upper):
-            return math.nan
-        low, high = bisect(grows, 0.0, upper, tol)
-        return 0.5 * (low + high)
+        """The onset of the damped 2 × 2 pencil (the friction's viscous term included): see
+        :func:`modal_onset`."""
+        return modal_onset(self.K0, self.B, self.C / self.mu1, upper, tol)
 
     def eigenvalues(self, mu: float, damped: bool = True) -> np.ndarray:
         """The two eigenvalues with Im λ >= 0 of the 2 × 2 pencil at μ (K0 + μB, and the
@@ -169,4 +181,4 @@ class TwoModeModel:
         return {"frequencies_hz": self.frequencies, "indices": self.indices, "mu1": self.mu1,
                 "K0": self.K0.tolist(), "B": self.B.tolist(), "C": self.C.tolist(),
                 "mu_c": mu_c, "f_c_hz": omega_c / (2 * math.pi),
-                "mu_c_damped": self.damped_onset(2 * mu_c) if math.isfinite(mu_c) else math.nan}
+                "mu_c_damped": self.damped_onset(1.5 * mu_c) if math.isfinite(mu_c) else math.nan}
