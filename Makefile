@@ -43,6 +43,7 @@ demo: setup
 	FENICSFRICTION_DEMO_OUT=$(OUT)/two_body_contact $(MPIRUN) $(PY) demos/demo_two_body_contact.py
 	FENICSFRICTION_DEMO_OUT=$(OUT)/rolling_contact $(MPIRUN) $(PY) demos/demo_rolling_contact.py
 	FENICSFRICTION_DEMO_OUT=$(OUT)/multicontact $(MPIRUN) $(PY) demos/demo_multicontact.py
+	$(MPIRUN) $(PY) -m fenicsfriction run cases/pin-on-disc.toml --out $(OUT)/pin-on-disc
 	$(PY) -m fenicsfriction rolling curve --method fastsim --xi-range 0:3e-3:31 --a 6.304e-3 \
 	    --b 12.61e-3 --G 82e9 --nu 0.28 --mu 0.3 --Fn 106.7e3 --out $(OUT)/rolling-fastsim
 

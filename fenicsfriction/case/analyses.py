@@ -185,7 +185,7 @@ def run_case(case: Case, out: pathlib.Path, comm: MPI.Comm = MPI.COMM_WORLD,
     model = CaseModel(case, comm)
     model.initial_guess()
     outcome = Outcome(parameter=case.parameter)
-    force = max(float(np.linalg.norm(model.load_resultant())), 1e-300)
+    force = max(model.load_magnitude(), 1e-300)
     solver = SteadySolver(model.residual, prefix="steady_", options={"snes_atol": 1e-10 * force})
     ndofs = model.V.dofmap.index_map.size_global * model.V.dofmap.index_map_bs
     log.info(f"{case.title}: {ndofs} dofs on {comm.size} rank(s), JIT {solver.jit_time_s:.2f} s")
@@ -370,7 +370,7 @@ def _transient(case: Case, model: CaseModel, solver: typing.Any, outcome: Outcom
         c = np.linalg.solve(gram, comm.allreduce(basis.T @ (R.u.x.array[:owned] - u0)))
         return {"amplitude": float(np.hypot(*c))}
 
-    force = max(float(np.linalg.norm(model.load_resultant())), 1e-300)
+    force = max(model.load_magnitude(), 1e-300)
     dynamics = DynamicsSolver(R, prefix="dynamics_", atol=1e-10 * force)
     rows: list[dict] = []
     with results.CsvRows(out / "transient.csv", comm) as table:

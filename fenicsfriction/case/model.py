@@ -327,14 +327,15 @@ class CaseModel:
                     terms.append(body_force(s * scale * ufl.as_vector(value), v,
                                             self.dx(self.body_tags[name])))
 
-    def load_resultant(self) -> np.ndarray:
-        """The total applied load (forces, times the thickness in 2D) at the current load
-        factor, for the initial guess."""
+    def _load_resultants(self) -> list[np.ndarray]:
+        """Each applied load's resultant force (times the thickness in 2D) at the current load
+        factor."""
         s = float(self.parameters["load_scale"].value)
-        total = np.zeros(self.dim)
         one = fem.Constant(self.msh, np.float64(1.0))
+        resultants = []
         for load in self.case.loads:
             value = np.asarray(load["value"])
+            total = np.zeros(self.dim)
             if load["type"] == "pressure":
                 ds = self.ds(self.surface_tag(load["on"]))
                 total += [-value * self._scalar(self.n[i] * ds) for i in range(self.dim)]
@@ -344,7 +345,19 @@ class CaseModel:
                 for name in load["bodies"]:
                     rho = self.case.bodies[name]["rho"] if load["type"] == "gravity" else 1.0
                     total += rho * value * self._scalar(one * self.dx(self.body_tags[name]))
-        return s * self.thickness * total
+            resultants.append(s * self.thickness * total)
+        return resultants
+
+    def load_resultant(self) -> np.ndarray:
+        """The total applied load (forces, times the thickness in 2D) at the current load
+        factor, for the initial guess."""
+        return sum(self._load_resultants(), np.zeros(self.dim))
+
+    def load_magnitude(self) -> float:
+        """The sum of the loads' resultant magnitudes: the force scale of the residual's
+        tolerances (the resultant itself vanishes where loads balance, e.g. two brake pads
+        pressed from both sides)."""
+        return float(sum(np.linalg.norm(r) for r in self._load_resultants()))
 
     # --- contacts -----------------------------------------------------------------------------
     def foundation_velocity(self, x: typing.Any) -> typing.Any:
