@@ -22,7 +22,6 @@ from fenicsfriction.cli.arguments import LazyChoices, Parser, floats
 if typing.TYPE_CHECKING:
     import numpy as np
 
-    from fenicsfriction.signals import Interrupted
     from fenicsfriction.steady import SteadySolver
     from fenicsfriction.studies.block import BlockModel, BlockOnBelt
 
@@ -178,19 +177,6 @@ def _build(args: argparse.Namespace) -> tuple[BlockOnBelt, BlockModel, SteadySol
     return scene, model, solver, np.linspace(0.0, args.mu_max, args.steps + 1)
 
 
-def _stopped(failure: str | None, interrupted: Interrupted | None) -> int:
-    """The one closing line of a run that did not finish, and its exit status."""
-    from fenicsfriction.cli.common import stop_line
-
-    if interrupted is not None:
-        stop_line(f"{interrupted}; the results so far are written")
-        return interrupted.exit_code
-    if failure is not None:
-        stop_line(failure)
-        return 1
-    return 0
-
-
 def run_steady(args: argparse.Namespace, log: logging.Logger) -> int:
     """Continuation in μ, the optional ε sequence, fields, JSON and figures."""
     from mpi4py import MPI
@@ -269,7 +255,8 @@ def run_steady(args: argparse.Namespace, log: logging.Logger) -> int:
     comm.Barrier()  # every file exists on return, whichever rank asks
     log.info(f"results in {out}/: steady.json, summary.json, steady.xdmf, deformed.png, forces.png"
              + (", epsilon.json" if eps_records else ""))
-    return _stopped(failure, interrupted)
+    from fenicsfriction.cli.common import stopped
+    return stopped(failure, interrupted)
 
 
 def run_stability(args: argparse.Namespace, log: logging.Logger) -> int:
@@ -351,7 +338,8 @@ def run_stability(args: argparse.Namespace, log: logging.Logger) -> int:
              f"intervals by mode {fe['unstable_intervals']}; rigid "
              f"{rigid.unstable_intervals if rigid else None}")
     log.info(f"results in {out}/: stability.json, loci.png, growth.png, unstable_modes.xdmf")
-    return _stopped(failure, interrupted)
+    from fenicsfriction.cli.common import stopped
+    return stopped(failure, interrupted)
 
 
 def run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
@@ -434,4 +422,5 @@ def run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
         "interrupted": None if interrupted is None else str(interrupted),
         "statistics": statistics}, comm)
     log.info(f"results in {out}/: timeseries.csv, summary.json, dynamics.xdmf, stick_slip.png")
-    return _stopped(failure, interrupted)
+    from fenicsfriction.cli.common import stopped
+    return stopped(failure, interrupted)

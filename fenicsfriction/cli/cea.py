@@ -167,7 +167,7 @@ def run_matrices(args: argparse.Namespace, log: logging.Logger) -> int:
         symmetric_part,
     )
     from fenicsfriction.cea.sweep import unstable_intervals
-    from fenicsfriction.cli.common import named_by_flag, output_folder, stop_line
+    from fenicsfriction.cli.common import named_by_flag, output_folder, stop_line, stopped
     from fenicsfriction.signals import Interrupted, StopSignals
     from fenicsfriction.stability import EigenSolveError, Mode
 
@@ -294,10 +294,4 @@ def run_matrices(args: argparse.Namespace, log: logging.Logger) -> int:
     comm.Barrier()
     log.info(f"results in {out}/: eigenvalues.csv, eigenvalues.json, unstable.json, "
              f"summary.json, coupling_map_*.png" + (", vectors/" if args.vectors else ""))
-    if interrupted is not None:
-        stop_line(f"{interrupted}; the results so far are written")
-        return interrupted.exit_code
-    if failure is not None:
-        stop_line(failure)
-        return 1
-    return 0
+    return stopped(failure, interrupted)

@@ -15,7 +15,7 @@ import typing
 from mpi4py import MPI
 
 __all__ = ["flag", "named_by_flag", "output_folder", "scene_from_flags", "stop_line",
-           "write_rows"]
+           "stopped", "write_rows"]
 
 
 def flag(name: str) -> str:
@@ -93,3 +93,23 @@ def write_rows(path: pathlib.Path, rows: typing.Iterable[dict],
         for row in rows:
             table.write(row)
     comm.Barrier()
+
+
+def stopped(failure: str | None, interrupted: typing.Any = None) -> int:
+    """The exit status of a run, after its one closing line if it did not finish.
+
+    Args:
+        failure: what failed (a solver's summary), or None.
+        interrupted: the :class:`~fenicsfriction.signals.Interrupted` that stopped the run, or
+            None.
+
+    Returns:
+        The signal's status (130/143) after an interruption, 1 after a failure, else 0.
+    """
+    if interrupted is not None:
+        stop_line(f"{interrupted}; the results so far are written")
+        return int(interrupted.exit_code)
+    if failure is not None:
+        stop_line(failure)
+        return 1
+    return 0
