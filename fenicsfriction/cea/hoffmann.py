@@ -160,8 +160,8 @@ class HoffmannModel:
         check("mu = 0", 0.0, self.is_stable(0.0), "the model must be stable without friction")
         quantities = self.hurwitz()
         roots = sorted({float(r.real) for q in quantities.values() if q.degree() > 0
-                        for r in q.roots() if abs(r.imag) <= 1e-12 * max(1.0, abs(r)) and
-                        r.real > 0})
+                        for r in map(complex, q.roots())
+                        if abs(r.imag) <= 1e-12 * max(1.0, abs(r)) and r.real > 0})
         for root in roots:
             if not self.is_stable(root * (1 + 1e-9) + 1e-15):
                 a = self.characteristic()

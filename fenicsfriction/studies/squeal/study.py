@@ -298,7 +298,8 @@ def transient_growth(model: PinOnDiscModel, mode: Mode, amplitude: float, period
                            fitted=[float(a), float(omega)],
                            amplification=float(math.exp(a * t[-1])),
                            max_relative_force=float(np.abs(n).max() / abs(normal0)),
-                           time=t.tolist(), normal_force=(n + normal0).tolist(),
+                           time=[float(x) for x in t],
+                           normal_force=[float(x) for x in n + normal0],
                            steps=len(records) - 1,
                            wall_time_s=float(sum(r["wall_time_s"] for r in records)))
 
