@@ -221,10 +221,11 @@ def add_symmetric_disc(gmsh: typing.Any, disc: Disc, h: float) -> dict[int, list
     The cross-section (r, z) is a grid of ``round((outer - inner) / h)`` by ``max(2,
     round(thickness / h))`` squares, each cut into two triangles; it is revolved in ``n =
     ceil(2π r_mean / h)`` steps (r_mean the mean radius: edges of length h there), each
-    prism cut into three tetrahedra by the rule of Dompierre et al. (1999, "How to subdivide
-    pyramids, prisms and hexahedra into tetrahedra") on the cross-section's node numbers, the
-    same in every sector, so that neighbouring prisms share their faces' diagonals. Sizes vary
-    with r and z only (the sectors stay identical).
+    prism cut into three tetrahedra by the rule of Dompierre, Labbé, Vallet & Camarero (1999,
+    "How to subdivide pyramids, prisms and hexahedra into tetrahedra") on the cross-section's
+    node numbers, the same in every sector, so that neighbouring prisms share their faces'
+    diagonals. The spacing is uniform (a grading would have to depend on r and z only, to
+    keep the sectors identical).
 
     Args:
         gmsh: the gmsh module, a model open (synchronised).
