@@ -15,7 +15,9 @@ if __name__ == "__main__":
     p = parser("brake", __doc__)
     defaults = geometry.BrakeGeometry()
     p.add_argument("--h", type=float, default=0.006,
-                   help="tetrahedra size [m] (6 mm: 1.7e4 unknowns, 2.8 mm: 1.1e5)")
+                   help="tetrahedra size [m] (6 mm: 1.6e4 unknowns, 2.8 mm: 1.2e5)")
+    p.add_argument("--free-disc", action="store_true",
+                   help="mesh the disc freely (gmsh) instead of from identical sectors")
     for name, value in vars(defaults).items():
         unit = "degrees" if name == "pad_angle" else "m"
         p.add_argument(f"--{name.replace('_', '-')}", type=float, default=value,
@@ -24,7 +26,8 @@ if __name__ == "__main__":
     dims = geometry.BrakeGeometry(**{k: getattr(args, k) for k in vars(defaults)})
     pathlib.Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
-    m = geometry.brake(MPI.COMM_SELF, h=args.h, geometry=dims, msh_file=str(args.out))
+    m = geometry.brake(MPI.COMM_SELF, h=args.h, geometry=dims, msh_file=str(args.out),
+                       symmetric_disc=not args.free_disc)
     vertices = m.mesh.topology.index_map(0).size_global
     print(f"{args.out}: {m.mesh.topology.index_map(3).size_global} tetrahedra, {vertices} "
           f"vertices ({3 * vertices} unknowns), {time.perf_counter() - start:.1f} s")

@@ -1,8 +1,10 @@
 r"""The simplified disc brake's mesh: an annular disc and two pads pressed on its faces.
 
-The disc is the brake-squeal scenes' shared disc
-(:func:`fenicsfriction.studies.squeal.geometry.add_disc`, tagged by
-:func:`~fenicsfriction.studies.squeal.geometry.disc_groups`): an annulus about the z
+The disc is the brake-squeal scenes' disc
+(:class:`fenicsfriction.studies.squeal.geometry.Disc`), meshed by default from identical
+sectors (:func:`~fenicsfriction.studies.squeal.geometry.add_symmetric_disc`: its doublets stay
+exactly degenerate, only the pads split them), or freely like the pin on the disc's
+(:func:`~fenicsfriction.studies.squeal.geometry.add_disc`): an annulus about the z
 axis (inner radius ``r_hub``, outer ``r_disc``), its top face z = 0, its bottom z =
 -``thickness``, clamped on its inner cylinder (the hub). It is described in Eulerian form: the
 mesh does not turn, the rotation enters only through the disc's velocity at the contact (the
@@ -58,6 +60,7 @@ from fenicsfriction.studies.squeal.geometry import (
     DISC_TOP,
     Disc,
     add_disc,
+    add_symmetric_disc,
     disc_groups,
 )
 
@@ -143,6 +146,7 @@ class BrakeMesh:
         facet_tags: the facet tags of the module's table.
         geometry: the dimensions.
         h: the mesh size [m].
+        symmetric_disc: whether the disc's mesh is made of identical sectors.
     """
 
     mesh: typing.Any
@@ -150,10 +154,12 @@ class BrakeMesh:
     facet_tags: typing.Any
     geometry: BrakeGeometry
     h: float
+    symmetric_disc: bool = True
 
     @property
     def parameters(self) -> dict:
-        return {"geometry": "brake", **dataclasses.asdict(self.geometry), "h": self.h}
+        return {"geometry": "brake", **dataclasses.asdict(self.geometry), "h": self.h,
+                "symmetric_disc": self.symmetric_disc}
 
 
 def _sector(occ: typing.Any, r_in: float, r_out: float, angle: float, z0: float,
@@ -180,14 +186,22 @@ def _classify(gmsh: typing.Any, volume: int, rules: dict[int, typing.Callable]) 
 
 
 def brake(comm: MPI.Comm, h: float = 0.006, geometry: BrakeGeometry | None = None,
-          msh_file: str | None = None) -> BrakeMesh:
+          msh_file: str | None = None, symmetric_disc: bool = True) -> BrakeMesh:
     """Mesh the disc and its two pads with tetrahedra of size ``h``.
+
+    The disc's mesh is by default rotationally symmetric
+    (:func:`~fenicsfriction.studies.squeal.geometry.add_symmetric_disc`: identical sectors,
+    so that the disc alone has exactly degenerate doublets and only the pads split them, as
+    in brake CEA practice); ``symmetric_disc=False`` gives the squeal scenes' free
+    tetrahedral mesh (:func:`~fenicsfriction.studies.squeal.geometry.add_disc`), whose own
+    asymmetry splits the doublets by a few Hz (docs/brake.md).
 
     Args:
         comm: the communicator the mesh is distributed over (gmsh runs on its rank 0).
         h: the tetrahedra's size [m] (6 mm: about 2e4 unknowns; 3 mm: 1e5).
         geometry: the dimensions (default :class:`BrakeGeometry`).
         msh_file: if given, rank 0 writes the gmsh mesh there (``.msh``).
+        symmetric_disc: the disc made of identical sectors (default) or meshed freely.
 
     Returns:
         The mesh, its tags (the module's table) and the parameters.
@@ -200,11 +214,15 @@ def brake(comm: MPI.Comm, h: float = 0.006, geometry: BrakeGeometry | None = Non
 
     def construct(gmsh: typing.Any) -> None:
         occ = gmsh.model.occ
-        disc = add_disc(gmsh, disc_shape)
+        disc = None if symmetric_disc else add_disc(gmsh, disc_shape)
         pad_in = _sector(occ, g.pad_r_in, g.pad_r_out, g.pad_angle, bottom - tp, tp)
         pad_out = _sector(occ, g.pad_r_in, g.pad_r_out, g.pad_angle, top, tp)
         occ.synchronize()  # no fragment: the bodies keep their own faces and nodes
-        faces = disc_groups(gmsh, disc_shape, disc)
+        if disc is None:
+            faces = add_symmetric_disc(gmsh, disc_shape, h)
+            disc_cells = faces.pop(DISC)
+        else:
+            faces, disc_cells = disc_groups(gmsh, disc_shape, disc), [disc]
         for volume, face, back, abutment, z_face, z_back in (
                 (pad_in, PAD_IN_FACE, PAD_IN_BACK, PAD_IN_ABUTMENT, bottom, bottom - tp),
                 (pad_out, PAD_OUT_FACE, PAD_OUT_BACK, PAD_OUT_ABUTMENT, top, top + tp)):
@@ -214,7 +232,7 @@ def brake(comm: MPI.Comm, h: float = 0.006, geometry: BrakeGeometry | None = Non
                 # the end faces are planes through the axis: their centres at angle ±α/2
                 abutment: lambda x, y, z: abs(abs(math.degrees(math.atan2(y, x)))
                                               - g.pad_angle / 2) < 1e-3}))
-        for tag, entities in ((DISC, [disc]), (PAD_IN, [pad_in]), (PAD_OUT, [pad_out])):
+        for tag, entities in ((DISC, disc_cells), (PAD_IN, [pad_in]), (PAD_OUT, [pad_out])):
             gmsh.model.addPhysicalGroup(3, entities, tag)
             gmsh.model.setPhysicalName(3, tag, NAMES[tag])
         for tag, entities in faces.items():
@@ -229,4 +247,4 @@ def brake(comm: MPI.Comm, h: float = 0.006, geometry: BrakeGeometry | None = Non
         gmsh.option.setNumber("Mesh.MeshSizeMax", h)
 
     msh, cell_tags, facet_tags = gmsh_mesh(comm, "brake", 3, construct, msh_file)
-    return BrakeMesh(msh, cell_tags, facet_tags, g, h)
+    return BrakeMesh(msh, cell_tags, facet_tags, g, h, symmetric_disc)

@@ -39,7 +39,7 @@ import numpy as np
 import ufl
 from dolfinx import fem
 
-from fenicsfriction import _compat, forms, laws
+from fenicsfriction import _compat, cea, forms, laws
 from fenicsfriction.contact import NodeToSegment, solve_with_search
 from fenicsfriction.laws import check
 from fenicsfriction.rotation import RigidRotation
@@ -105,7 +105,8 @@ class BrakeModel:
         omega: the disc's angular velocity [rad/s], counter-clockwise about +z (default 100:
             11 m/s at the pads' mean radius). It enters through the friction's viscous part
             μp/|w| only, which damps the modes that slide the pads on the disc: on the 6 mm
-            mesh the n = 2 doublet couples from μ = 0.086 at 100 rad/s, not up to 0.8 at 10.
+            mesh with the free disc (docs/brake.md) the n = 3 doublet coupled from μ = 0.086 at
+            100 rad/s, not up to 0.8 at 10.
         disc, pad: the solids (default grey cast iron and a friction material).
 
     Attributes:
@@ -273,6 +274,42 @@ class BrakeModel:
         y.destroy()
         whole = sum(energy.values())
         return {name: value / whole for name, value in energy.items()}
+
+    def disc_alone(self, fmax: float, modes: int = 16, prefix: str = "brake_disc_"
+                   ) -> list[float]:
+        """The frequencies [Hz] of the disc alone up to ``fmax`` on this mesh: its stiffness
+        and mass, the hub clamped and every pad node held (no contact, no friction). On an
+        exact disc, and on a mesh with its rotational symmetry, the doublets of n nodal
+        diameters are exact pairs: their split is the mesh's own asymmetry.
+
+        Args:
+            fmax: the band's top [Hz].
+            modes: at most this many modes (:class:`~fenicsfriction.cea.ModalBasis`).
+            prefix: the eigensolver's PETSc options prefix.
+        """
+        import dolfinx.fem.petsc
+
+        dx = ufl.Measure("dx", domain=self.mesh.mesh, subdomain_data=self.mesh.cell_tags)
+        w, v = ufl.TrialFunction(self.V), ufl.TestFunction(self.V)
+        tags = self.mesh.cell_tags
+        pads = np.isin(tags.values, (PAD_IN, PAD_OUT))
+        facets = self.mesh.facet_tags
+        held = np.unique(np.concatenate([
+            _compat.cell_dofs(self.V, tags.indices[pads]),
+            fem.locate_dofs_topological(self.V, 2, facets.indices[facets.values == DISC_HUB])]))
+        bc = fem.dirichletbc(np.zeros(3), held, self.V)
+        # over every cell (the held pads' rows become identity rows: their pattern must exist)
+        disc, pad = self.solids["disc"], self.solids["pad"]
+        stiffness = forms.elasticity(w, v, disc.E, disc.nu, dx(DISC)) + sum(
+            forms.elasticity(w, v, pad.E, pad.nu, dx(tag)) for tag in (PAD_IN, PAD_OUT))
+        mass = forms.inertia(disc.rho, w, v, dx(DISC)) + sum(
+            forms.inertia(pad.rho, w, v, dx(tag)) for tag in (PAD_IN, PAD_OUT))
+        K = dolfinx.fem.petsc.assemble_matrix(_compat.form(stiffness), [bc])
+        M = dolfinx.fem.petsc.assemble_matrix(_compat.form(mass), [bc], 0.0)
+        K.assemble()
+        M.assemble()
+        basis = cea.ModalBasis(K, M, modes=modes, max_frequency=fmax, prefix=prefix)
+        return basis.frequencies.tolist()
 
     def load(self) -> float:
         """The pressure's resultant on one pad's back [N] (p times the meshed area)."""

@@ -33,7 +33,9 @@ holder holds the x and y components (a case file can say so), while the disc's a
 
 For another scene on the same disc (the brake's pads), call :func:`add_disc` in the gmsh
 model being built (the disc frame), tag its volume and faces with :func:`disc_groups`, and
-size the mesh with :func:`refine_near`; :class:`Disc` holds the disc's dimensions with the
+size the mesh with :func:`refine_near`; or add the disc already meshed from identical sectors
+with :func:`add_symmetric_disc` (exact doublets: a mode coupling's onset is then the other
+bodies', not the mesh's); :class:`Disc` holds the disc's dimensions with the
 defaults of a small steel brake disc.
 """
 
@@ -66,6 +68,7 @@ __all__ = [
     "Pin",
     "PinOnDiscMesh",
     "add_disc",
+    "add_symmetric_disc",
     "disc_groups",
     "pin_on_disc",
     "refine_near",
@@ -206,6 +209,103 @@ def add_disc(gmsh: typing.Any, disc: Disc) -> int:
     inner = occ.addCylinder(0, 0, -disc.thickness, 0, 0, disc.thickness, disc.inner_radius)
     (_, volume), = occ.cut([(3, outer)], [(3, inner)])[0]
     return volume
+
+
+def add_symmetric_disc(gmsh: typing.Any, disc: Disc, h: float) -> dict[int, list[int]]:
+    """Add the disc to the current gmsh model as a mesh with the disc's rotational symmetry:
+    ``n`` identical sectors, each a rotated copy of the first (node for node), so that the
+    mesh splits no doublet (an n-nodal-diameter pair stays degenerate to round-off for
+    2 n_d < n). Call it after the other bodies are synchronised; they mesh as usual, the
+    disc's mesh is already there (gmsh's discrete entities: a volume and its four faces).
+
+    The cross-section (r, z) is a grid of ``round((outer - inner) / h)`` by ``max(2,
+    round(thickness / h))`` squares, each cut into two triangles; it is revolved in ``n =
+    ceil(2π r_mean / h)`` steps (r_mean the mean radius: edges of length h there), each
+    prism cut into three tetrahedra by the rule of Dompierre, Labbé, Vallet & Camarero (1999,
+    "How to subdivide pyramids, prisms and hexahedra into tetrahedra") on the cross-section's
+    node numbers, the same in every sector, so that neighbouring prisms share their faces'
+    diagonals. The spacing is uniform (a grading would have to depend on r and z only, to
+    keep the sectors identical).
+
+    Args:
+        gmsh: the gmsh module, a model open (synchronised).
+        disc: the disc's dimensions.
+        h: the target edge length [m].
+
+    Returns:
+        The volume's entity under :data:`DISC` and the faces' under :data:`DISC_HUB`,
+        :data:`DISC_TOP`, :data:`DISC_BOTTOM`, :data:`DISC_RIM`.
+    """
+    laws.check_positive("h", h)
+    n_r = max(1, round((disc.outer_radius - disc.inner_radius) / h))
+    n_z = max(2, round(disc.thickness / h))
+    n = math.ceil(math.pi * (disc.inner_radius + disc.outer_radius) / h)
+    r = np.linspace(disc.inner_radius, disc.outer_radius, n_r + 1)
+    z = np.linspace(-disc.thickness, 0.0, n_z + 1)
+    section = (n_r + 1) * (n_z + 1)  # cross-section nodes, index i * (n_z + 1) + k
+
+    def index(i: int | np.ndarray, k: int | np.ndarray) -> np.ndarray:
+        return np.asarray(i) * (n_z + 1) + k
+
+    i, k = (a.ravel() for a in np.meshgrid(np.arange(n_r), np.arange(n_z), indexing="ij"))
+    a, b, c, d = index(i, k), index(i + 1, k), index(i, k + 1), index(i + 1, k + 1)
+    triangles = np.sort(np.concatenate([np.column_stack([a, b, d]),
+                                        np.column_stack([a, d, c])]), axis=1)
+    # the sectors' nodes: sector s holds the cross-section at angle 2π s / n
+    theta = 2 * np.pi * np.arange(n) / n
+    rr, zz = np.meshgrid(r, z, indexing="ij")
+    rr, zz = rr.ravel(), zz.ravel()
+    xyz = np.stack([np.outer(np.cos(theta), rr), np.outer(np.sin(theta), rr),
+                    np.broadcast_to(zz, (n, section))], axis=-1).reshape(-1, 3)
+
+    def node(s: np.ndarray, j: np.ndarray) -> np.ndarray:
+        return (s % n)[:, None] * section + j[None, :] + 1  # gmsh's tags from 1
+
+    s = np.arange(n)
+    p, q, t = triangles.T  # p < q < t: the diagonals p-q', p-t', q-t' on the side faces
+    tets = np.concatenate([
+        np.stack([node(s, p), node(s, q), node(s, t), node(s + 1, t)], axis=-1),
+        np.stack([node(s, p), node(s, q), node(s + 1, q), node(s + 1, t)], axis=-1),
+        np.stack([node(s, p), node(s + 1, p), node(s + 1, q), node(s + 1, t)], axis=-1),
+    ]).reshape(-1, 4)
+    corners = xyz[tets - 1]
+    volume = np.einsum("ij,ij->i", np.cross(corners[:, 1] - corners[:, 0],
+                                            corners[:, 2] - corners[:, 0]),
+                       corners[:, 3] - corners[:, 0])
+    tets[volume < 0] = tets[volume < 0][:, [0, 2, 1, 3]]
+
+    def band(edges: list[tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
+        """The triangles of the revolved cross-section's boundary edges (j0, j1)."""
+        j0 = np.concatenate([e[0] for e in edges])
+        j1 = np.concatenate([e[1] for e in edges])
+        lo, hi = np.minimum(j0, j1), np.maximum(j0, j1)  # the diagonal lo-hi' as above
+        return np.concatenate([
+            np.stack([node(s, lo), node(s, hi), node(s + 1, hi)], axis=-1),
+            np.stack([node(s, lo), node(s + 1, lo), node(s + 1, hi)], axis=-1)]).reshape(-1, 3)
+
+    rows, cols = np.arange(n_r), np.arange(n_z)
+    faces = {DISC_HUB: band([(index(0, cols), index(0, cols + 1))]),
+             DISC_RIM: band([(index(n_r, cols), index(n_r, cols + 1))]),
+             DISC_TOP: band([(index(rows, n_z), index(rows + 1, n_z))]),
+             DISC_BOTTOM: band([(index(rows, 0), index(rows + 1, 0))])}
+    model = gmsh.model
+    existing = model.mesh.getNodes()[0]  # gmsh 4.8 has no getMaxNodeTag
+    offset = int(existing.max()) if len(existing) else 0
+    first = offset + 1
+    volume_tag = model.addDiscreteEntity(3)
+    model.mesh.addNodes(3, volume_tag, np.arange(first, first + len(xyz)), xyz.ravel())
+    element = 1 + max((int(t.max()) for t in model.mesh.getElements()[1] if len(t)), default=0)
+    model.mesh.addElementsByType(volume_tag, 4, np.arange(element, element + len(tets)),
+                                 (tets + offset).ravel())
+    element += len(tets)
+    groups: dict[int, list[int]] = {DISC: [volume_tag]}
+    for tag, triangles_of_face in faces.items():
+        face = model.addDiscreteEntity(2)
+        model.mesh.addElementsByType(face, 2, np.arange(element, element + len(triangles_of_face)),
+                                     (triangles_of_face + offset).ravel())
+        element += len(triangles_of_face)
+        groups[tag] = [face]
+    return groups
 
 
 def _boundary(gmsh: typing.Any, volume: int) -> list[tuple[int, list[float]]]:
