@@ -159,7 +159,10 @@ disc_mode, pin_mode = sorted(study.coupling, key=lambda m: m["pin_share"])
 assert disc_mode["pin_share"] < 0.1 < 0.5 < pin_mode["pin_share"]
 assert 0.2 < study.mu_crit < 0.8
 assert two["mu_c"] > study.mu_crit
-assert abs(study.basis_onset / study.mu_crit - 1) < 0.03
+# the 12-mode onset's Galerkin error depends on the mesh (0.6 % here with Debian 12's gmsh,
+# 5.8 % with Debian 13's): within 8 %, and well inside the two-mode model's
+assert abs(study.basis_onset / study.mu_crit - 1) < 0.08
+assert abs(study.basis_onset - study.mu_crit) < 0.25 * abs(two["mu_c"] - study.mu_crit)
 
 # %% [markdown]
 # ## The transient grows at Re λ

@@ -9,11 +9,12 @@ from mpi4py import MPI
 import numpy as np
 from _common import parser
 
+from fenicsfriction import discs
 from fenicsfriction.studies.squeal import geometry
 
 if __name__ == "__main__":
     p = parser("pin_on_disc", __doc__)
-    disc, pin = geometry.Disc(), geometry.Pin()
+    disc, pin = discs.Disc(), geometry.Pin()
     p.add_argument("--h-far", type=float, default=0.008, help="largest mesh size, in the disc [m]")
     p.add_argument("--refine", type=int, default=0, help="halve the mesh sizes this many times")
     p.add_argument("--angle", type=float, default=pin.angle,
@@ -31,6 +32,6 @@ if __name__ == "__main__":
     print(f"{args.out}: {m.mesh.topology.index_map(3).size_global} cells, {vertices} vertices, "
           f"{3 * vertices} P1 dofs ({time.perf_counter() - start:.1f} s)")
     for tag, name in geometry.NAMES.items():
-        tags = m.cell_tags if tag in (geometry.DISC, geometry.PIN) else m.facet_tags
+        tags = m.cell_tags if tag in (discs.DISC, geometry.PIN) else m.facet_tags
         print(f"  {name} = {tag}: {int(np.count_nonzero(tags.values == tag))}")
     print("  sizes:", m.parameters)

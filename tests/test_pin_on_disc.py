@@ -71,12 +71,17 @@ def test_the_projected_onset_converges_to_the_full_one_with_the_modes(studied):
     """The pencil projected on the two real modes (Hoffmann's model, closed form) flutters
     later than the full model: it drops the other modes, through which the pin's mode veers
     faster towards the disc's (32 % on the coarse mesh, docs/brake-squeal.md). Projected on
-    the 12 lowest modes (up to 9.4 kHz, twice the band) its onset is the full model's to
-    within a Galerkin error of the modes left out: 0.6 % measured, 3 % allowed."""
+    the 12 lowest modes (up to 9.4 kHz, twice the band) its onset nears the full model's, to
+    a Galerkin error of the modes left out that depends on the mesh: 0.6 %, 4.7 % and 0.8 % on
+    three meshes of Debian 12's gmsh, 5.8 % on the coarse mesh of Debian 13's (8,043 unknowns
+    against 8,004). So: within 8 %, and at most a quarter of the two-mode model's error
+    (measured 2 % to 19 % of it)."""
     _, study = studied
     assert study.two_mode["mu_c"] > study.mu_crit
     assert study.two_mode["mu_c_damped"] == pytest.approx(study.two_mode["mu_c"], rel=2e-2)
-    assert study.basis_onset == pytest.approx(study.mu_crit, rel=3e-2)
+    assert study.basis_onset == pytest.approx(study.mu_crit, rel=8e-2)
+    assert (abs(study.basis_onset - study.mu_crit)
+            < 0.25 * abs(study.two_mode["mu_c"] - study.mu_crit))
 
 
 def test_the_flutter_mode_grows_at_the_rate_of_its_eigenvalue(studied):

@@ -11,6 +11,7 @@ MODULES = [
     # generic pieces
     "fenicsfriction.laws", "fenicsfriction.events", "fenicsfriction.timestepping",
     "fenicsfriction.statistics", "fenicsfriction.numerics", "fenicsfriction.studies",
+    "fenicsfriction.discs",
     # the families' mesh-free models and data
     "fenicsfriction.studies.block.data", "fenicsfriction.studies.block.slab",
     "fenicsfriction.studies.block.rigid",

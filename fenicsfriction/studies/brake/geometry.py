@@ -1,10 +1,10 @@
 r"""The simplified disc brake's mesh: an annular disc and two pads pressed on its faces.
 
 The disc is the brake-squeal scenes' disc
-(:class:`fenicsfriction.studies.squeal.geometry.Disc`), meshed by default from identical
-sectors (:func:`~fenicsfriction.studies.squeal.geometry.add_symmetric_disc`: its doublets stay
+(:class:`fenicsfriction.discs.Disc`), meshed by default from identical
+sectors (:func:`~fenicsfriction.discs.add_symmetric_disc`: its doublets stay
 exactly degenerate, only the pads split them), or freely like the pin on the disc's
-(:func:`~fenicsfriction.studies.squeal.geometry.add_disc`): an annulus about the z
+(:func:`~fenicsfriction.discs.add_disc`): an annulus about the z
 axis (inner radius ``r_hub``, outer ``r_disc``), its top face z = 0, its bottom z =
 -``thickness``, clamped on its inner cylinder (the hub). It is described in Eulerian form: the
 mesh does not turn, the rotation enters only through the disc's velocity at the contact (the
@@ -17,7 +17,7 @@ The three bodies are meshed apart (no common node: the meshes do not match on th
 faces) with tetrahedra of size ``h`` (degree-1 geometry), on rank 0 of ``comm``, and read into
 one distributed dolfinx mesh.
 
-Tags (the disc's are those of :mod:`fenicsfriction.studies.squeal.geometry`; the gmsh physical
+Tags (the disc's are those of :mod:`fenicsfriction.discs`; the gmsh physical
 groups carry the names in brackets):
 
 =========================  =====  ================================================================
@@ -51,8 +51,7 @@ import typing
 from mpi4py import MPI
 
 from fenicsfriction import laws
-from fenicsfriction.meshing import gmsh_mesh
-from fenicsfriction.studies.squeal.geometry import (
+from fenicsfriction.discs import (
     DISC,
     DISC_BOTTOM,
     DISC_HUB,
@@ -63,6 +62,7 @@ from fenicsfriction.studies.squeal.geometry import (
     add_symmetric_disc,
     disc_groups,
 )
+from fenicsfriction.meshing import gmsh_mesh
 
 __all__ = ["NAMES", "PAD_IN", "PAD_IN_ABUTMENT", "PAD_IN_BACK", "PAD_IN_FACE", "PAD_OUT",
            "PAD_OUT_ABUTMENT", "PAD_OUT_BACK", "PAD_OUT_FACE", "BrakeGeometry", "BrakeMesh",
@@ -190,10 +190,10 @@ def brake(comm: MPI.Comm, h: float = 0.006, geometry: BrakeGeometry | None = Non
     """Mesh the disc and its two pads with tetrahedra of size ``h``.
 
     The disc's mesh is by default rotationally symmetric
-    (:func:`~fenicsfriction.studies.squeal.geometry.add_symmetric_disc`: identical sectors,
+    (:func:`~fenicsfriction.discs.add_symmetric_disc`: identical sectors,
     so that the disc alone has exactly degenerate doublets and only the pads split them, as
     in brake CEA practice); ``symmetric_disc=False`` gives the squeal scenes' free
-    tetrahedral mesh (:func:`~fenicsfriction.studies.squeal.geometry.add_disc`), whose own
+    tetrahedral mesh (:func:`~fenicsfriction.discs.add_disc`), whose own
     asymmetry splits the doublets by a few Hz (docs/brake.md).
 
     Args:

@@ -41,6 +41,7 @@ from dolfinx import fem
 
 from fenicsfriction import _compat, cea, forms, laws
 from fenicsfriction.contact import NodeToSegment, solve_with_search
+from fenicsfriction.discs import DISC, DISC_BOTTOM, DISC_HUB, DISC_TOP
 from fenicsfriction.laws import check
 from fenicsfriction.rotation import RigidRotation
 from fenicsfriction.stability import StabilitySolver
@@ -56,7 +57,6 @@ from fenicsfriction.studies.brake.geometry import (
     PAD_OUT_FACE,
     BrakeMesh,
 )
-from fenicsfriction.studies.squeal.geometry import DISC, DISC_BOTTOM, DISC_HUB, DISC_TOP
 
 __all__ = ["CAST_IRON", "FRICTION_MATERIAL", "BrakeModel", "Solid", "default_law"]
 

@@ -1,7 +1,7 @@
 """Brake squeal: bodies pressed on a turning disc, the stability of their steady sliding.
 
-``geometry`` holds the disc shared by the scenes (:func:`~.geometry.add_disc`) and the pin on
-the disc (:func:`~.geometry.pin_on_disc`); ``model`` the pin-on-disc finite element model;
+``geometry`` holds the pin on the disc (:func:`~.geometry.pin_on_disc`; the disc is
+:mod:`fenicsfriction.discs`, shared with the brake); ``model`` the pin-on-disc finite element model;
 ``study`` its stability study and the transient growth of its flutter mode; ``two_mode`` its
 reduction to the two coupling modes. Loads dolfinx on first use."""
 

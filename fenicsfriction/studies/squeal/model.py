@@ -41,10 +41,8 @@ from dolfinx import fem
 
 from fenicsfriction import _compat, forms, laws
 from fenicsfriction.contact import NodeToSegment
+from fenicsfriction.discs import DISC, DISC_HUB, DISC_TOP
 from fenicsfriction.studies.squeal.geometry import (
-    DISC,
-    DISC_HUB,
-    DISC_TOP,
     PIN,
     PIN_FACE,
     PIN_HELD,
