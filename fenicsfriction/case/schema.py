@@ -740,7 +740,10 @@ def read_physical_names(path: pathlib.Path) -> dict[tuple[int, str], int]:
 def _check_groups(c: _Checker, case: Case, make_mesh: bool) -> dict[tuple[int, str], int]:
     assert case.mesh is not None
     file, script = case.mesh["file"], case.mesh["script"]
-    if not file.is_file():
+    # made when missing, and made again when older than its script (as make does)
+    stale = (file.is_file() and script is not None and script.is_file()
+             and script.stat().st_mtime > file.stat().st_mtime)
+    if not file.is_file() or (stale and make_mesh):
         if script is None or not make_mesh:
             c.fail("mesh.file", str(file), "no such file" + (" (and no mesh.script to make it)"
                                                             if script is None else ""))
