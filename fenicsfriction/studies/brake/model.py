@@ -309,7 +309,7 @@ class BrakeModel:
         K.assemble()
         M.assemble()
         basis = cea.ModalBasis(K, M, modes=modes, max_frequency=fmax, prefix=prefix)
-        return basis.frequencies.tolist()
+        return [float(f) for f in basis.frequencies]
 
     def load(self) -> float:
         """The pressure's resultant on one pad's back [N] (p times the meshed area)."""
