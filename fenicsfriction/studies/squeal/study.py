@@ -16,16 +16,12 @@ import typing
 
 import numpy as np
 
+from fenicsfriction.cea.projection import ModalBasis
 from fenicsfriction.results import Record
 from fenicsfriction.stability import Loci, Mode, StabilitySolver
 from fenicsfriction.steady import SteadySolver, continuation
 from fenicsfriction.studies.squeal.model import PinOnDiscModel
-from fenicsfriction.studies.squeal.two_mode import (
-    TwoModeModel,
-    modal_onset,
-    project,
-    real_modes,
-)
+from fenicsfriction.studies.squeal.two_mode import TwoModeModel, modal_onset
 
 __all__ = ["StabilityStudy", "TransientGrowth", "stability_study", "transient_growth"]
 
@@ -109,10 +105,11 @@ class _MassOverlap:
 
 
 def overlap_with(M: typing.Any, vector: np.ndarray, comm: typing.Any,
-                 basis: typing.Sequence[typing.Any]) -> tuple[list[float], float]:
-    """The mass overlaps of ``vector`` with each basis vector, and the largest."""
+                 basis: typing.Sequence[np.ndarray]) -> tuple[list[float], float]:
+    """The mass overlaps of ``vector`` with each basis vector (this rank's rows), and the
+    largest."""
     overlap = _MassOverlap(M, vector, comm)
-    weights = [overlap(phi.getArray()) for phi in basis]
+    weights = [overlap(phi) for phi in basis]
     overlap.destroy()
     return weights, max(weights)
 
@@ -146,7 +143,8 @@ def stability_study(model: PinOnDiscModel, mus: typing.Sequence[float],
     stability = StabilitySolver(model.residual, prefix=f"{prefix}pep_")
     stability.assemble()
     K0, M = stability.K.copy(), stability.M.copy()
-    omega2, basis = real_modes(K0, M, basis_size, prefix=f"{prefix}eps_")
+    modal = ModalBasis(K0, M, modes=basis_size, prefix=f"{prefix}eps_")
+    omega2, basis = modal.omega2, list(modal.phi.T)
     loci = Loci(steady, stability, model.mu, 2 * math.pi * max_frequency, growth_tol)
     seen: list[list[Mode]] = []
 
@@ -185,7 +183,7 @@ def stability_study(model: PinOnDiscModel, mus: typing.Sequence[float],
     for value in (mu1 / 2, mu1):
         continuation(steady, model.mu, [value])
         stability.assemble()
-        projected[value] = (project(stability.K, basis), project(stability.C, basis))
+        projected[value] = (modal.project(stability.K), modal.project(stability.C))
     both = np.ix_(pair, pair)
     k0 = np.diag(omega2[pair])
     K1, C1 = projected[mu1]
@@ -196,8 +194,7 @@ def stability_study(model: PinOnDiscModel, mus: typing.Sequence[float],
     all_modes = modal_onset(np.diag(omega2), (K1 - np.diag(omega2)) / mu1, C1 / mu1,
                             upper=1.5 * mu1)
     continuation(steady, model.mu, [mus[-1]])
-    for vec in basis:
-        vec.destroy()
+    modal.eps.destroy()
     for mat in (K0, M):
         mat.destroy()
     return StabilityStudy(dofs=model.dofs, axial_load=model.axial_load, loci=records,

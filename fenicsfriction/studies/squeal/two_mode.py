@@ -2,8 +2,8 @@ r"""The pin on the disc reduced to its two coupling modes: a Hoffmann-type model
 finite element model's own modes.
 
 The real modes of the symmetric, frictionless problem, :math:`\bar K(0)\,\phi = \omega^2 M\phi`
-(SLEPc EPS, shift-and-invert, :math:`\phi^T M \phi = 1`), are a basis in which the pencil of
-steady sliding at μ is
+(:class:`fenicsfriction.cea.projection.ModalBasis`, :math:`\phi^T M \phi = 1`), are a basis
+in which the pencil of steady sliding at μ is
 
 .. math:: \big(\lambda^2 I + \lambda\,\Phi^T C(\mu)\Phi + \Phi^T\bar K(\mu)\Phi\big)\,q = 0,
           \qquad \Phi^T\bar K(\mu)\Phi \approx \mathrm{diag}(\omega_1^2, \omega_2^2)
@@ -34,22 +34,12 @@ import dataclasses
 import math
 import typing
 
-from petsc4py import PETSc
-from slepc4py import SLEPc
-
 import numpy as np
 
 from fenicsfriction.laws import check
 from fenicsfriction.numerics import bisect, dense_eigenvalues
-from fenicsfriction.petsc_options import options_with_defaults
 
-__all__ = ["TwoModeModel", "coalescence", "modal_onset", "project", "real_modes"]
-
-#: the EPS's defaults: Krylov-Schur, shift-and-invert with a MUMPS LU
-EPS_OPTIONS = {"eps_type": "krylovschur", "eps_tol": 1e-10, "st_type": "sinvert",
-               "st_ksp_type": "preonly", "st_pc_type": "lu",
-               "st_pc_factor_mat_solver_type": "mumps"}
-
+__all__ = ["TwoModeModel", "coalescence", "modal_onset"]
 
 def coalescence(K0: np.ndarray, B: np.ndarray) -> tuple[float, float]:
     """``(mu_c, omega_c)``: where the two undamped frequencies of
@@ -85,51 +75,6 @@ def modal_onset(K0: np.ndarray, B: np.ndarray, C1: np.ndarray, upper: float,
         return math.nan
     low, high = bisect(grows, 0.0 if first == 0 else grid[first - 1], grid[first], tol)
     return 0.5 * (low + high)
-
-
-def real_modes(K: PETSc.Mat, M: PETSc.Mat, count: int, prefix: str = "two_mode_eps_",
-               options: dict | None = None) -> tuple[np.ndarray, list[PETSc.Vec]]:
-    """The ``count`` lowest real modes of :math:`K\\phi = \\omega^2 M\\phi` (K symmetric:
-    :math:`\\bar K` at μ = 0), M-normalised: ``(omega2, vectors)``. Dirichlet rows (1 on K's
-    diagonal, 0 on M's) give infinite ω² and are never found."""
-    eps = SLEPc.EPS().create(K.getComm())
-    eps.setOptionsPrefix(prefix)
-    eps.setOperators(K, M)
-    eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
-    eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
-    eps.setTarget(0.0)
-    eps.setDimensions(nev=count)
-    with options_with_defaults(prefix, {**EPS_OPTIONS, **(options or {})}):
-        eps.setFromOptions()
-    eps.solve()
-    found = eps.getConverged()
-    check("count", count, found >= count, f"only {found} modes converged")
-    pairs = []
-    for i in range(found):
-        x = K.createVecRight()
-        omega2 = eps.getEigenpair(i, x).real
-        Mx = x.duplicate()
-        M.mult(x, Mx)
-        x.scale(1.0 / math.sqrt(x.dot(Mx)))
-        Mx.destroy()
-        pairs.append((omega2, x))
-    eps.destroy()
-    pairs.sort(key=lambda p: p[0])
-    for _, x in pairs[count:]:
-        x.destroy()
-    return np.array([p[0] for p in pairs[:count]]), [p[1] for p in pairs[:count]]
-
-
-def project(A: PETSc.Mat, basis: typing.Sequence[PETSc.Vec]) -> np.ndarray:
-    """:math:`\\Phi^T A \\Phi` (dense, on every rank)."""
-    Ax = basis[0].duplicate()
-    out = np.zeros((len(basis), len(basis)))
-    for j, phi in enumerate(basis):
-        A.mult(phi, Ax)
-        for i, psi in enumerate(basis):
-            out[i, j] = psi.dot(Ax)
-    Ax.destroy()
-    return out
 
 
 @dataclasses.dataclass
