@@ -84,8 +84,7 @@ class PressAndDrag(_Bodies):
 
     def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
         mesh = geometry.hertz_2d(comm, R=self.radius, h_contact=self.h_contact)
-        return TwoBodyModel(mesh, self.materials, self.law, passes=self.passes,
-                            density=self.density)
+        return self.model(mesh, density=self.density)
 
     def traction(self, t: float) -> np.ndarray:
         """The traction on the cylinder's top at time t: −P/(2R) normal, the drag between
