@@ -29,6 +29,7 @@ import ufl
 from dolfinx import fem, mesh
 
 from fenicsfriction import _compat, forms, laws
+from fenicsfriction.assembly import assemble_owned
 from fenicsfriction.contact import FORMULATIONS, make_contact, solve_with_search
 from fenicsfriction.contact.node_to_segment import ENFORCEMENTS
 from fenicsfriction.laws import check
@@ -86,11 +87,19 @@ class SurfaceValues:
 
     Attributes:
         x: reference coordinates of the slave nodes (n, dim).
-        weight: each node's tributary length (2D) or area (3D).
+        weight: each node's tributary length (2D) or area (3D): the weight of the contact's
+            nodal rule.
         gap: the normal gap to the master surface (< 0: penetration).
         pressure: the contact pressure of the law at the node.
         traction: the tangential traction vector (zeros when frictionless), (n, dim).
-        force: the contact force on the node from all passes (n, dim) per unit weight.
+        force: the contact force on the node from all passes (n, dim) per unit load weight:
+            the pressure the node transmits (a uniform pressure p loads every node with p
+            times its load weight). Where the load weight is zero (the vertices of 6-node
+            triangles), per the surface's mean load weight instead.
+        load_weight: the integral of the node's shape function over the slave surface, the
+            force a unit pressure puts on the node (degree 1: ``weight``; degree 2 in 2D: 1/6
+            and 2/3 of a facet's length at its vertices and midpoint, in 3D 0 and 1/3 of a
+            triangle's area).
     """
 
     x: np.ndarray
@@ -99,6 +108,7 @@ class SurfaceValues:
     pressure: np.ndarray
     traction: np.ndarray
     force: np.ndarray
+    load_weight: np.ndarray
 
 
 class TwoBodyModel:
@@ -309,14 +319,25 @@ class TwoBodyModel:
         force = self._contact_force()
         owned = np.flatnonzero(weight > 0)
         x = contact.nodal_space.tabulate_dof_coordinates()[owned, :self.dim]
+        load = self._load_weight[owned]
+        loaded = load > 1e-12 * self.comm.allreduce(float(load.max(initial=0.0)), op=MPI.MAX)
+        mean = self.comm.allreduce(float(load[loaded].sum())) \
+            / self.comm.allreduce(int(np.count_nonzero(loaded)))
         local = np.column_stack([x, weight[owned], values[owned],
-                                 force[owned] / weight[owned, None]])
+                                 force[owned] / np.where(loaded, load, mean)[:, None],
+                                 np.where(loaded, load, 0.0)])
         rows = np.vstack(self.comm.allgather(local))
         rows = rows[np.lexsort(rows[:, :self.dim].T[::-1])]  # by x, then y (then z)
         d = self.dim
         return SurfaceValues(x=rows[:, :d], weight=rows[:, d], gap=rows[:, d + 1],
                              pressure=rows[:, d + 2], traction=rows[:, d + 3:2 * d + 3],
-                             force=rows[:, 2 * d + 3:])
+                             force=rows[:, 2 * d + 3:3 * d + 3], load_weight=rows[:, 3 * d + 3])
+
+    @functools.cached_property
+    def _load_weight(self) -> np.ndarray:
+        """∫ N_k over the slave surface of each owned node (exact: P1 geometry)."""
+        q = ufl.TestFunction(self.contacts[0].nodal_space)
+        return assemble_owned(_compat.form(q * self.ds(SLAVE)))
 
     @functools.cached_property
     def _surface_nodal(self) -> typing.Callable[[], np.ndarray]:
