@@ -47,7 +47,9 @@ an hour on one core, most of it the 3D rungs at a/10 (about 100 000 unknowns eac
 from __future__ import annotations
 
 import dataclasses
+import json
 import logging
+import pathlib
 import resource
 import statistics
 import sys
@@ -325,6 +327,9 @@ def main() -> int:
                        help="the compliance c_n of every run (the scene's default, 1e4)")
     flags.add_argument("--repeats", type=int, default=3,
                        help=f"runs of each mesh up to {SMALL} unknowns (median; 3)")
+    flags.add_argument("--merge", type=pathlib.Path, nargs="*", default=[],
+                       help="JSON files of earlier runs to tabulate and plot with this one's "
+                            "(e.g. --dims '' --merge 2d/*.json 3d/*.json: no new run)")
     flags.add_argument("--dpi", type=int, default=110)
     args = flags.parse_args()
     comm = MPI.COMM_WORLD
@@ -335,6 +340,11 @@ def main() -> int:
     degree2 = {2: numbers(args.degree2_2d), 3: numbers(args.degree2_3d)}
     runs: list[dict] = []
     failures: list[dict] = []
+    for path in args.merge:  # earlier runs' results, tabulated with this run's
+        earlier = json.loads(path.read_text())
+        runs += earlier["runs"]
+        failures += earlier["failures"]
+    json_path = args.out / "bench_hertz_formulations.json"
     for dim in numbers(args.dims):
         for a_over_h in ladders[dim][:args.levels]:
             for formulation, degree in CONFIGS:
@@ -343,6 +353,9 @@ def main() -> int:
                 row = run_mesh(dim, a_over_h, formulation, degree, args.repeats, comm,
                                args.c_n)
                 (failures if "failed" in row else runs).append(row)
+                # written after every run: a long ladder stopped keeps what it measured
+                ff.results.write_summary(json_path, {"ranks": comm.size, "runs": runs,
+                                                     "failures": failures}, comm=comm)
     same_mesh = ratios(runs)
     if comm.rank == 0:
         args.out.mkdir(parents=True, exist_ok=True)
@@ -354,12 +367,12 @@ def main() -> int:
             print(f"failed: {row['dim']}D h = a/{row['a_over_h']} {row['formulation']} "
                   f"P{row['degree']}: {row['failed']}")
         plot(runs, args.out / "bench_hertz_formulations.png", args.dpi)
-    ff.results.write_summary(args.out / "bench_hertz_formulations.json",
+    ff.results.write_summary(json_path,
                              {"ranks": comm.size, "runs": runs, "failures": failures,
                               "same_mesh_ratios": same_mesh},
                              comm=comm)
     if comm.rank == 0:
-        print(f"wrote {args.out / 'bench_hertz_formulations.json'} and "
+        print(f"wrote {json_path} and "
               f"{args.out / 'bench_hertz_formulations.png'}", file=sys.stderr)
     return 0
 
