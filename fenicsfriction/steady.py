@@ -109,7 +109,8 @@ class ContinuationError(RuntimeError):
 
 @dataclasses.dataclass
 class SolveReport:
-    """Outcome of one SNES solve (``atol``: the absolute tolerance actually used)."""
+    """Outcome of one solve (``atol``: the absolute tolerance actually used; ``iterations``
+    summed over the ``rounds`` of Newton solves the contact search needed)."""
 
     converged: bool
     reason: str
@@ -117,6 +118,7 @@ class SolveReport:
     residual_norm: float
     wall_time_s: float
     atol: float
+    rounds: int = 1
 
 
 _REASONS = {v: k for k, v in vars(PETSc.SNES.ConvergedReason).items() if not k.startswith("_")}
@@ -151,6 +153,8 @@ class SteadySolver:
             in the PETSc options (``-<prefix>pc_type lu``) overrides it. Where the Jacobian
             splits, the first two assemble the constant bulk once and only the interface at
             each iteration (docs/benchmarks.md has what each costs).
+        search_rounds: how many Newton solves :meth:`solve` may run until a search of the
+            contact couplings at the converged state keeps their pairing.
 
     Attributes:
         snes: the PETSc SNES, exposed for monitoring or further configuration.
@@ -162,9 +166,13 @@ class SteadySolver:
 
     def __init__(self, residual: Residual, prefix: str = "steady_",
                  options: dict | None = None, jit_cache_dir: str | None = None,
-                 roundoff_safety: float = 1.0, linear_solver: str = "auto"):
+                 roundoff_safety: float = 1.0, linear_solver: str = "auto",
+                 search_rounds: int = 10):
         check("linear_solver", linear_solver, linear_solver in LINEAR_SOLVERS,
               f"use one of {', '.join(LINEAR_SOLVERS)}")
+        check("search_rounds", search_rounds,
+              isinstance(search_rounds, int) and search_rounds >= 1, "an integer >= 1")
+        self.search_rounds = search_rounds
         self.residual = residual
         self.u = residual.u
         t0 = time.perf_counter()
@@ -273,12 +281,50 @@ class SteadySolver:
         self.convergence.jacobian_assembled(A)
 
     def solve(self) -> SolveReport:
-        """Solve from the current ``u``; on failure restore ``u`` and raise :class:`SolveError`."""
-        for coupling in self.couplings:  # the contact pairing, searched at the first residual
-            coupling.contact.search_pending = True
+        """Solve from the current ``u``; on failure restore ``u`` and raise :class:`SolveError`.
+
+        With contact couplings, each Newton solve uses the pairing (the mortar geometry)
+        searched at its first residual; while a search at the converged state changes it, the
+        solve is repeated from there (up to ``search_rounds`` solves), so the state returned
+        is an equilibrium of its own pairing (a fixed point of the search). Mortar contact,
+        whose geometry is held within a solve, needs it wherever the bodies slide between
+        solves; node-to-segment contact recomputes its projections within the solve.
+        """
         u_vec = _compat.petsc_vec(self.u)
-        u_vec.copy(self.x)
         saved = u_vec.copy()
+        t0 = time.perf_counter()
+        iterations = 0
+        try:
+            for rounds in range(1, self.search_rounds + 1):
+                report = self._newton()
+                iterations += report.iterations
+                report.iterations, report.rounds = iterations, rounds
+                report.wall_time_s = time.perf_counter() - t0
+                if not report.converged:
+                    raise SolveError(
+                        f"Newton did not converge ({report.reason}) after "
+                        f"{report.iterations} iterations, residual norm "
+                        f"{report.residual_norm:.3e}; state restored", report)
+                # every coupling searches (collectively), whether or not another changed
+                changed = [coupling.contact.search() for coupling in self.couplings]
+                if not any(changed):
+                    return report
+            raise SolveError(f"contact search: the pairing still changed after "
+                             f"{self.search_rounds} Newton solves (search_rounds); state "
+                             "restored", report)
+        except SolveError:
+            saved.copy(u_vec)
+            self.u.x.scatter_forward()
+            raise
+        finally:
+            saved.destroy()
+
+    def _newton(self) -> SolveReport:
+        """One SNES solve from the current ``u``, the contact pairing searched at its first
+        residual; ``u`` takes the result if it converged."""
+        for coupling in self.couplings:
+            coupling.contact.search_pending = True
+        _compat.petsc_vec(self.u).copy(self.x)
         t0 = time.perf_counter()
         self.snes.solve(None, self.x)
         reason = self.snes.getConvergedReason()
@@ -287,18 +333,9 @@ class SteadySolver:
             iterations=self.snes.getIterationNumber(),
             residual_norm=float(self.snes.getFunctionNorm()),
             wall_time_s=time.perf_counter() - t0, atol=self.convergence.atol_used)
-        finite = np.isfinite(report.residual_norm)
-        if report.converged and finite:
+        report.converged = report.converged and bool(np.isfinite(report.residual_norm))
+        if report.converged:
             self._update(self.x)
-        else:
-            saved.copy(u_vec)
-            self.u.x.scatter_forward()
-            report.converged = False
-        saved.destroy()
-        if not report.converged:
-            raise SolveError(
-                f"Newton did not converge ({report.reason}) after {report.iterations} "
-                f"iterations, residual norm {report.residual_norm:.3e}; state restored", report)
         return report
 
 

@@ -258,9 +258,13 @@ def _run_hertz(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) ->
     except RuntimeError as err:
         return _failed(out, "hertz", scene, err, comm)
     results.write_summary(out / "contact.json", summary, comm)
+    fitted = summary[f"fitted_{width}"], summary["fitted_max_pressure"]
     log.info(f"{width.replace('_', ' ')} {_percent(summary[width], a)}; peak pressure "
-             f"{_percent(summary['max_pressure'], p0)}; {summary['newton_iterations']} Newton "
-             f"iterations in {summary['solves']} solves, {summary['wall_time_s']:.1f} s")
+             f"{_percent(summary['max_pressure'], p0)}; Hertz's ellipse fitted to the nodal "
+             "pressures: " + (f"{_percent(fitted[0], a)}, {_percent(fitted[1], p0)}"
+                              if fitted[0] is not None else "none")
+             + f"; {summary['newton_iterations']} Newton iterations in {summary['solves']} "
+             f"solves, {summary['wall_time_s']:.1f} s")
     _hertz_outputs(scene, summary, model, out, comm, log)
     return 0
 

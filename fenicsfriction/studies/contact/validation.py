@@ -159,6 +159,12 @@ class Hertz(_Bodies):
         measured = (np.ptp(edge[:, 0]) / 2 if self.dim == 2
                     else float(np.mean(np.linalg.norm(edge[:, :2], axis=1))))
         width = "half_width" if self.dim == 2 else "contact_radius"
+        r = values.x[:, 0] if self.dim == 2 else np.linalg.norm(values.x[:, :2], axis=1)
+        try:  # Hertz's ellipse through every contact node's pressure
+            fitted: tuple[float | None, float | None] = closed_forms.fit_hertz_pressure(
+                np.abs(r), values.pressure)
+        except ValueError:  # fewer than two contact nodes, or no falling profile
+            fitted = (None, None)
         summary = {
             "scene": "hertz", "dim": self.dim, "load": solved["load"] / share,
             "parameters": {"radius": self.radius, "E1": self.E1, "nu1": self.nu1,
@@ -171,6 +177,9 @@ class Hertz(_Bodies):
             "max_pressure": float(values.pressure.max()), "hertz_max_pressure": p0,
             f"{width}_error": measured / a - 1,
             "max_pressure_error": float(values.pressure.max()) / p0 - 1,
+            f"fitted_{width}": fitted[0], "fitted_max_pressure": fitted[1],
+            f"fitted_{width}_error": None if fitted[0] is None else fitted[0] / a - 1,
+            "fitted_max_pressure_error": None if fitted[1] is None else fitted[1] / p0 - 1,
             "approach": solved["approach"], "newton_iterations": solved["newton_iterations"],
             "solves": solved["solves"], "wall_time_s": time.perf_counter() - t0,
         }
