@@ -244,8 +244,9 @@ class MortarIntegrals:
             to the nearest master facet along :math:`-n`).
         slave_nodes: the owned slave nodes (local indices).
         searches, changes: how many searches ran, how many changed B's sparsity pattern.
-        time_s: seconds in ``"search"`` (gathers, normals, segmentation, integrals) and
-            ``"build"`` (B as a PETSc matrix, the reference gaps), summed over calls.
+        time_s: seconds in ``"search"`` (gathers, normals, segmentation, integrals, the
+            change test: until every rank is done) and ``"build"`` (B as a PETSc matrix, the
+            reference gaps, normals and coverage as Functions), summed over calls.
     """
 
     def __init__(self, V: fem.FunctionSpace, slave: np.ndarray, master: np.ndarray):
@@ -311,8 +312,6 @@ class MortarIntegrals:
         B = (scipy.sparse.diags(scale) @ (D - M)).tocsr()
         B.sort_indices()
         B.eliminate_zeros()
-        t1 = time.perf_counter()
-        self.time_s["search"] += t1 - t0
         # the relative positions at u with the new geometry, uncovered nodes at their distance
         x_all = self._surface_coordinates(u)
         G = (B @ x_all) - offset
@@ -328,6 +327,8 @@ class MortarIntegrals:
         changed = pattern_changed or moved > GAP_TOLERANCE * (reach if reach > 0 else size)
         changed = bool(self.comm.allreduce(changed, op=MPI.LOR))
         pattern_changed = bool(self.comm.allreduce(pattern_changed, op=MPI.LOR))
+        t1 = time.perf_counter()  # the ranks' searches done (the collectives wait for all)
+        self.time_s["search"] += t1 - t0
         self._B, self._gap = B, gap
         self._set(self.normal, normals)
         fraction = self.coverage.x.array
