@@ -72,7 +72,7 @@ from fenicsfriction.studies.contact.validation import Hertz
 CONFIGS = (("node-to-segment", 1), ("mortar", 1), ("mortar", 2))
 EVENTS = ("MatLUFactorSym", "MatLUFactorNum", "MatSolve")
 LINE_SEARCH = "contact_snes_linesearch_type"  # TwoBodyModel's solver prefix is contact_
-SMALL = 20_000  # unknowns: meshes up to this size are run --repeats times
+SMALL = 15_000  # unknowns: meshes up to this size are run --repeats times
 
 log = logging.getLogger("bench_hertz_formulations")
 
