@@ -304,7 +304,7 @@ def plot(runs: list[dict], path, dpi: int) -> None:
                              "pressure_l2_error": "p L2"}[key]
                     ax.loglog(x, [max(abs(r[key]), 1e-4) for r in rows], style,
                               color=colours[config], label=f"{name} {short}")
-            ax.axhline(0.03, color="0.6", lw=0.8)
+            ax.axhline(0.03, color="0.6", lw=0.8, label="3 %")
             ax.set(xlabel=x_label, ylabel="|relative error| against Hertz",
                    title=f"Hertz {dim}D: error against {x_label.split(' [')[0]}")
             ax.legend(fontsize=6, ncol=3)
