@@ -32,6 +32,7 @@ For each run it records:
   1e-5, with the contact search repeated until it holds), Newton iterations and searches;
   within the solve the contact search (and building its pairing operator), the contact
   residual and Jacobian, and the LU factorisations and triangular solves (PETSc's log);
+* the solve's CPU time (the process's), steadier than its wall time where the cores are shared;
 * the linear solver (the KSP, PC and factorisation package) and the peak resident memory of
   the process so far (the rungs run from small to large within each dimension);
 * same-run ratios: mortar's solve time over node-to-segment's on the same mesh (degree 1;
@@ -133,9 +134,11 @@ def run_once(dim: int, a_over_h: int, formulation: str, degree: int, comm: MPI.C
     t2 = time.perf_counter()
     before = event_times(comm)
     comm.Barrier()
-    t3 = time.perf_counter()
+    t3, cpu = time.perf_counter(), time.process_time()
     summary, _ = scene.run(comm, model)
     solve_time = comm.allreduce(time.perf_counter() - t3, op=MPI.MAX)
+    # the process's own CPU time: on shared cores a steadier measure of cost than wall time
+    solve_cpu = comm.allreduce(time.process_time() - cpu, op=MPI.MAX)
     after = event_times(comm)
     mx = lambda value: comm.allreduce(value, op=MPI.MAX)  # noqa: E731
     pairings = [c.pairing for c in model.contacts]
@@ -150,6 +153,7 @@ def run_once(dim: int, a_over_h: int, formulation: str, degree: int, comm: MPI.C
         **accuracy(scene, values),
         "newton_iterations": summary["newton_iterations"], "solves": summary["solves"],
         "mesh_time_s": mx(t1 - t0), "model_time_s": mx(t2 - t1), "solve_time_s": solve_time,
+        "solve_cpu_s": solve_cpu,
         "time_s": {
             "search": mx(sum(p.time_s["search"] + p.time_s["build"] for p in pairings)),
             "contact_residual": mx(sum(op.time_s["residual"] for op in solver.couplings)),
