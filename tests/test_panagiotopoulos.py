@@ -15,7 +15,7 @@ import pytest
 
 import fenicsfriction as ff
 from fenicsfriction.panagiotopoulos import PanagiotopoulosSolver, ProcessError
-from fenicsfriction.studies.block import LayeredBlockOnBelt
+from fenicsfriction.studies.block import BlockOnSlab, LayeredBlockOnBelt
 
 COMM = MPI.COMM_WORLD
 
@@ -116,3 +116,60 @@ def test_bad_options_are_rejected():
     frictionless = ff.BlockOnBelt().build(COMM)
     with pytest.raises(ValueError, match="needs a friction term"):
         PanagiotopoulosSolver(frictionless.residual)
+
+
+# --- two bodies: the block on an elastic slab (node-to-segment contact as a coupling) ------------
+
+def _slab_profile(model, u):
+    """(x, penetration) of the block's contact nodes, sorted by x, on every rank."""
+    model.residual.u.x.array[:] = u
+    d = model.nodal_contact()[0]
+    x = model.V.tabulate_dof_coordinates()[model.contact.pairing.slave_nodes, 0]
+    gathered = model.msh.comm.allgather((x, d))
+    xs, ds = (np.concatenate(a) for a in zip(*gathered, strict=True))
+    order = np.argsort(xs)
+    return xs[order], ds[order]
+
+
+def test_process_on_a_two_body_contact_reaches_newtons_state():
+    """The block on a slab of its own stiffness, μ = 0.8 (half the tipping limit 1.6): the
+    friction bound lives in the contact coupling's forms only, and the process fixes it there.
+
+    The process stops at a change of 1e-8 (the coupled residual relative to the friction
+    forces) with a contraction below 0.9 per iteration, so its traction is within ~1e-7 of the
+    fixed point; d ∝ bound^(1/m_n): 1e-6 of the largest penetration leaves a factor ≥ 4 for
+    the elastic solve's condition and Newton's own tolerance. Johnson's step (the frictionless
+    pressure's bound) is off by more than 1e-3, so the comparison can tell a frozen bound
+    from none."""
+    model, (newton, process, johnson) = _solvers(BlockOnSlab(), "newton", "panagiotopoulos",
+                                                 "johnson", rtol=1e-8)
+    _, u_newton = _solve(model, newton, 0.8)
+    report, u_process = _solve(model, process, 0.8)
+    assert report.converged and 3 < report.outer_iterations < 15
+    _, u_johnson = _solve(model, johnson, 0.8)
+    x, d_newton = _slab_profile(model, u_newton)
+    _, d_process = _slab_profile(model, u_process)
+    _, d_johnson = _slab_profile(model, u_johnson)
+    assert len(x) == 5 and d_newton.min() > 0
+    assert np.max(np.abs(d_process - d_newton)) < 1e-6 * d_newton.max()
+    assert np.max(np.abs(d_johnson - d_newton)) > 1e-3 * d_newton.max()
+
+
+@pytest.mark.mpi(min_size=2)
+def test_distributed_process_on_two_bodies_matches_serial():
+    """The process on the block-on-slab scene over COMM_WORLD (the mesh, the contact's slave
+    nodes and the pairing split over the ranks) and on COMM_SELF: the same penetrations, to
+    the same 1e-6 of the largest as against Newton, and the same number of outer iterations
+    (the changes are norms of assembled vectors, equal up to round-off)."""
+    profiles, outer = [], []
+    for comm in (COMM, MPI.COMM_SELF):
+        model = BlockOnSlab().build(comm, with_friction=True)
+        process = PanagiotopoulosSolver(model.residual, prefix=f"slab_{comm.size}_",
+                                        options=model.solver_options(),
+                                        parameters={"mu": model.mu})
+        report, u = _solve(model, process, 0.8)
+        outer.append(report.outer_iterations)
+        profiles.append(_slab_profile(model, u)[1])
+    world, alone = profiles
+    assert len(world) == len(alone) == 5 and outer[0] == outer[1]
+    assert np.max(np.abs(world - alone)) < 1e-6 * alone.max()
