@@ -4,11 +4,12 @@ Four studies (Kalker 1986, sections 3-4 and eq. 27):
 
 * **block** — steady sliding of the block on the belt (Martins & Oden 1986's data, Q2,
   ``--refine``; ``--scene block-on-slab``: Q1 on an elastic slab, the friction bound then in
-  the two-body contact coupling's forms), μ from 0 to just below the discrete tipping limit: for each method
-  (:class:`fenicsfriction.panagiotopoulos.PanagiotopoulosSolver`, every solve from the same
-  initial guess) the outer and Newton iterations, the wall time (median of ``--repeats``), the
-  contraction factor of the process (geometric mean of its change ratios) and the error of
-  the contact penetrations against Newton's (max over the nodes, relative to the largest);
+  the two-body contact coupling's forms), μ from 0 to just below the discrete tipping limit:
+  for each method (:class:`fenicsfriction.panagiotopoulos.PanagiotopoulosSolver`, every solve
+  from the same initial guess) the outer and Newton iterations, the wall time (median of
+  ``--repeats``), the contraction factor of the process (geometric mean of its change ratios)
+  and the error of the contact penetrations against Newton's (max over the nodes, relative
+  to the largest);
 * **layered** — the same block on a soft layer (E/1000, ν = 0 or 0.25; spring at H/12, so
   the tipping limit is 9.6): the μ where the process stops converging (bisection to
   ``--mu-tol`` with at most 200 outer iterations), against 1/β, β = (1 - 2ν)/(2(1 - ν)) the
