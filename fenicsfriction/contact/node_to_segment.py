@@ -220,14 +220,16 @@ class NodeToSegment:
         """The law's friction bound :math:`c_T d^{m_T}` at the slave nodes (UFL), ``None``
         without friction or with the perturbed Lagrangian (its bound is not the law's
         labelled one)."""
-        bounds = laws.friction_bounds(self.F)
+        bounds = [b for form in (self.F, self.G) if form is not None
+                  for b in laws.friction_bounds(form)]
         return bounds[0] if bounds else None
 
     def with_friction_bound(self, bound: typing.Any) -> NodeToSegment:
         """A copy of this contact whose forms ``F``, ``G`` have ``bound`` (UFL) in place of
         the friction bound; it shares the pairing and the mirrors with this one."""
         twin = copy.copy(self)
-        twin.F, twin.G = (laws.substitute_friction_bound(form, lambda _: bound)
+        twin.F, twin.G = (None if form is None
+                          else laws.substitute_friction_bound(form, lambda _: bound)
                           for form in (self.F, self.G))
         return twin
 
