@@ -8,6 +8,8 @@ the rigid belt that coupling is the layer's second Dundurs constant β = (1 - 2�
 and the process stops converging near μβ = 1 while Newton goes on.
 """
 
+import dataclasses
+
 from mpi4py import MPI
 
 import numpy as np
@@ -173,3 +175,24 @@ def test_distributed_process_on_two_bodies_matches_serial():
     world, alone = profiles
     assert len(world) == len(alone) == 5 and outer[0] == outer[1]
     assert np.max(np.abs(world - alone)) < 1e-6 * alone.max()
+
+
+def test_couplings_without_the_friction_bound_hook_are_refused():
+    """A coupling that cannot hand over its friction bound (only the solvers' members) would
+    keep a live bound the process cannot see: refused, as is mollifying a coupling's bound."""
+    model = BlockOnSlab().build(COMM, with_friction=True)
+
+    class Opaque:  # a Coupling (the solvers' members), without FrictionBoundCoupling's
+        search_pending, m_n = True, 1.0
+
+        def operator(self, derivatives, rest=(), jit_cache_dir=None):
+            return model.contact.operator(derivatives, rest, jit_cache_dir)
+
+        def frequency_bound(self, lumped_mass):
+            return 0.0
+
+    opaque = dataclasses.replace(model.residual, couplings=[Opaque()])
+    with pytest.raises(ValueError, match="residual='couplings'.*FrictionBoundCoupling"):
+        PanagiotopoulosSolver(opaque)
+    with pytest.raises(ValueError, match="mollification_radius=1.0"):
+        PanagiotopoulosSolver(model.residual, mollification_radius=1.0)
