@@ -92,7 +92,8 @@ class FrictionBoundCoupling(Coupling, typing.Protocol):
 
     The process evaluates the bound at a frozen state by ``ufl.replace``-ing each Function of
     :attr:`configuration` in :meth:`friction_bound` by a copy of it taken after a solve, and
-    solves the next time with the coupling :meth:`with_friction_bound` returns.
+    solves the next time with the coupling :meth:`with_friction_bound` returns. Node-to-segment
+    and mortar contact are such couplings.
     """
 
     @property
@@ -107,6 +108,11 @@ class FrictionBoundCoupling(Coupling, typing.Protocol):
         the expression labelled :data:`fenicsfriction.laws.FRICTION_BOUND` in its forms), or
         ``None`` if it has none."""
 
-    def with_friction_bound(self, bound: typing.Any) -> Coupling:
+    def with_friction_bound(self, bound: typing.Any) -> FrictionBoundCoupling:
         """The same coupling with the UFL scalar ``bound`` in place of its friction bound,
         sharing this one's pairing (one search serves both)."""
+
+    def search(self) -> bool:
+        """Pair the surfaces at the current displacement; True if the pairing changed (the
+        process goes on when a state it converged to no longer has the pairing it was
+        solved with)."""

@@ -304,6 +304,13 @@ class PanagiotopoulosSolver:
             vector.axpy(-1.0, self._frictionless)
         return vector
 
+    def _searched_again(self) -> bool:
+        """Search every coupling's pairing at the current state; True if one changed (the
+        state was solved with a pairing it no longer has)."""
+        assert self.frozen is not None
+        changed = [coupling.search() for coupling in self.frozen.couplings]  # every one
+        return any(changed)
+
     # --- the solve ----------------------------------------------------------------------------
     def _report(self, converged: bool, outer: int, newton: int, t0: float, changes: list,
                 reason: str) -> ProcessReport:
@@ -334,6 +341,7 @@ class PanagiotopoulosSolver:
             return self._report(True, 1, inner.iterations, t0, [], inner.reason)
         changes: list[float] = []
         newton = 0
+        since = 0  # the patience counts the changes since the last change of the pairing
         outer_limit = 2 if self.method == "johnson" else self.max_iterations
         self.friction_on.value = 0.0  # p_τ(0) = 0: the frictionless normal problem first
         for outer in range(1, outer_limit + 1):
@@ -358,12 +366,15 @@ class PanagiotopoulosSolver:
             change = new.norm() / size if size > 0 else (0.0 if new.norm() == 0 else np.inf)
             changes.append(float(change))
             if change <= self.rtol:
-                return self._report(True, outer, newton, t0, changes,
-                                    f"change {change:.3e} <= rtol {self.rtol:.1e}")
+                if self.method == "johnson" or not self._searched_again():
+                    return self._report(True, outer, newton, t0, changes,
+                                        f"change {change:.3e} <= rtol {self.rtol:.1e}")
+                since = len(changes)  # solved with a pairing it no longer has: go on
+                continue
             if self.method == "johnson" and outer == 2:
                 return self._report(False, outer, newton, t0, changes,
                                     "one step (Johnson's approximation)")
-            best = int(np.argmin(changes))
+            best = since + int(np.argmin(changes[since:]))
             if not np.isfinite(change) or len(changes) - 1 - best >= self.patience:
                 report = self._report(False, outer, newton, t0, changes,
                                       "the change stopped falling")

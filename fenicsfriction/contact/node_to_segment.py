@@ -227,7 +227,7 @@ class NodeToSegment:
                   for b in laws.friction_bounds(form)]
         return bounds[0] if bounds else None
 
-    def with_friction_bound(self, bound: typing.Any) -> NodeToSegment:
+    def with_friction_bound(self, bound: typing.Any) -> typing.Self:
         """A copy of this contact whose forms ``F``, ``G`` have ``bound`` (UFL) in place of
         the friction bound; it shares the pairing and the mirrors with this one."""
         twin = copy.copy(self)
