@@ -92,8 +92,9 @@ class FrictionBoundCoupling(Coupling, typing.Protocol):
 
     The process evaluates the bound at a frozen state by ``ufl.replace``-ing each Function of
     :attr:`configuration` in :meth:`friction_bound` by a copy of it taken after a solve, and
-    solves the next time with the coupling :meth:`with_friction_bound` returns. Node-to-segment
-    and mortar contact are such couplings.
+    solves the next time with the coupling :meth:`with_friction_bound` returns.
+    :class:`~fenicsfriction.contact.NodeToSegment` is one; its ``friction_bound`` and
+    ``with_friction_bound`` read and rebuild any coupling's forms ``F`` and ``G``.
     """
 
     @property
