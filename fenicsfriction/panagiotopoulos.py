@@ -173,7 +173,7 @@ class PanagiotopoulosSolver:
         for coupling in couplings:
             check("residual", "couplings", isinstance(coupling, FrictionBoundCoupling),
                   "contact couplings that expose their friction bound (configuration, "
-                  "friction_bound, with_friction_bound: "
+                  "friction_bound, with_friction_bound, search: "
                   "fenicsfriction.coupling.FrictionBoundCoupling)")
         coupling_bounds = [c.friction_bound() for c in couplings]
         steady = residual.steady()
