@@ -84,6 +84,20 @@ def test_mortar_integrals_are_a_partition_of_unity(dim, degree):
     assert total == pytest.approx(1.0, rel=1e-13)
 
 
+@pytest.mark.parametrize("formulation", ["mortar", "node-to-segment"])
+def test_gap_and_normal_mean_the_same_in_both_formulations(formulation):
+    """The upper block moved 0.01 into the lower one (flat interface z = 0): at every slave
+    node the gap is -0.01, the penetration 0.01 and the normal +z, out of the master body."""
+    msh, _, facet_tags = stacked_blocks(MPI.COMM_WORLD, 3, 2, 3, overlap=0.01)
+    u = fem.Function(_compat.vector_function_space(msh, 1))
+    contact = make_contact(formulation, u, facet_tags, SLAVE, MASTER,
+                           InterfaceLaw(c_n=1.0, m_n=1.0))
+    contact.update()
+    values = contact.nodal_values([contact.gap, contact.penetration, *contact.normal])()
+    slave = contact.nodal_weights > 0
+    assert np.allclose(values[slave], [-0.01, 0.01, 0.0, 0.0, 1.0], rtol=0, atol=1e-14)
+
+
 def _reference_integrals(degree: int) -> tuple[np.ndarray, np.ndarray]:
     """D and M of one slave segment [0, 1] (nodes 0, 1 and, for degree 2, 1/2) against two
     master segments [0, 1/2], [1/2, 1] (nodes 0, 1/2, 1 and the quarter points), by

@@ -616,7 +616,10 @@ class SegmentToSegment:
         F, G: ``None`` and the form of the contact's virtual power on the mirrors' test
             functions (:math:`R_c = B^T G`).
         ds: the nodal measure on the slave facets, :math:`\int q\, ds = \sum_j A_j q_j`.
-        normal, gap, penetration: :math:`n_j` (a Function of V), :math:`g_j`, :math:`d_j`.
+        normal, gap, penetration: the contact normal :math:`-n_j`, out of the master body
+            (node-to-segment's orientation: ``pressure * normal + traction`` is the force on
+            the slave side with either formulation; :math:`n_j` is the Function
+            ``pairing.normal``), :math:`g_j = -n_j\cdot G_j` and :math:`d_j` (UFL, nodal).
         pressure, traction: the pressure and the friction traction (UFL, nodal; the traction
             None without friction).
         relative_velocity: :math:`w` (UFL; None without ``velocity``).
@@ -661,10 +664,12 @@ class SegmentToSegment:
             f: fem.Function(V, name=f"mortar_{f.name}") for f in (u, *fields)}
         self.ds = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags, subdomain_id=slave,
                               metadata=_compat.nodal_quadrature(dim - 1, degree=degree))
-        n = self.normal = self.pairing.normal
+        # the contact normal out of the master body, -n_j, as node-to-segment's: the force on
+        # the slave side is p n + t_T with either formulation
+        n = self.normal = -self.pairing.normal
         G = self.pairing.reference + self.mirrors[u]
-        self.gap = -ufl.dot(n, G)
-        d = self.penetration = laws.penetration(ufl.dot(n, G))
+        self.gap = ufl.dot(n, G)
+        d = self.penetration = laws.penetration(-self.gap)
         w = None
         if velocity is not None:
             unmirrored = set(ufl.algorithms.extract_coefficients(velocity)) - {u, *fields}
@@ -686,18 +691,18 @@ class SegmentToSegment:
                           * self.ds)
         dissipated = 0.0 * d
         if w is not None:
-            dissipated = (self.pressure - law.pressure(d)) * ufl.dot(n, w)
+            dissipated = (self.pressure - law.pressure(d)) * -ufl.dot(w, n)
             if self.traction is not None:
                 dissipated = dissipated - ufl.dot(self.traction, w)
         self.dissipation = weight * covered * dissipated * self.ds
 
     def _force(self, d: typing.Any, n: typing.Any, w: typing.Any) -> typing.Any:
-        """The force on the slave side at penetration ``d``, normal ``n`` and relative
-        velocity ``w`` (None: none), :math:`-p n + t_T`; sets ``pressure`` and
-        ``traction``."""
-        approach = ufl.dot(n, w) if w is not None else 0.0
+        """The force on the slave side at penetration ``d``, contact normal ``n`` (out of
+        the master body) and relative velocity ``w`` (None: none): :math:`p n + t_T`, the
+        approach rate :math:`\\dot d = -w\\cdot n`; sets ``pressure`` and ``traction``."""
+        approach = -ufl.dot(w, n) if w is not None else 0.0
         self.pressure = self.law.normal_traction(d, approach)
-        force = -self.pressure * n
+        force = self.pressure * n
         self.traction = None
         if self.law.has_friction:
             w_T = w - ufl.dot(w, n) * n
