@@ -368,11 +368,6 @@ class MortarIntegrals:
         return float(np.linalg.norm(X[:, 1] - X[:, 0], axis=-1).mean()) if len(X) else 1.0
 
     @functools.cached_property
-    def _columns(self) -> np.ndarray:
-        """The global indices of every node of both surfaces (sorted)."""
-        return np.unique(np.concatenate([self.slave.nodes.ravel(), self.master.nodes.ravel()]))
-
-    @functools.cached_property
     def _surface_reference(self) -> np.ndarray:
         return self._dense_columns(self.slave.reference, self.master.reference)
 
