@@ -206,15 +206,24 @@ class _Pieces:
 
     facet: np.ndarray  # (p,) the facet of each piece
     nodes: np.ndarray  # (p, nv) global node indices of the piece's vertices
-    parent: np.ndarray  # (p, nv, nv) barycentric coordinates of its vertices in the facet
     split: np.ndarray  # (pieces per facet, nv) the pieces' vertices among the facet's nodes
+    parent: np.ndarray  # (pieces per facet, nv, nv) their barycentric coordinates in it
 
     @classmethod
     def split_facets(cls, nodes: np.ndarray, dim: int, degree: int) -> _Pieces:
         split = np.array(_PIECES[dim, degree])
         facet = np.repeat(np.arange(len(nodes)), len(split))
-        return cls(facet, nodes[:, split].reshape(-1, dim),
-                   np.tile(_NODES[dim][split], (len(nodes), 1, 1)), split)
+        return cls(facet, nodes[:, split].reshape(-1, dim), split, _NODES[dim][split])
+
+    def in_facet(self, lam: np.ndarray, pieces: np.ndarray) -> np.ndarray:
+        """The facet's barycentric coordinates of points with coordinates ``lam[q]`` in the
+        pieces ``pieces[q]``."""
+        kind = pieces % len(self.split)
+        out = np.empty_like(lam)
+        for k, parent in enumerate(self.parent):
+            chosen = kind == k
+            out[chosen] = lam[chosen] @ parent
+        return out
 
     def coordinates(self, x: np.ndarray) -> np.ndarray:
         """The pieces' vertices' coordinates, ``x`` those of the facets' nodes (f, nen, dim):
@@ -419,8 +428,13 @@ class MortarIntegrals:
         s_index = np.repeat(np.arange(len(mine)), counts)
         m_index = (np.concatenate([np.asarray(f, dtype=np.int64) for f in found])
                    if counts.sum() else np.zeros(0, dtype=np.int64))
-        facing = np.einsum("pk,pk->p", s_normal[s_index], m_normal[m_index]) < 0
-        s_index, m_index = s_index[facing], m_index[facing]
+        # facing each other, and close enough across the slave normal to overlap
+        unit = s_normal[s_index] / np.linalg.norm(s_normal[s_index], axis=-1, keepdims=True)
+        offset = m_centre[m_index] - s_centre[s_index]
+        across = offset - np.einsum("pk,pk->p", offset, unit)[:, None] * unit
+        keep = ((np.einsum("pk,pk->p", unit, m_normal[m_index]) < 0)
+                & (np.linalg.norm(across, axis=-1) <= s_radius[s_index] + m_radius[m_index]))
+        s_index, m_index = s_index[keep], m_index[keep]
         segment = _segments_2d if d == 2 else _segments_3d
         mu, nu, weight, pair = segment(s_x[s_index], master_x[m_index])
         # reference measure: the piece's reference size over its current one
@@ -433,18 +447,17 @@ class MortarIntegrals:
         sp, mp = self.slave_pieces, self.master_pieces
         s_piece, m_piece = mine[s_index[pair]], m_index[pair]
         points = np.repeat(np.arange(len(pair)), np.diff(np.append(starts, len(order))))
-        N_s = shape_functions(np.einsum("qa,qab->qb", mu, sp.parent[s_piece][points]),
-                              self.degree)
-        N_m = shape_functions(np.einsum("qa,qab->qb", nu, mp.parent[m_piece][points]),
-                              self.degree)
+        N_s = shape_functions(sp.in_facet(mu, s_piece[points]), self.degree)
+        N_m = shape_functions(mp.in_facet(nu, m_piece[points]), self.degree)
         rows = sp.nodes[s_piece]  # (pairs, nv)
         owned = self._owned(rows)
         rows_local = rows - self.owned_range[0]
+        weighted = weight[:, None] * mu
         matrices = []
         for N, facets, nodes in ((N_s, sp.facet[s_piece], self.slave.nodes),
                                  (N_m, mp.facet[m_piece], self.master.nodes)):
             columns = nodes[facets]  # (pairs, nen)
-            values = np.add.reduceat(np.einsum("q,qa,qk->qak", weight, mu, N), starts, axis=0)
+            values = np.add.reduceat(weighted[:, :, None] * N[:, None, :], starts, axis=0)
             keep = np.broadcast_to(owned[:, :, None], values.shape)
             r = np.broadcast_to(rows_local[:, :, None], values.shape)[keep]
             c = np.broadcast_to(columns[:, None, :], values.shape)[keep]
@@ -573,8 +586,9 @@ def _clip(subject: np.ndarray, clip: np.ndarray) -> tuple[np.ndarray, np.ndarray
         candidates = np.stack([subject, crossing], axis=2).reshape(p, 2 * k, 2)
         used = np.stack([valid & inside, valid & (inside != inside_next)], axis=2).reshape(p, -1)
         count = used.sum(axis=1)
-        order = np.argsort(~used, axis=1, kind="stable")
-        subject = candidates[rows, order][:, :max(int(count.max(initial=0)), 1)]
+        subject = np.zeros((p, max(int(count.max(initial=0)), 1), 2))
+        r, c = np.nonzero(used)  # the used candidates, in order, to the front of each row
+        subject[r, (np.cumsum(used, axis=1) - 1)[r, c]] = candidates[r, c]
     return subject, count
 
 
