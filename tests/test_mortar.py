@@ -84,6 +84,36 @@ def test_mortar_integrals_are_a_partition_of_unity(dim, degree):
     assert total == pytest.approx(1.0, rel=1e-13)
 
 
+@pytest.mark.parametrize("degree", [1, 2])
+@pytest.mark.parametrize("dim", [2, 3])
+def test_sliding_leaves_the_integrals_on_the_overlap(dim, degree):
+    """The upper block slid by s = 0.37 along x (not a multiple of either mesh's size): the
+    integrals cover the overlap only, Σ A_j = 1 - s (its length or area), each row of D and M
+    still sums to A_j, the covered fraction of each node is in [0, 1], and the new pattern of
+    B is counted as a change."""
+    contact, u = _contact(dim, degree, 3, 4)
+    contact.update()
+    changes = contact.pairing.changes
+    x = u.function_space.tabulate_dof_coordinates()[:, :dim]
+    slide = 0.37
+    upper = u.x.array.reshape(-1, dim)
+    upper[x[:, -1] > 1e-12, 0] = slide  # the upper block's nodes, above z = 0 ...
+    slave = contact.pairing.slave_nodes
+    upper[slave, 0] = slide  # ... and its contact face
+    u.x.scatter_forward()
+    assert contact.search()
+    integrals = contact.pairing
+    assert integrals.changes == changes + 1
+    area = integrals.area[slave]
+    total = MPI.COMM_WORLD.allreduce(float(area.sum()))
+    assert total == pytest.approx(1.0 - slide, rel=1e-12)
+    for matrix in (integrals.D, integrals.M):
+        assert np.allclose(np.asarray(matrix.sum(axis=1)).ravel()[slave], area,
+                           rtol=1e-12, atol=1e-15)
+    fraction = integrals.coverage.x.array[slave]
+    assert np.all((fraction >= 0) & (fraction <= 1 + 1e-12))
+
+
 @pytest.mark.parametrize("formulation", ["mortar", "node-to-segment"])
 def test_gap_and_normal_mean_the_same_in_both_formulations(formulation):
     """The upper block moved 0.01 into the lower one (flat interface z = 0): at every slave
