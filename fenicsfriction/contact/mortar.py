@@ -648,8 +648,10 @@ class SegmentToSegment:
         degree = _compat.element_degree(V)
         laws.check("V", degree, degree in (1, 2),
                    "mortar contact needs a Lagrange displacement space of degree 1 or 2")
-        laws.check("mesh", msh.geometry.cmap.degree, msh.geometry.cmap.degree == 1,
-                   "mortar contact needs a mesh of degree-1 (straight) geometry")
+        simplex = msh.topology.cell_type in (mesh.CellType.triangle, mesh.CellType.tetrahedron)
+        laws.check("mesh", msh.topology.cell_type.name,
+                   simplex and msh.geometry.cmap.degree == 1,
+                   "mortar contact needs a mesh of straight (degree-1) triangles or tetrahedra")
         if formulation is not None:
             enforcement = formulation
         laws.check("enforcement", enforcement, enforcement == "compliance",
