@@ -390,6 +390,10 @@ class ContactOperator:
         #: chained Jacobian (``"jacobian"``: blocks, products, addition), summed over calls
         self.time_s = {"residual": 0.0, "jacobian": 0.0}
 
+    def create_vector(self) -> PETSc.Vec:
+        """A vector of the displacement space's layout, for :meth:`add_to_residual`."""
+        return dolfinx.fem.petsc.create_vector(self.F if self.F is not None else self.G)
+
     def add_to_residual(self, b: PETSc.Vec) -> None:
         """``b += F + Q^T G`` at the current state (the pairing searched first if due)."""
         contact = self.contact
