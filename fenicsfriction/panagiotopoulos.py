@@ -113,8 +113,8 @@ class PanagiotopoulosSolver:
         residual: the problem's one residual (its ``u``: the initial guess and the result). The
             process needs a friction term (:func:`fenicsfriction.forms.friction`) or a contact
             coupling with friction; every coupling must be a
-            :class:`~fenicsfriction.coupling.FrictionBoundCoupling` (node-to-segment contact),
-            its bound fixed the same way as the integrals'.
+            :class:`~fenicsfriction.coupling.FrictionBoundCoupling` (node-to-segment and
+            mortar contact), its bound fixed the same way as the integrals'.
         method: one of :data:`METHODS`.
         rtol: the relative change of the tangential traction at which the process stops.
         max_iterations: the most outer iterations (Newton solves of the frozen residual).

@@ -235,9 +235,9 @@ def test_refused_inputs_name_what_is_allowed():
     cubic = fem.Function(_compat.vector_function_space(msh, 3))
     with pytest.raises(ValueError, match="degree 1 or 2"):
         SegmentToSegment(cubic, facet_tags, SLAVE, MASTER, law)
-    squares = _compat.create_rectangle(MPI.COMM_WORLD, [0.0, 0.0], [1.0, 1.0], [2, 2])
-    with pytest.raises(ValueError, match="straight .degree-1. triangles or tetrahedra"):
-        SegmentToSegment(fem.Function(_compat.vector_function_space(squares, 1)), facet_tags,
+    cubes = _compat.create_box(MPI.COMM_WORLD, [0.0, 0.0, 0.0], [1.0, 1.0, 1.0], [2, 2, 2])
+    with pytest.raises(ValueError, match="mesh='hexahedron'.*tetrahedra"):
+        SegmentToSegment(fem.Function(_compat.vector_function_space(cubes, 1)), facet_tags,
                          SLAVE, MASTER, law)
     u = fem.Function(_compat.vector_function_space(msh, 1))
     for options in ({"enforcement": "perturbed-lagrangian"},

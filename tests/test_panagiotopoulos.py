@@ -18,8 +18,7 @@ import pytest
 
 import fenicsfriction as ff
 from fenicsfriction.case import CaseModel, read_case
-from fenicsfriction.contact import NodeToSegment, solve_with_search
-from fenicsfriction.contact.mortar import SegmentToSegment
+from fenicsfriction.contact import solve_with_search
 from fenicsfriction.panagiotopoulos import PanagiotopoulosSolver, ProcessError
 from fenicsfriction.studies.block import BlockOnSlab, LayeredBlockOnBelt
 
@@ -166,21 +165,6 @@ def test_process_on_a_two_body_contact_reaches_newtons_state():
 CASE_CONTACTS = [("node-to-segment", 1), ("mortar", 1), ("mortar", 2)]
 
 
-@pytest.fixture
-def mortar_hook(monkeypatch):
-    """The FrictionBoundCoupling members on the mortar contact, where mortar.py does not have
-    them yet: its geometry is u's mirror B u, the reference B X and the slave nodes' normal
-    (the Functions its penetration is made of); its bound and forms are found and rebuilt
-    exactly as node-to-segment's."""
-    if not hasattr(SegmentToSegment, "friction_bound"):
-        monkeypatch.setattr(SegmentToSegment, "configuration", property(
-            lambda c: [c.u, c.mirrors[c.u], c.pairing.reference, c.pairing.normal]),
-            raising=False)
-        for name in ("friction_bound", "with_friction_bound"):
-            monkeypatch.setattr(SegmentToSegment, name, getattr(NodeToSegment, name),
-                                raising=False)
-
-
 def _slab_case(folder, formulation: str, degree: int, comm=COMM):
     """cases/block-on-slab.toml with the contact's formulation and the degree given."""
     text = (ROOT / "cases" / "block-on-slab.toml").read_text().replace(
@@ -218,7 +202,7 @@ def _case_solve(model, method, mu, search=False):
 
 
 @pytest.mark.parametrize(("formulation", "degree"), CASE_CONTACTS)
-def test_process_on_a_case_files_contact_reaches_newtons_state(shared_tmp_path, mortar_hook,
+def test_process_on_a_case_files_contact_reaches_newtons_state(shared_tmp_path,
                                                                formulation, degree):
     """The block-on-slab case with either contact formulation, μ = 0.8: the process against
     Newton, whose state is made consistent with its pairing by solve_with_search (the case's
@@ -241,7 +225,7 @@ def test_process_on_a_case_files_contact_reaches_newtons_state(shared_tmp_path, 
 
 @pytest.mark.mpi(min_size=2)
 @pytest.mark.parametrize(("formulation", "degree"), [("node-to-segment", 1), ("mortar", 2)])
-def test_distributed_process_on_two_bodies_matches_serial(shared_tmp_path, mortar_hook,
+def test_distributed_process_on_two_bodies_matches_serial(shared_tmp_path,
                                                           formulation, degree):
     """The process on the block-on-slab case over COMM_WORLD (the mesh, the contact's slave
     nodes and the pairing split over the ranks) and on COMM_SELF: the same nodal pressures,

@@ -73,7 +73,7 @@ from scipy.spatial import cKDTree
 
 from fenicsfriction import _compat, laws
 from fenicsfriction.assembly import assemble_owned
-from fenicsfriction.contact.node_to_segment import ContactOperator, NodalValues
+from fenicsfriction.contact.node_to_segment import ContactOperator, NodalValues, NodeToSegment
 
 __all__ = ["MortarIntegrals", "SegmentToSegment", "surface_facets"]
 
@@ -648,10 +648,13 @@ class SegmentToSegment:
         degree = _compat.element_degree(V)
         laws.check("V", degree, degree in (1, 2),
                    "mortar contact needs a Lagrange displacement space of degree 1 or 2")
-        simplex = msh.topology.cell_type in (mesh.CellType.triangle, mesh.CellType.tetrahedron)
+        # the facets must be straight segments (2D: of triangles or quadrilaterals) or
+        # triangles (3D: of tetrahedra; a hexahedron's quadrilateral facet is not one)
+        simplex_facets = msh.topology.cell_type != mesh.CellType.hexahedron
         laws.check("mesh", msh.topology.cell_type.name,
-                   simplex and msh.geometry.cmap.degree == 1,
-                   "mortar contact needs a mesh of straight (degree-1) triangles or tetrahedra")
+                   simplex_facets and msh.geometry.cmap.degree == 1,
+                   "mortar contact needs a mesh of straight (degree-1) triangles or "
+                   "quadrilaterals (2D) or tetrahedra (3D)")
         if formulation is not None:
             enforcement = formulation
         laws.check("enforcement", enforcement, enforcement == "compliance",
@@ -766,6 +769,18 @@ class SegmentToSegment:
     def commit(self) -> None:
         """Nothing to store between increments (the compliance law has no history)."""
 
+    @property
+    def configuration(self) -> list[fem.Function]:
+        """What the mortar gaps, normals and friction bound are made of: u, its mirror
+        :math:`B u`, the reference :math:`B X`, the slave nodes' normal and covered fraction
+        (:class:`~fenicsfriction.coupling.FrictionBoundCoupling`)."""
+        return [self.u, self.mirrors[self.u], self.pairing.reference, self.pairing.normal,
+                self.pairing.coverage]
+
+    # the bound is found and the form rebuilt as node-to-segment's (``F`` is None here)
+    friction_bound = NodeToSegment.friction_bound
+    with_friction_bound = NodeToSegment.with_friction_bound
+
     def search(self) -> bool:
         """The contact geometry at the current ``u``; True if it changed
         (:meth:`MortarIntegrals.search`)."""
@@ -800,4 +815,10 @@ if typing.TYPE_CHECKING:  # mypy checks that the mortar contact is a Coupling
     from fenicsfriction.coupling import Coupling
 
     def _segment_to_segment_is_a_coupling(contact: SegmentToSegment) -> Coupling:
+        return contact
+
+    from fenicsfriction.coupling import FrictionBoundCoupling
+
+    def _segment_to_segment_has_a_friction_bound(contact: SegmentToSegment
+                                                 ) -> FrictionBoundCoupling:
         return contact
