@@ -7,8 +7,9 @@ upper face 2 m² (``--m``, default 43). For each displacement degree (1 and 2) i
 candidate pairs from a k-d tree, the segmentation and integration of D and M: ``"search"``;
 B as a PETSc matrix and the reference gaps: ``"build"``), then ``--repeats`` further searches
 after a small displacement (the median), beside node-to-segment's search on the same degree-1
-surfaces (:class:`fenicsfriction.contact.Pairing`) as a same-run baseline. Prints a markdown
-table (rank 0); run serially or under ``mpirun -n 2``.
+surfaces (:class:`fenicsfriction.contact.Pairing`) as a same-run baseline. Writes
+``bench_mortar.json`` to ``--out`` and prints a markdown table (rank 0); run serially or under
+``mpirun -n 2``. About 20 s serially.
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ import numpy as np
 from _common import parser as benchmark_parser
 from dolfinx import fem, mesh
 
-from fenicsfriction import _compat
+from fenicsfriction import _compat, results
 from fenicsfriction.contact import NodeToSegment
 from fenicsfriction.contact.mortar import SegmentToSegment
 from fenicsfriction.laws import InterfaceLaw
@@ -115,6 +116,13 @@ def main(argv: list[str]) -> None:
         first, again = _timed_searches(contact, u, args.repeats)
         parts = contact.pairing.time_s
         rows.append((name, degree, setup, first, again, parts["search"], parts["build"]))
+    keys = ("contact", "degree", "setup_s", "first_search_s", "later_search_median_s",
+            "search_s", "build_s")
+    results.write_summary(args.out / "bench_mortar.json",
+                          {"slave_facets": 2 * args.n**2, "master_facets": 2 * args.m**2,
+                           "ranks": comm.size, "repeats": args.repeats,
+                           "runs": [dict(zip(keys, row, strict=True)) for row in rows]},
+                          comm=comm)
     if comm.rank == 0:
         facets = 2 * args.n**2
         print(f"{facets} slave facets against {2 * args.m**2}, {comm.size} rank(s)\n")

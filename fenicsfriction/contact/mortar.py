@@ -73,7 +73,7 @@ from scipy.spatial import cKDTree
 
 from fenicsfriction import _compat, laws
 from fenicsfriction.assembly import assemble_owned
-from fenicsfriction.contact.node_to_segment import ContactOperator, NodalValues
+from fenicsfriction.contact.node_to_segment import ContactOperator, NodalValues, NodeToSegment
 
 __all__ = ["MortarIntegrals", "SegmentToSegment", "surface_facets"]
 
@@ -206,15 +206,24 @@ class _Pieces:
 
     facet: np.ndarray  # (p,) the facet of each piece
     nodes: np.ndarray  # (p, nv) global node indices of the piece's vertices
-    parent: np.ndarray  # (p, nv, nv) barycentric coordinates of its vertices in the facet
     split: np.ndarray  # (pieces per facet, nv) the pieces' vertices among the facet's nodes
+    parent: np.ndarray  # (pieces per facet, nv, nv) their barycentric coordinates in it
 
     @classmethod
     def split_facets(cls, nodes: np.ndarray, dim: int, degree: int) -> _Pieces:
         split = np.array(_PIECES[dim, degree])
         facet = np.repeat(np.arange(len(nodes)), len(split))
-        return cls(facet, nodes[:, split].reshape(-1, dim),
-                   np.tile(_NODES[dim][split], (len(nodes), 1, 1)), split)
+        return cls(facet, nodes[:, split].reshape(-1, dim), split, _NODES[dim][split])
+
+    def in_facet(self, lam: np.ndarray, pieces: np.ndarray) -> np.ndarray:
+        """The facet's barycentric coordinates of points with coordinates ``lam[q]`` in the
+        pieces ``pieces[q]``."""
+        kind = pieces % len(self.split)
+        out = np.empty_like(lam)
+        for k, parent in enumerate(self.parent):
+            chosen = kind == k
+            out[chosen] = lam[chosen] @ parent
+        return out
 
     def coordinates(self, x: np.ndarray) -> np.ndarray:
         """The pieces' vertices' coordinates, ``x`` those of the facets' nodes (f, nen, dim):
@@ -368,11 +377,6 @@ class MortarIntegrals:
         return float(np.linalg.norm(X[:, 1] - X[:, 0], axis=-1).mean()) if len(X) else 1.0
 
     @functools.cached_property
-    def _columns(self) -> np.ndarray:
-        """The global indices of every node of both surfaces (sorted)."""
-        return np.unique(np.concatenate([self.slave.nodes.ravel(), self.master.nodes.ravel()]))
-
-    @functools.cached_property
     def _surface_reference(self) -> np.ndarray:
         return self._dense_columns(self.slave.reference, self.master.reference)
 
@@ -424,8 +428,13 @@ class MortarIntegrals:
         s_index = np.repeat(np.arange(len(mine)), counts)
         m_index = (np.concatenate([np.asarray(f, dtype=np.int64) for f in found])
                    if counts.sum() else np.zeros(0, dtype=np.int64))
-        facing = np.einsum("pk,pk->p", s_normal[s_index], m_normal[m_index]) < 0
-        s_index, m_index = s_index[facing], m_index[facing]
+        # facing each other, and close enough across the slave normal to overlap
+        unit = s_normal[s_index] / np.linalg.norm(s_normal[s_index], axis=-1, keepdims=True)
+        offset = m_centre[m_index] - s_centre[s_index]
+        across = offset - np.einsum("pk,pk->p", offset, unit)[:, None] * unit
+        keep = ((np.einsum("pk,pk->p", unit, m_normal[m_index]) < 0)
+                & (np.linalg.norm(across, axis=-1) <= s_radius[s_index] + m_radius[m_index]))
+        s_index, m_index = s_index[keep], m_index[keep]
         segment = _segments_2d if d == 2 else _segments_3d
         mu, nu, weight, pair = segment(s_x[s_index], master_x[m_index])
         # reference measure: the piece's reference size over its current one
@@ -438,18 +447,17 @@ class MortarIntegrals:
         sp, mp = self.slave_pieces, self.master_pieces
         s_piece, m_piece = mine[s_index[pair]], m_index[pair]
         points = np.repeat(np.arange(len(pair)), np.diff(np.append(starts, len(order))))
-        N_s = shape_functions(np.einsum("qa,qab->qb", mu, sp.parent[s_piece][points]),
-                              self.degree)
-        N_m = shape_functions(np.einsum("qa,qab->qb", nu, mp.parent[m_piece][points]),
-                              self.degree)
+        N_s = shape_functions(sp.in_facet(mu, s_piece[points]), self.degree)
+        N_m = shape_functions(mp.in_facet(nu, m_piece[points]), self.degree)
         rows = sp.nodes[s_piece]  # (pairs, nv)
         owned = self._owned(rows)
         rows_local = rows - self.owned_range[0]
+        weighted = weight[:, None] * mu
         matrices = []
         for N, facets, nodes in ((N_s, sp.facet[s_piece], self.slave.nodes),
                                  (N_m, mp.facet[m_piece], self.master.nodes)):
             columns = nodes[facets]  # (pairs, nen)
-            values = np.add.reduceat(np.einsum("q,qa,qk->qak", weight, mu, N), starts, axis=0)
+            values = np.add.reduceat(weighted[:, :, None] * N[:, None, :], starts, axis=0)
             keep = np.broadcast_to(owned[:, :, None], values.shape)
             r = np.broadcast_to(rows_local[:, :, None], values.shape)[keep]
             c = np.broadcast_to(columns[:, None, :], values.shape)[keep]
@@ -578,8 +586,9 @@ def _clip(subject: np.ndarray, clip: np.ndarray) -> tuple[np.ndarray, np.ndarray
         candidates = np.stack([subject, crossing], axis=2).reshape(p, 2 * k, 2)
         used = np.stack([valid & inside, valid & (inside != inside_next)], axis=2).reshape(p, -1)
         count = used.sum(axis=1)
-        order = np.argsort(~used, axis=1, kind="stable")
-        subject = candidates[rows, order][:, :max(int(count.max(initial=0)), 1)]
+        subject = np.zeros((p, max(int(count.max(initial=0)), 1), 2))
+        r, c = np.nonzero(used)  # the used candidates, in order, to the front of each row
+        subject[r, (np.cumsum(used, axis=1) - 1)[r, c]] = candidates[r, c]
     return subject, count
 
 
@@ -616,7 +625,10 @@ class SegmentToSegment:
         F, G: ``None`` and the form of the contact's virtual power on the mirrors' test
             functions (:math:`R_c = B^T G`).
         ds: the nodal measure on the slave facets, :math:`\int q\, ds = \sum_j A_j q_j`.
-        normal, gap, penetration: :math:`n_j` (a Function of V), :math:`g_j`, :math:`d_j`.
+        normal, gap, penetration: the contact normal :math:`-n_j`, out of the master body
+            (node-to-segment's orientation: ``pressure * normal + traction`` is the force on
+            the slave side with either formulation; :math:`n_j` is the Function
+            ``pairing.normal``), :math:`g_j = -n_j\cdot G_j` and :math:`d_j` (UFL, nodal).
         pressure, traction: the pressure and the friction traction (UFL, nodal; the traction
             None without friction).
         relative_velocity: :math:`w` (UFL; None without ``velocity``).
@@ -636,8 +648,13 @@ class SegmentToSegment:
         degree = _compat.element_degree(V)
         laws.check("V", degree, degree in (1, 2),
                    "mortar contact needs a Lagrange displacement space of degree 1 or 2")
-        laws.check("mesh", msh.geometry.cmap.degree, msh.geometry.cmap.degree == 1,
-                   "mortar contact needs a mesh of degree-1 (straight) geometry")
+        # the facets must be straight segments (2D: of triangles or quadrilaterals) or
+        # triangles (3D: of tetrahedra; a hexahedron's quadrilateral facet is not one)
+        simplex_facets = msh.topology.cell_type != mesh.CellType.hexahedron
+        laws.check("mesh", msh.topology.cell_type.name,
+                   simplex_facets and msh.geometry.cmap.degree == 1,
+                   "mortar contact needs a mesh of straight (degree-1) triangles or "
+                   "quadrilaterals (2D) or tetrahedra (3D)")
         if formulation is not None:
             enforcement = formulation
         laws.check("enforcement", enforcement, enforcement == "compliance",
@@ -661,10 +678,12 @@ class SegmentToSegment:
             f: fem.Function(V, name=f"mortar_{f.name}") for f in (u, *fields)}
         self.ds = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags, subdomain_id=slave,
                               metadata=_compat.nodal_quadrature(dim - 1, degree=degree))
-        n = self.normal = self.pairing.normal
+        # the contact normal out of the master body, -n_j, as node-to-segment's: the force on
+        # the slave side is p n + t_T with either formulation
+        n = self.normal = -self.pairing.normal
         G = self.pairing.reference + self.mirrors[u]
-        self.gap = -ufl.dot(n, G)
-        d = self.penetration = laws.penetration(ufl.dot(n, G))
+        self.gap = ufl.dot(n, G)
+        d = self.penetration = laws.penetration(-self.gap)
         w = None
         if velocity is not None:
             unmirrored = set(ufl.algorithms.extract_coefficients(velocity)) - {u, *fields}
@@ -686,18 +705,18 @@ class SegmentToSegment:
                           * self.ds)
         dissipated = 0.0 * d
         if w is not None:
-            dissipated = (self.pressure - law.pressure(d)) * ufl.dot(n, w)
+            dissipated = (self.pressure - law.pressure(d)) * -ufl.dot(w, n)
             if self.traction is not None:
                 dissipated = dissipated - ufl.dot(self.traction, w)
         self.dissipation = weight * covered * dissipated * self.ds
 
     def _force(self, d: typing.Any, n: typing.Any, w: typing.Any) -> typing.Any:
-        """The force on the slave side at penetration ``d``, normal ``n`` and relative
-        velocity ``w`` (None: none), :math:`-p n + t_T`; sets ``pressure`` and
-        ``traction``."""
-        approach = ufl.dot(n, w) if w is not None else 0.0
+        """The force on the slave side at penetration ``d``, contact normal ``n`` (out of
+        the master body) and relative velocity ``w`` (None: none): :math:`p n + t_T`, the
+        approach rate :math:`\\dot d = -w\\cdot n`; sets ``pressure`` and ``traction``."""
+        approach = -ufl.dot(w, n) if w is not None else 0.0
         self.pressure = self.law.normal_traction(d, approach)
-        force = -self.pressure * n
+        force = self.pressure * n
         self.traction = None
         if self.law.has_friction:
             w_T = w - ufl.dot(w, n) * n
@@ -750,6 +769,18 @@ class SegmentToSegment:
     def commit(self) -> None:
         """Nothing to store between increments (the compliance law has no history)."""
 
+    @property
+    def configuration(self) -> list[fem.Function]:
+        """What the mortar gaps, normals and friction bound are made of: u, its mirror
+        :math:`B u`, the reference :math:`B X`, the slave nodes' normal and covered fraction
+        (:class:`~fenicsfriction.coupling.FrictionBoundCoupling`)."""
+        return [self.u, self.mirrors[self.u], self.pairing.reference, self.pairing.normal,
+                self.pairing.coverage]
+
+    # the bound is found and the form rebuilt as node-to-segment's (``F`` is None here)
+    friction_bound = NodeToSegment.friction_bound
+    with_friction_bound = NodeToSegment.with_friction_bound
+
     def search(self) -> bool:
         """The contact geometry at the current ``u``; True if it changed
         (:meth:`MortarIntegrals.search`)."""
@@ -784,4 +815,10 @@ if typing.TYPE_CHECKING:  # mypy checks that the mortar contact is a Coupling
     from fenicsfriction.coupling import Coupling
 
     def _segment_to_segment_is_a_coupling(contact: SegmentToSegment) -> Coupling:
+        return contact
+
+    from fenicsfriction.coupling import FrictionBoundCoupling
+
+    def _segment_to_segment_has_a_friction_bound(contact: SegmentToSegment
+                                                 ) -> FrictionBoundCoupling:
         return contact
