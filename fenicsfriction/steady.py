@@ -153,8 +153,11 @@ class SteadySolver:
             in the PETSc options (``-<prefix>pc_type lu``) overrides it. Where the Jacobian
             splits, the first two assemble the constant bulk once and only the interface at
             each iteration (docs/benchmarks.md has what each costs).
-        search_rounds: how many Newton solves :meth:`solve_searched` may run until a search
-            of the contact couplings at the converged state keeps their pairing.
+        search_rounds: how many Newton solves :meth:`solve_searched` (each step of
+            :func:`continuation`) may run until a search of the contact couplings at the
+            converged state keeps their pairing; 1 (default): one solve, no search after it.
+            Mortar contact, whose geometry is held within a solve, needs more wherever the
+            bodies slide between solves (10 for the block on a slab).
 
     Attributes:
         snes: the PETSc SNES, exposed for monitoring or further configuration.
@@ -167,7 +170,7 @@ class SteadySolver:
     def __init__(self, residual: Residual, prefix: str = "steady_",
                  options: dict | None = None, jit_cache_dir: str | None = None,
                  roundoff_safety: float = 1.0, linear_solver: str = "auto",
-                 search_rounds: int = 10):
+                 search_rounds: int = 1):
         check("linear_solver", linear_solver, linear_solver in LINEAR_SOLVERS,
               f"use one of {', '.join(LINEAR_SOLVERS)}")
         check("search_rounds", search_rounds,
@@ -298,16 +301,18 @@ class SteadySolver:
     def solve_searched(self) -> SolveReport:
         """:meth:`solve`, repeated from its result while a search of the contact couplings at
         the converged state changes their pairing (up to ``search_rounds`` solves): the state
-        returned is an equilibrium of its own pairing, a fixed point of the search. Mortar
-        contact, whose geometry is held within a solve, needs it wherever the bodies slide
-        between solves (the block on a slab slides 2 cm between continuation steps);
-        node-to-segment contact recomputes its projections within the solve.
-        :func:`continuation` solves so.
+        returned is an equilibrium of its own pairing, a fixed point of the search
+        (:func:`fenicsfriction.contact.solve_with_search` for any solver). Mortar contact,
+        whose geometry is held within a solve, needs it wherever the bodies slide between
+        solves (the block on a slab slides 2 cm between continuation steps); node-to-segment
+        contact recomputes its projections within the solve. :func:`continuation` solves so.
 
         Raises:
             SolveError: a solve failed (``u`` is the last converged round's, or the start), or
                 the pairing still changed after ``search_rounds`` solves.
         """
+        if self.search_rounds == 1:
+            return self.solve()
         t0 = time.perf_counter()
         iterations = 0
         for rounds in range(1, self.search_rounds + 1):

@@ -109,7 +109,8 @@ def test_mortar_slab_steady_state_on_two_ranks_is_the_serial_one():
     for comm, prefix in ((MPI.COMM_WORLD, "mortar_world_"), (MPI.COMM_SELF, "mortar_self_")):
         model = scene.build(comm, with_friction=True)
         model.initial_guess()
-        steady = ff.SteadySolver(model.residual, prefix=prefix, options=model.solver_options())
+        steady = ff.SteadySolver(model.residual, prefix=prefix, options=model.solver_options(),
+                                 search_rounds=model.search_rounds)
         records = model.slide_to(0.3, steady, step=0.1)
         d = model.nodal_contact()[0]
         x = model.V.tabulate_dof_coordinates()[model._contact_y // 2, 0]

@@ -91,6 +91,10 @@ class SlabModel(BlockModel):
 
     CONTACT = CONTACT
     scene: BlockOnSlab
+    #: the steady solves are repeated until the contact search holds: the block slides along
+    #: the slab between continuation steps (μW/K_x, 2 cm per 0.05), and mortar contact holds
+    #: its geometry within a solve (:meth:`fenicsfriction.steady.SteadySolver.solve_searched`)
+    search_rounds = 10
 
     def __init__(self, scene: BlockOnSlab, comm: MPI.Comm, with_friction: bool | None):
         laws.check("g", scene.law.g, scene.law.g == 0,
