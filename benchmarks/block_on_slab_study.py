@@ -46,7 +46,8 @@ def onset(scene, mu_step: float, mu_max: float, tol: float, prefix: str) -> dict
     t0 = time.perf_counter()
     model = scene.build(MPI.COMM_SELF, with_friction=True)
     model.initial_guess()
-    steady = ff.SteadySolver(model.residual, prefix=prefix, options=model.solver_options())
+    steady = ff.SteadySolver(model.residual, prefix=prefix, options=model.solver_options(),
+                             search_rounds=model.search_rounds)
     pep = StabilitySolver(model.residual, prefix=prefix + "pep_")
     loci = Loci(steady, pep, model.mu, MAX_MODULUS)
     grid = np.arange(0.0, mu_max + 0.5 * mu_step, mu_step)

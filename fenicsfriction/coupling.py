@@ -72,8 +72,9 @@ class Coupling(typing.Protocol):
 
     def search(self) -> bool:
         """Look again, at the current state, for which points the coupling joins (a contact's
-        pairing, a mortar contact's geometry); True if that changed. The steady solver
-        repeats its solve until a search at the converged state returns False."""
+        pairing, a mortar contact's geometry); True if that changed.
+        :meth:`~fenicsfriction.steady.SteadySolver.solve_searched` repeats its solve until a
+        search at the converged state returns False."""
 
     def operator(self, derivatives: dict[fem.Function, typing.Any],
                  rest: typing.Sequence[fem.Function] = (),

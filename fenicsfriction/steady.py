@@ -153,8 +153,11 @@ class SteadySolver:
             in the PETSc options (``-<prefix>pc_type lu``) overrides it. Where the Jacobian
             splits, the first two assemble the constant bulk once and only the interface at
             each iteration (docs/benchmarks.md has what each costs).
-        search_rounds: how many Newton solves :meth:`solve` may run until a search of the
-            contact couplings at the converged state keeps their pairing.
+        search_rounds: how many Newton solves :meth:`solve_searched` (each step of
+            :func:`continuation`) may run until a search of the contact couplings at the
+            converged state keeps their pairing; 1 (default): one solve, no search after it.
+            Mortar contact, whose geometry is held within a solve, needs more wherever the
+            bodies slide between solves (10 for the block on a slab).
 
     Attributes:
         snes: the PETSc SNES, exposed for monitoring or further configuration.
@@ -167,7 +170,7 @@ class SteadySolver:
     def __init__(self, residual: Residual, prefix: str = "steady_",
                  options: dict | None = None, jit_cache_dir: str | None = None,
                  roundoff_safety: float = 1.0, linear_solver: str = "auto",
-                 search_rounds: int = 10):
+                 search_rounds: int = 1):
         check("linear_solver", linear_solver, linear_solver in LINEAR_SOLVERS,
               f"use one of {', '.join(LINEAR_SOLVERS)}")
         check("search_rounds", search_rounds,
@@ -281,47 +284,55 @@ class SteadySolver:
         self.convergence.jacobian_assembled(A)
 
     def solve(self) -> SolveReport:
-        """Solve from the current ``u``; on failure restore ``u`` and raise :class:`SolveError`.
+        """Solve from the current ``u``, the contact couplings' pairing searched at the first
+        residual; on failure restore ``u`` and raise :class:`SolveError`."""
+        saved = _compat.petsc_vec(self.u).copy()
+        report = self._newton()
+        if not report.converged:
+            saved.copy(_compat.petsc_vec(self.u))
+            self.u.x.scatter_forward()
+        saved.destroy()
+        if not report.converged:
+            raise SolveError(
+                f"Newton did not converge ({report.reason}) after {report.iterations} "
+                f"iterations, residual norm {report.residual_norm:.3e}; state restored", report)
+        return report
 
-        With contact couplings, each Newton solve uses the pairing (the mortar geometry)
-        searched at its first residual; while a search at the converged state changes it, the
-        solve is repeated from there (up to ``search_rounds`` solves), so the state returned
-        is an equilibrium of its own pairing (a fixed point of the search). Mortar contact,
+    def solve_searched(self) -> SolveReport:
+        """:meth:`solve`, repeated from its result while a search of the contact couplings at
+        the converged state changes their pairing (up to ``search_rounds`` solves): the state
+        returned is an equilibrium of its own pairing, a fixed point of the search
+        (:func:`fenicsfriction.contact.solve_with_search` for any solver). Mortar contact,
         whose geometry is held within a solve, needs it wherever the bodies slide between
-        solves; node-to-segment contact recomputes its projections within the solve.
+        solves (the block on a slab slides 2 cm between continuation steps); node-to-segment
+        contact recomputes its projections within the solve. :func:`continuation` solves so.
+
+        Raises:
+            SolveError: a solve failed (``u`` is the last converged round's, or the start), or
+                the pairing still changed after ``search_rounds`` solves.
         """
-        u_vec = _compat.petsc_vec(self.u)
-        saved = u_vec.copy()
+        if self.search_rounds == 1:
+            return self.solve()
         t0 = time.perf_counter()
         iterations = 0
-        try:
-            for rounds in range(1, self.search_rounds + 1):
-                report = self._newton()
-                iterations += report.iterations
-                report.iterations, report.rounds = iterations, rounds
-                report.wall_time_s = time.perf_counter() - t0
-                if not report.converged:
-                    raise SolveError(
-                        f"Newton did not converge ({report.reason}) after "
-                        f"{report.iterations} iterations, residual norm "
-                        f"{report.residual_norm:.3e}; state restored", report)
-                # every coupling searches (collectively), whether or not another changed
-                changed = [coupling.contact.search() for coupling in self.couplings]
-                if not any(changed):
-                    return report
-            raise SolveError(f"contact search: the pairing still changed after "
-                             f"{self.search_rounds} Newton solves (search_rounds); state "
-                             "restored", report)
-        except SolveError:
-            saved.copy(u_vec)
-            self.u.x.scatter_forward()
-            raise
-        finally:
-            saved.destroy()
+        for rounds in range(1, self.search_rounds + 1):
+            try:
+                report = self.solve()
+            except SolveError as err:
+                err.report.iterations += iterations
+                raise
+            iterations += report.iterations
+            report.iterations, report.rounds = iterations, rounds
+            report.wall_time_s = time.perf_counter() - t0
+            # every coupling searches (collectively), whether or not another changed
+            changed = [coupling.contact.search() for coupling in self.couplings]
+            if not any(changed):
+                return report
+        raise SolveError(f"contact search: the pairing still changed after "
+                         f"{self.search_rounds} Newton solves (search_rounds)", report)
 
     def _newton(self) -> SolveReport:
-        """One SNES solve from the current ``u``, the contact pairing searched at its first
-        residual; ``u`` takes the result if it converged."""
+        """One SNES solve from the current ``u``; ``u`` takes the result if it converged."""
         for coupling in self.couplings:
             coupling.contact.search_pending = True
         _compat.petsc_vec(self.u).copy(self.x)
@@ -347,7 +358,8 @@ def continuation(solver: SteadySolver, parameter: fem.Constant, targets: typing.
     """Step ``parameter`` through ``targets``, solving at each value.
 
     Args:
-        solver: the steady solver (its ``u`` is the warm start and holds the result).
+        solver: the steady solver (its ``u`` is the warm start and holds the result); a
+            :class:`SteadySolver` solves each step with :meth:`SteadySolver.solve_searched`.
         parameter: the ``fem.Constant`` being continued (e.g. the friction coefficient).
         targets: the values to reach, in order; each one reached produces one record.
         observe: returns extra quantities recorded at each converged target, a dict or a
@@ -368,6 +380,9 @@ def continuation(solver: SteadySolver, parameter: fem.Constant, targets: typing.
             ``parameter`` keep the last converged state, ``error.records`` the steps so far.
     """
     check("predictor", predictor, predictor in ("secant", "none"), "use 'secant' or 'none'")
+    # a SteadySolver's solves are repeated until the contact search holds; another solver
+    # (the Panagiotopoulos process) searches in its own iterations
+    solve = getattr(solver, "solve_searched", solver.solve)
     records: list[dict] = []
     current = float(parameter.value)
     u_vec = _compat.petsc_vec(solver.u)
@@ -388,7 +403,7 @@ def continuation(solver: SteadySolver, parameter: fem.Constant, targets: typing.
                     u_vec.axpy(1.0, converged)
                     solver.u.x.scatter_forward()
                 try:
-                    report = solver.solve()
+                    report = solve()
                 except SolveError as err:
                     iterations += err.report.iterations
                     parameter.value = current

@@ -36,7 +36,8 @@ def sliding(scene, mu: float, comm=COMM, prefix: str = "slab_"):
     """The built ``scene`` in steady sliding at ``mu`` (continuation in steps <= 0.1)."""
     model = scene.build(comm, with_friction=True)
     model.initial_guess()
-    steady = ff.SteadySolver(model.residual, prefix=prefix, options=model.solver_options())
+    steady = ff.SteadySolver(model.residual, prefix=prefix, options=model.solver_options(),
+                             search_rounds=model.search_rounds)
     records = model.slide_to(mu, steady, step=0.1)
     return model, steady, records
 

@@ -183,7 +183,8 @@ def _build(args: argparse.Namespace) -> tuple[BlockOnBelt, BlockModel, SteadySol
     output_folder(args.out)
     model = scene.build(MPI.COMM_WORLD, with_friction=args.mu_max > 0)
     model.initial_guess()
-    solver = SteadySolver(model.residual, prefix="steady_", options=model.solver_options())
+    solver = SteadySolver(model.residual, prefix="steady_", options=model.solver_options(),
+                          search_rounds=model.search_rounds)
     return scene, model, solver, np.linspace(0.0, args.mu_max, args.steps + 1)
 
 
@@ -380,7 +381,8 @@ def run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
     out = output_folder(args.out)
     model = scene.build(comm)
     model.initial_guess()
-    steady = SteadySolver(model.residual, prefix="steady_", options=model.solver_options())
+    steady = SteadySolver(model.residual, prefix="steady_", options=model.solver_options(),
+                          search_rounds=model.search_rounds)
     model.slide_to(args.mu, steady)
     model.perturb_normal_velocity(args.perturbation)
     dynamics: CentralDifference | DynamicsSolver

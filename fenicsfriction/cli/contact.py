@@ -179,12 +179,18 @@ def _percent(value: float, reference: float) -> str:
 def _write_fields(path: pathlib.Path, model: TwoBodyModel) -> None:
     """The displacement with the cell (body) and facet (surface) tags, for ParaView
     (collective)."""
-    from dolfinx import io
+    from dolfinx import fem, io
 
     from fenicsfriction import _compat
 
     geometry = model.geometry
     msh = geometry.mesh
+    u = model.u
+    if _compat.element_degree(u.function_space) != 1:
+        # XDMF holds fields of the mesh's coordinate degree (1): the quadratic displacement
+        # at the vertices
+        u = fem.Function(_compat.vector_function_space(msh, 1), name=model.u.name)
+        u.interpolate(model.u)
     msh.topology.create_connectivity(msh.topology.dim - 1, msh.topology.dim)
     geometry.cell_tags.name = "bodies"
     geometry.facet_tags.name = "surfaces"
@@ -192,7 +198,7 @@ def _write_fields(path: pathlib.Path, model: TwoBodyModel) -> None:
         xdmf.write_mesh(msh)
         _compat.write_meshtags(xdmf, geometry.cell_tags, msh)
         _compat.write_meshtags(xdmf, geometry.facet_tags, msh)
-        xdmf.write_function(model.u, 0.0)
+        xdmf.write_function(u, 0.0)
 
 
 def _surface_rows(values: typing.Any, columns: dict[str, np.ndarray], dim: int,

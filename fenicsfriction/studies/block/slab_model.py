@@ -91,6 +91,10 @@ class SlabModel(BlockModel):
 
     CONTACT = CONTACT
     scene: BlockOnSlab
+    #: the steady solves are repeated until the contact search holds: the block slides along
+    #: the slab between continuation steps (μW/K_x, 2 cm per 0.05), and mortar contact holds
+    #: its geometry within a solve (:meth:`fenicsfriction.steady.SteadySolver.solve_searched`)
+    search_rounds = 10
 
     def __init__(self, scene: BlockOnSlab, comm: MPI.Comm, with_friction: bool | None):
         laws.check("g", scene.law.g, scene.law.g == 0,
@@ -193,21 +197,13 @@ class SlabModel(BlockModel):
             return ufl.zero(2)
         return self.contact.traction
 
-    @property
-    def upward_normal(self) -> typing.Any:
-        """UFL: the contact's normal oriented from the slab into the block (+y when flat):
-        node-to-segment takes it out of the master body, mortar out of the slave body, and the
-        slab's top faces up."""
-        n = self.contact.normal
-        return ufl.sign(n[1]) * n
-
     def damping_pressure(self) -> typing.Any:
         """UFL normal damping pressure: the contact's normal traction less its elastic part."""
         return self.contact.pressure - self.pressure()
 
     def contact_traction(self) -> typing.Any:
         """UFL traction of the slab on the block (meaningful at the slave nodes only)."""
-        return self.contact.pressure * self.upward_normal + self.friction_traction()
+        return self.contact.pressure * self.contact.normal + self.friction_traction()
 
     def energy_forms(self) -> dict[str, ufl.Form]:
         """Kinetic and strain energies of the block and the slab together."""
@@ -229,8 +225,7 @@ class SlabModel(BlockModel):
         if c.traction is not None:
             forms["friction"] = ufl.inner(c.traction, jump) * c.ds
         if self.scene.law.b_n > 0:
-            forms["damping"] = self.damping_pressure() * ufl.inner(self.upward_normal, jump) \
-                * c.ds
+            forms["damping"] = self.damping_pressure() * ufl.inner(c.normal, jump) * c.ds
         return forms
 
     # --- nodal values ----------------------------------------------------------------------
@@ -245,10 +240,10 @@ class SlabModel(BlockModel):
     @functools.cached_property
     def _nodal_contact(self) -> typing.Callable[[], np.ndarray]:
         """The contact's penetration, the relative velocity w (belt included) along the
-        tangent t = (n_y, -n_x) of the upward normal n (+x on the flat slab) and the approach
-        rate -w·n, at the slave nodes (compiled once)."""
+        tangent t = (n_y, -n_x) of the contact normal n (out of the slab: +x on the flat slab)
+        and the approach rate -w·n, at the slave nodes (compiled once)."""
         c = self.contact
-        n, w = self.upward_normal, c.relative_velocity
+        n, w = c.normal, c.relative_velocity
         t = ufl.as_vector([n[1], -n[0]])
         return c.nodal_values([c.penetration, ufl.dot(w, t), -ufl.dot(w, n)])
 
