@@ -317,6 +317,8 @@ def main() -> int:
                        help="2D rungs (a/h) where mortar degree 2 runs (5,10,20)")
     flags.add_argument("--degree2-3d", default="5",
                        help="3D rungs (a/h) where mortar degree 2 runs (5)")
+    flags.add_argument("--configs", default="node-to-segment:1,mortar:1,mortar:2",
+                       help="formulation:degree pairs to run (all three)")
     flags.add_argument("--c-n", type=float, default=None,
                        help="the compliance c_n of every run (the scene's default, 1e4)")
     flags.add_argument("--repeats", type=int, default=3,
@@ -332,6 +334,8 @@ def main() -> int:
     numbers = lambda text: [int(v) for v in text.split(",") if v]  # noqa: E731
     ladders = {2: numbers(args.ladder_2d), 3: numbers(args.ladder_3d)}
     degree2 = {2: numbers(args.degree2_2d), 3: numbers(args.degree2_3d)}
+    configs = [(name, int(degree)) for name, degree in
+               (pair.split(":") for pair in args.configs.split(",") if pair)]
     runs: list[dict] = []
     failures: list[dict] = []
     for path in args.merge:  # earlier runs' results, tabulated with this run's
@@ -341,7 +345,7 @@ def main() -> int:
     json_path = args.out / "bench_hertz_formulations.json"
     for dim in numbers(args.dims):
         for a_over_h in ladders[dim][:args.levels]:
-            for formulation, degree in CONFIGS:
+            for formulation, degree in configs:
                 if degree == 2 and a_over_h not in degree2[dim]:
                     continue
                 row = run_mesh(dim, a_over_h, formulation, degree, args.repeats, comm,
