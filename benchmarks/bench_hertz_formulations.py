@@ -7,7 +7,8 @@ size at the contact h = a/5, a/10, a/20, a/40 in 2D (``--ladder-2d``) and a/5, a
 (``--ladder-3d``), set by the scene's ``h_contact`` (the far field, graded from it, is the
 same on every rung). Degree 2 in 3D runs at h = a/5 only by default (``--degree2-3d``): its
 surface node spacing is then that of degree 1 at a/10, and at a/10 it would have eight times
-the 100 000 unknowns of degree 1 there.
+the 100 000 unknowns of degree 1 there; even at a/5 (about 140 000 unknowns) it is the longest
+run (``--degree2-3d ""`` leaves it out; ``--configs mortar:2`` runs it alone).
 
 For each run it records:
 
@@ -41,8 +42,10 @@ For each run it records:
 
 Writes ``bench_hertz_formulations.json`` and ``.png`` (error against solve time, log-log, both
 formulations, 2D and 3D panels; error against unknowns) to ``--out``, prints markdown tables to
-stdout, progress to stderr. ``--dims 2 --levels 2`` takes about a minute; the full run about
-an hour on one core, most of it the 3D rungs at a/10 (about 100 000 unknowns each).
+stdout, progress to stderr. ``--dims 2 --levels 2`` takes about a minute; the 2D ladder about
+15 minutes and the 3D rungs of degree 1 about half an hour on one core, most of it at a/10
+(about 100 000 unknowns each). ``--merge`` tabulates and plots the JSON of separate runs
+together.
 """
 
 from __future__ import annotations
