@@ -88,6 +88,12 @@ class NodeToSegment:
         penalty_T: the tangential penalty κ_T [force/length³] (perturbed Lagrangian).
         time_step: the increment's duration, slip increment = velocity × time_step
             (perturbed Lagrangian; 1 with a quasi-static velocity (u - u_old)/1).
+        step_from: the displacement u_n at the start of a time step of the midpoint rule
+            (:class:`~fenicsfriction.dynamics.DynamicsSolver` with ``energy_consistent``),
+            ``u`` then holding the step's midpoint (u_n + u_{n+1})/2: the elastic pressure
+            becomes the discrete gradient of the compliance's potential between the two ends
+            (:meth:`_discrete_gradient`), so that the step's normal force does exactly the
+            work φ(d_{n+1}) − φ(d_n); ``None`` (default): the pressure at ``u``.
         search: when the pairing is searched again: ``"solve"`` (default) once at the start
             of each Newton solve or time step (:func:`solve_with_search` repeats a solve until
             its converged state keeps its pairing), ``"residual"`` at every residual
@@ -113,7 +119,7 @@ class NodeToSegment:
                  fields: typing.Sequence[fem.Function] = (), transport: typing.Any = None,
                  weight: float = 1.0, frozen: bool = False, search: str = "solve",
                  formulation: str = "compliance", penalty_T: Value | None = None,
-                 time_step: Value = 1.0):
+                 time_step: Value = 1.0, step_from: fem.Function | None = None):
         V = u.function_space
         msh = V.mesh
         dim = msh.geometry.dim
@@ -144,7 +150,9 @@ class NodeToSegment:
         owned = slave_nodes[slave_nodes < V.dofmap.index_map.size_local]
         self.pairing = Pairing(V, self.W, owned, facet_nodes(V, facet_tags, master))
         self.mirrors: dict[fem.Function, fem.Function] = {
-            f: fem.Function(self.W, name=f"master_{f.name}") for f in (u, *fields)}
+            f: fem.Function(self.W, name=f"master_{f.name}")
+            for f in (u, *fields, *([] if step_from is None else [step_from]))}
+        self.step_from = step_from
         self.ds = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags,
                               subdomain_id=slave, metadata=_compat.nodal_quadrature(dim - 1))
         self.searched = False
@@ -167,6 +175,10 @@ class NodeToSegment:
         self.relative_velocity = w
         approach = -ufl.dot(w, n) if w is not None else 0.0
         self.pressure = law.normal_traction(d, approach)
+        elastic = law.pressure(d)
+        if step_from is not None:  # the step's elastic pressure: φ's discrete gradient
+            elastic = self._discrete_gradient(X)
+            self.pressure = self.pressure - law.pressure(d) + elastic
         force = self.pressure * n
         self.traction = None
         if law.has_friction:
@@ -187,11 +199,47 @@ class NodeToSegment:
         self.potential = weight * law.c_n * d ** (law.m_n + 1) / (law.m_n + 1) * self.ds
         dissipated = 0.0 * d
         if w is not None:
-            damping = self.pressure - law.pressure(d)
+            damping = self.pressure - elastic
             dissipated = damping * approach
             if self.traction is not None:
                 dissipated = dissipated - ufl.dot(self.traction, w)
         self.dissipation = weight * dissipated * self.ds
+
+    def _discrete_gradient(self, X: typing.Any) -> typing.Any:
+        r"""The elastic pressure of a midpoint step from :math:`u_n` (``step_from``) to
+        :math:`u_{n+1} = 2u - u_n`: the discrete gradient of the potential
+        :math:`\phi(d) = c_n d^{m_n+1}/(m_n+1)` (Gonzalez 1996, "Time integration and
+        discrete Hamiltonian systems"; for contact, Laursen & Chawla 1997 and Armero &
+        Petőcz 1998),
+
+        .. math:: p = \frac{\phi(d(g_{n+1})) - \phi(d(g_n))}{g_n - g_{n+1}}
+                  \quad (\phi'(d(g_{n+1/2}))\ \text{when}\ g_{n+1} = g_n),
+
+        a quotient in the gap (:math:`d = (-g)_+`), both ends' gaps projected on the same
+        master facet (the step's pairing). Along the midpoint normal, whose
+        :math:`n\cdot(\Delta u_s - \sum_a N_a(\xi)\, \Delta u_a)` is the gradient of the
+        gap at the midpoint applied to the step, its work is
+        :math:`\phi(d_{n+1}) - \phi(d_n)` up to the change of that gradient across the step
+        (none where the master facet translates). A midpoint pressure misses it wherever a
+        node enters or leaves contact within the step (φ' is not smooth at d = 0)."""
+        assert self.step_from is not None
+        u, start = self.u, self.step_from
+        approaches = []  # -g at both ends: d = (-g)_+
+        for field, mirror in ((start, self.mirrors[start]),
+                              (2 * u - start, 2 * self.mirrors[u] - self.mirrors[start])):
+            x_master = [self._node(self.pairing.reference, a) + self._node(mirror, a)
+                        for a in range(self.dim)]
+            approaches.append(-project(X + field, x_master).gap)
+        a0, a1 = approaches
+        law = self.law
+        potential = lambda a: law.c_n * laws.penetration(a) ** (law.m_n + 1) / (law.m_n + 1)  # noqa: E731
+        jump = a1 - a0
+        # below the round-off of the gaps the quotient is 0/0: its limit instead
+        tiny = 1e-12 * ufl.max_value(ufl.max_value(abs(a0), abs(a1)), 1e-300)
+        moved = ufl.gt(abs(jump), tiny)
+        return ufl.conditional(moved, (potential(a1) - potential(a0))
+                               / ufl.conditional(moved, jump, 1.0),
+                               law.pressure(laws.penetration(0.5 * (a0 + a1))))
 
     @functools.cached_property
     def nodal_space(self) -> fem.FunctionSpace:

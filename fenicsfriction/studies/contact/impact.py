@@ -17,8 +17,10 @@ from __future__ import annotations
 
 import dataclasses
 import typing
+import warnings
 
 from mpi4py import MPI
+from petsc4py import PETSc
 
 import numpy as np
 import ufl
@@ -34,7 +36,13 @@ from fenicsfriction.studies.contact.validation import _Bodies
 
 __all__ = ["PressAndDrag"]
 
-SCHEMES = ("alpha2", "central")
+#: ``"energy"``: the energy-consistent midpoint rule (:class:`DynamicsSolver` with
+#: ``energy_consistent``); ``"alpha2"``: generalized-α at ``rho_infinity``; ``"central"``:
+#: explicit central differences
+SCHEMES = ("energy", "alpha2", "central")
+
+#: steps a contact period (:meth:`PressAndDrag.contact_period`) for the default step
+STEPS_PER_PERIOD = 4
 
 
 @dataclasses.dataclass
@@ -82,10 +90,32 @@ class PressAndDrag(_Bodies):
               "0 <= drag_start <= drag_end")
         check("t_end", self.t_end, self.t_end > 0, "must be > 0")
 
-    def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
+    def build(self, comm: MPI.Comm = MPI.COMM_WORLD, scheme: str = "energy") -> TwoBodyModel:
+        """The model the scheme integrates (``"energy"``: with the contacts' start of step)."""
         mesh = geometry.hertz_2d(comm, R=self.radius, h_contact=self.h_contact)
         return TwoBodyModel(mesh, self.materials, self.law, passes=self.passes,
-                            density=self.density)
+                            density=self.density, energy_consistent=scheme == "energy")
+
+    def contact_period(self, model: TwoBodyModel) -> float:
+        """2π/ω of the contact springs, ω² the bound of
+        :meth:`~fenicsfriction.contact.NodeToSegment.frequency_bound` on the row-sum lumped
+        mass (every slave node's spring c_n A_i between the lightest surface nodes; linear
+        compliance): the shortest period the contact can ring with."""
+        import dolfinx.fem.petsc
+        v = ufl.TestFunction(model.V)
+        ones = ufl.as_vector([1.0] * model.dim)
+        lumped = dolfinx.fem.petsc.assemble_vector(
+            _compat.form(self.density * ufl.inner(ones, v) * model.dx))
+        lumped.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        omega2 = sum(c.frequency_bound(lumped) for c in model.contacts)
+        lumped.destroy()
+        return float(2 * np.pi / np.sqrt(omega2))
+
+    def default_dt(self, model: TwoBodyModel) -> float:
+        """The step that resolves the contact period: :data:`STEPS_PER_PERIOD` steps a
+        :meth:`contact_period`, rounded down to a divisor of t_end."""
+        dt = self.contact_period(model) / STEPS_PER_PERIOD
+        return self.t_end / np.ceil(self.t_end / dt)
 
     def traction(self, t: float) -> np.ndarray:
         """The traction on the cylinder's top at time t: −P/(2R) normal, the drag between
@@ -95,21 +125,36 @@ class PressAndDrag(_Bodies):
         drag = self.q_ratio * self.law.mu * p if self.drag_start <= t < self.drag_end else 0.0
         return np.array([drag, -p])
 
-    def run(self, scheme: str = "alpha2", dt: float = 0.05, comm: MPI.Comm = MPI.COMM_WORLD,
-            model: TwoBodyModel | None = None,
+    def run(self, scheme: str = "energy", dt: float | None = None,
+            comm: MPI.Comm = MPI.COMM_WORLD, model: TwoBodyModel | None = None,
             on_step: typing.Callable[[dict], None] | None = None) -> tuple[list[dict], dict]:
         """Integrate; returns one record per step (time, energies, approach, slip) and a
-        summary (energy balance error, largest penetration, cut-backs, Newton iterations)."""
+        summary (energy balance error, largest penetration, cut-backs, Newton iterations).
+
+        ``dt=None``: :meth:`default_dt` (implicit schemes); a step that does not resolve the
+        contact springs' period is warned about in one line (:meth:`contact_period`)."""
         check("scheme", scheme, scheme in SCHEMES, f"one of {', '.join(SCHEMES)}")
-        model = model or self.build(comm)
+        model = model or self.build(comm, scheme)
+        check("model", "TwoBodyModel", (scheme == "energy") == hasattr(model, "u_start"),
+              "built for the scheme (PressAndDrag.build(comm, scheme))")
         assert self.load is not None
         energy = _EnergyBalance(model)
-        if scheme == "alpha2":
+        if scheme != "central":
+            period = self.contact_period(model)
+            if dt is None:
+                dt = self.default_dt(model)
+            elif dt > period / STEPS_PER_PERIOD:
+                warnings.warn(f"dt = {dt:g} does not resolve the contact springs' period "
+                              f"{period:.3g} (at most {period / STEPS_PER_PERIOD:.3g}: "
+                              f"{STEPS_PER_PERIOD} steps a period)", stacklevel=2)
+        if scheme in ("energy", "alpha2"):
             solver: typing.Any = DynamicsSolver(
                 model.residual, prefix="press_", atol=1e-10 * self.load,
-                options={"ts_alpha_radius": self.rho_infinity})
+                options={"ts_alpha_radius": self.rho_infinity},
+                energy_consistent=scheme == "energy")
         else:
             solver = CentralDifference(model.residual)
+            dt = self.t_end if dt is None else dt  # capped at the stable step
 
         def observe(t: float) -> dict:
             record = energy.record(t)  # with the load of the step that ends at t
@@ -122,7 +167,7 @@ class PressAndDrag(_Bodies):
         balance = np.array([r["balance"] for r in records])
         summary = {
             "scheme": scheme, "dt": dt, "steps": len(records) - 1, "dofs": model.dofs,
-            "energy_error": float(np.max(np.abs(balance - balance[0]))
+            "energy_balance_error": float(np.max(np.abs(balance - balance[0]))
                                   / max(abs(r["work"]) for r in records[1:])),
             "max_penetration": float(max(r["max_penetration"] for r in records)),
             "rejected_steps": int(sum(r["rejected_steps"] for r in records)),
@@ -133,10 +178,17 @@ class PressAndDrag(_Bodies):
 
 
 class _EnergyBalance:
-    """Energies of the two bodies and the work and dissipation integrated in time
-    (trapezoidal rule on the powers)."""
+    r"""Energies of the two bodies and the work and dissipation summed over the steps.
+
+    The work of the (stepwise constant) load over a step is exact, :math:`t\cdot(u_{n+1} -
+    u_n)`. The dissipation of a step: with the energy-consistent scheme its own,
+    :math:`\Delta t\, D(u_{n+1/2}, (u_{n+1} - u_n)/\Delta t)` at the state the step's
+    contact force was evaluated at (so the discrete balance closes to Newton's tolerance);
+    otherwise the trapezoidal rule on the end-of-step powers.
+    """
 
     def __init__(self, model: TwoBodyModel):
+        from dolfinx import fem
         self.model = model
         u, u_dot = model.u, model.residual.u_dot
         dx = model.dx
@@ -149,14 +201,13 @@ class _EnergyBalance:
             elastic = elastic + (mu * ufl.inner(eps, eps) + 0.5 * lmbda * ufl.tr(eps) ** 2) \
                 * dx(tag)
         forms["elastic"] = elastic
-        # the work of the (stepwise constant) load over a step, exact: t · (u_n - u_{n-1})
-        from dolfinx import fem
         self.u_previous = fem.Function(u.function_space)
         forms["work"] = ufl.inner(model.shear, u - self.u_previous) * model.ds(LOAD)
         self.forms = {k: _compat.form(f) for k, f in forms.items()}
         self.contact = [(_compat.form(c.potential),
                          _compat.form(c.dissipation) if c.relative_velocity is not None
                          else None) for c in model.contacts]
+        self.start: fem.Function | None = getattr(model, "u_start", None)
         self.last: tuple[float, float] | None = None  # t, dissipated power
         self.work = 0.0
         self.dissipated = 0.0
@@ -165,17 +216,40 @@ class _EnergyBalance:
         from dolfinx import fem
         return self.model.comm.allreduce(fem.assemble_scalar(form))
 
+    def _dissipation(self) -> float:
+        return sum(self._scalar(d) for _, d in self.contact if d is not None)
+
+    def _step_dissipation(self, dt: float) -> float:
+        """Δt D at the step's midpoint state (the fields put back afterwards)."""
+        assert self.start is not None
+        model = self.model
+        u, u_dot = model.u, model.residual.u_dot
+        end, velocity = u.x.array.copy(), u_dot.x.array.copy()
+        u.x.array[:] = 0.5 * (end + self.u_previous.x.array)
+        u_dot.x.array[:] = (end - self.u_previous.x.array) / dt
+        self.start.x.array[:] = self.u_previous.x.array
+        for contact in model.contacts:
+            contact.update(search=False)
+        dissipated = dt * self._dissipation()
+        u.x.array[:], u_dot.x.array[:] = end, velocity
+        self.start.x.array[:] = end  # the contact's pressure at u_{n+1} until the next step
+        for contact in model.contacts:
+            contact.update(search=False)
+        return dissipated
+
     def record(self, t: float) -> dict:
         for contact in self.model.contacts:  # the pairing the step was solved with
             contact.update(search=not contact.searched)
         values = {k: self._scalar(f) for k, f in self.forms.items()}
         stored = sum(self._scalar(p) for p, _ in self.contact)
-        dissipation = sum(self._scalar(d) for _, d in self.contact if d is not None)
         if self.last is not None:
             t0, d0 = self.last
             self.work += values["work"]
-            self.dissipated += 0.5 * (t - t0) * (d0 + dissipation)
-        self.last = (t, dissipation)
+            if self.start is not None:
+                self.dissipated += self._step_dissipation(t - t0)
+            else:
+                self.dissipated += 0.5 * (t - t0) * (d0 + self._dissipation())
+        self.last = (t, 0.0 if self.start is not None else self._dissipation())
         self.u_previous.x.array[:] = self.model.u.x.array
         penetration = self.model.comm.allreduce(
             -min(0.0, float(self.model.nodal_gap().min(initial=0.0))), op=MPI.MAX)
