@@ -16,6 +16,7 @@ order; generalized-α with ρ∞ = 1 adds no numerical dissipation).
 from __future__ import annotations
 
 import dataclasses
+import time
 import typing
 import warnings
 
@@ -26,7 +27,7 @@ import numpy as np
 import ufl
 
 from fenicsfriction import _compat, laws
-from fenicsfriction.dynamics import CentralDifference, DynamicsSolver
+from fenicsfriction.dynamics import CentralDifference, DynamicsError, DynamicsSolver
 from fenicsfriction.elasticity import lame
 from fenicsfriction.laws import check
 from fenicsfriction.studies.contact import closed_forms, geometry
@@ -42,7 +43,7 @@ __all__ = ["PressAndDrag"]
 SCHEMES = ("energy", "alpha2", "central")
 
 #: steps a contact period (:meth:`PressAndDrag.contact_period`) for the default step
-STEPS_PER_PERIOD = 4
+STEPS_PER_PERIOD = 8
 
 
 @dataclasses.dataclass
@@ -128,8 +129,11 @@ class PressAndDrag(_Bodies):
     def run(self, scheme: str = "energy", dt: float | None = None,
             comm: MPI.Comm = MPI.COMM_WORLD, model: TwoBodyModel | None = None,
             on_step: typing.Callable[[dict], None] | None = None) -> tuple[list[dict], dict]:
-        """Integrate; returns one record per step (time, energies, approach, slip) and a
-        summary (energy balance error, largest penetration, cut-backs, Newton iterations).
+        """Integrate; returns one record per step (time, energies, penetration) and a summary
+        (``energy_balance_error``: the largest drift of the balance over the largest work of
+        the loads; the largest penetration, cut-backs, Newton iterations, wall time;
+        ``failure``: None, or why the integration stopped at ``t_reached``, the records then
+        those of the steps done).
 
         ``dt=None``: :meth:`default_dt` (implicit schemes); a step that does not resolve the
         contact springs' period is warned about in one line (:meth:`contact_period`)."""
@@ -163,16 +167,28 @@ class PressAndDrag(_Bodies):
 
         # the drag switches within a step: set the load of the first step before it starts
         model.shear.value = self.traction(0.0)
-        records = solver.run(self.t_end, dt, observe=observe, on_step=on_step)
+        failure = None
+        clock = time.perf_counter()
+        try:
+            records = solver.run(self.t_end, dt, observe=observe, on_step=on_step)
+        except DynamicsError as err:  # the fields hold the last accepted state
+            records, failure = err.records, str(err)
         balance = np.array([r["balance"] for r in records])
+        work = max((abs(r["work"]) for r in records[1:]), default=0.0)
         summary = {
             "scheme": scheme, "dt": dt, "steps": len(records) - 1, "dofs": model.dofs,
-            "energy_balance_error": float(np.max(np.abs(balance - balance[0]))
-                                  / max(abs(r["work"]) for r in records[1:])),
-            "max_penetration": float(max(r["max_penetration"] for r in records)),
+            "t_reached": float(records[-1]["time"]) if records else 0.0,
+            "energy_balance_error": (float(np.max(np.abs(balance - balance[0])) / work)
+                                     if work > 0 else None),
+            "work": float(records[-1]["work"]) if records else 0.0,
+            "dissipated": float(records[-1]["dissipated"]) if records else 0.0,
+            "max_penetration": float(max((r["max_penetration"] for r in records),
+                                         default=0.0)),
             "rejected_steps": int(sum(r["rejected_steps"] for r in records)),
             "newton_iterations": int(sum(r["newton_iterations"] for r in records)),
+            "wall_time_s": time.perf_counter() - clock,
             "stable_dt": getattr(solver, "stable_dt", None),
+            "failure": failure,
         }
         return records, summary
 
