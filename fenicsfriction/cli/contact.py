@@ -18,6 +18,7 @@ import logging
 import pathlib
 import typing
 
+from fenicsfriction.cli import press_drag
 from fenicsfriction.cli.arguments import Parser, floats
 
 if typing.TYPE_CHECKING:
@@ -113,6 +114,7 @@ def add_parser(commands: typing.Any) -> None:
     cattaneo.add_argument("--penalty-T", dest="penalty_T", type=float,
                           help="tangential penalty of the perturbed Lagrangian "
                                "[force/length^3] (1e4)")
+    press_drag.add_parser(scenes)
 
 
 def _named_by_flag(message: str, args: argparse.Namespace) -> str:
@@ -366,7 +368,8 @@ def run_contact(args: argparse.Namespace, log: logging.Logger) -> int:
     """``contact hertz|patch|cattaneo``: the scene, its summary and its outputs."""
     from mpi4py import MPI
 
-    run = {"hertz": _run_hertz, "patch": _run_patch, "cattaneo": _run_cattaneo}[args.scene]
+    run = {"hertz": _run_hertz, "patch": _run_patch, "cattaneo": _run_cattaneo,
+           "press-drag": press_drag.run_press_drag}[args.scene]
     try:
         return run(args, log, MPI.COMM_WORLD)
     except ValueError as err:  # the scenes and meshes name their fields: name the flags
