@@ -6,8 +6,10 @@ one line (exit status 1). Serial and under ``mpirun -n 2``."""
 import csv
 import json
 import os
+import signal
 import subprocess
 import sys
+import time
 
 from mpi4py import MPI
 
@@ -75,3 +77,29 @@ def test_a_diverged_integration_writes_its_summary_and_exits_1(tmp_path):
     assert summary["failure"] is not None and 0 < summary["t_reached"] < 1.0
     last = [line for line in result.stderr.splitlines() if line.strip()][-1]
     assert last.startswith("fenicsfriction: press-drag: TS ")
+
+
+@pytest.mark.skipif(MPI.COMM_WORLD.size > 1,
+                    reason="starts its own interpreter; runs in the serial pass")
+def test_ctrl_c_keeps_every_step_and_exits_130(tmp_path):
+    """Ctrl-C in a long run (the default step, 8 a contact period: thousands of steps): the
+    rows so far, a summary saying where it stopped, one line, status 130."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_"))}
+    table = tmp_path / "energy.csv"
+    process = subprocess.Popen([sys.executable, "-m", "fenicsfriction", "contact", "press-drag",
+                                "--out", str(tmp_path)], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True, env=env)
+    start = time.monotonic()
+    rows = lambda: len(table.read_text().splitlines()) - 1 if table.exists() else 0  # noqa: E731
+    while rows() < 5 and process.poll() is None:
+        assert time.monotonic() - start < 300, "no rows written"
+        time.sleep(0.2)
+    assert process.poll() is None, process.communicate()
+    process.send_signal(signal.SIGINT)
+    _, err = process.communicate(timeout=120)
+    assert process.returncode == 130, err
+    assert "Traceback" not in err
+    assert "interrupted by SIGINT" in err.strip().splitlines()[-1]
+    summary = json.loads((tmp_path / "contact.json").read_text())
+    assert summary["interrupted"].startswith("interrupted by SIGINT")
+    assert summary["steps"] == rows() - 1 >= 4
