@@ -84,14 +84,31 @@ class _QuietArrayMetadata(logging.Filter):
 _QUIET_ARRAY_METADATA = _QuietArrayMetadata()
 
 
-def nodal_quadrature(facet_dim: int, simplex: bool = True) -> dict:
+def nodal_quadrature(facet_dim: int, simplex: bool = True, degree: int = 1) -> dict:
     """Integral metadata of the nodal (trapezoidal) rule on facets: the facet's vertices with
     equal weights. FFCx's ``"vertex"`` rule is for cell integrals only, so the points are given
     as a ``"custom"`` rule on the reference facet (an interval or a triangle; with
-    ``simplex=False`` in 3D, the unit square of a hexahedron's facet)."""
+    ``simplex=False`` in 3D, the unit square of a hexahedron's facet).
+
+    ``degree=2`` (simplices): the nodes of the quadratic facet, vertices and edge midpoints,
+    each weighted by the integral of its P1 hat on the facet split at the midpoints (an
+    interval into two, a triangle into four): 1/4, 1/4, 1/2 of the length; 1/12 of the area
+    per vertex, 1/4 per midpoint. Every weight is positive (the quadratic vertex functions
+    integrate to zero on a triangle), and the rule integrates each node's quadratic basis
+    function to that weight, its value at the other nodes being 0."""
     # UFL 2022 logs the notice, UFL 2024 warns it; neither call adds a filter twice
     logging.getLogger("UFL").addFilter(_QUIET_ARRAY_METADATA)
     warnings.filterwarnings("ignore", message=".*metadata value of type ndarray")
+    if degree == 2 and simplex:
+        vertices = np.vstack([np.zeros(facet_dim), np.eye(facet_dim)])
+        pairs = [(0, 1)] if facet_dim == 1 else [(0, 1), (1, 2), (2, 0)]
+        middles = np.array([(vertices[a] + vertices[b]) / 2 for a, b in pairs])
+        volume = 1.0 / math.factorial(facet_dim)
+        shares = (0.25, 0.5) if facet_dim == 1 else (1 / 12, 0.25)
+        return {"quadrature_rule": "custom", "quadrature_degree": 2,
+                "quadrature_points": np.vstack([vertices, middles]),
+                "quadrature_weights": np.concatenate([np.full(len(vertices), shares[0]),
+                                                      np.full(len(middles), shares[1])]) * volume}
     if simplex or facet_dim == 1:
         points = np.vstack([np.zeros(facet_dim), np.eye(facet_dim)])
         volume = 1.0 / math.factorial(facet_dim)

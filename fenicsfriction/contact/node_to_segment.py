@@ -106,6 +106,8 @@ class NodeToSegment:
         mirrors: the W Function of each V field (``mirrors[u]`` is ``Q u``).
         F, G: the slave- and master-side forms of the contact's virtual power.
         projection: the UFL projection (shape functions, normal, gap).
+        normal, gap, penetration: the projection's normal (out of the master body), its gap
+            and the penetration :math:`d = (-g)_+` (UFL, at the slave nodes).
         pressure, traction: the normal pressure and tangential traction (UFL) at slave nodes.
         potential, dissipation: the energy stored in the compliance
             :math:`\int c_n d^{m_n+1}/(m_n+1)` and the power dissipated by friction and normal
@@ -161,8 +163,9 @@ class NodeToSegment:
         x_master = [self._node(self.pairing.reference, a) + self._node(self.mirrors[u], a)
                     for a in range(dim)]
         self.projection: Projection = project(X + u, x_master)
-        n = self.projection.normal
-        d = laws.penetration(-self.projection.gap)
+        n = self.normal = self.projection.normal
+        self.gap = self.projection.gap
+        d = self.penetration = laws.penetration(-self.projection.gap)
         w = None
         if velocity is not None:
             unmirrored = set(ufl.algorithms.extract_coefficients(velocity)) - {u, *fields}
@@ -315,10 +318,14 @@ class NodeToSegment:
                  for a in range(self.dim)]
         return self.projection.interpolate(nodal)
 
+    def search(self) -> bool:
+        """Pair the slave nodes at the current ``u``; True if the pairing changed."""
+        return self.pairing.search(self.u)
+
     def update(self, search: bool = True) -> None:
         """Pair the slave nodes at the current ``u`` (unless frozen) and refresh the mirrors."""
         if search and not (self.frozen and self.searched):
-            self.pairing.search(self.u)
+            self.search()
             self.searched = True
             self.search_pending = False
         Q = self.pairing.Q
@@ -386,16 +393,19 @@ class ContactOperator:
         self.contact = contact
         compile_ = lambda form: None if form is None else _compat.form(form, jit_cache_dir)  # noqa: E731
         F, G = contact.F, contact.G
-        self.F, self.G = compile_(_substitute(F, at_rest)), compile_(_substitute(G, at_rest))
+        # a mortar contact has no slave-side form F: all of it acts through Q (= B)
+        self.F = None if F is None else compile_(_substitute(F, at_rest))
+        self.G = compile_(_substitute(G, at_rest))
         own = list(derivatives.items())
         mirrored = [(contact.mirrors[f], w) for f, w in derivatives.items()
                     if f in contact.mirrors]
         V, W = contact.V, contact.W
-        self.blocks = {key: compile_(_derivative(form, pairs, space, at_rest))
+        self.blocks = {key: compile_(None if form is None
+                                     else _derivative(form, pairs, space, at_rest))
                        for key, form, pairs, space in (
                            ("VV", F, own, V), ("VW", F, mirrored, W),
                            ("WV", G, own, V), ("WW", G, mirrored, W))}
-        self.b_F = dolfinx.fem.petsc.create_vector(self.F)
+        self.b_F = None if self.F is None else dolfinx.fem.petsc.create_vector(self.F)
         self.b_G = dolfinx.fem.petsc.create_vector(self.G)
         self.matrices = {key: dolfinx.fem.petsc.create_matrix(a)
                          for key, a in self.blocks.items() if a is not None}
@@ -409,9 +419,9 @@ class ContactOperator:
         contact.update(search=contact.search_pending or contact.search_every_residual
                        or not contact.searched)
         t0 = time.perf_counter()
-        for vector, form in ((self.b_F, self.F), (self.b_G, self.G)):
-            assemble_into(vector, form)
-        b.axpy(1.0, self.b_F)
+        if self.b_F is not None:
+            b.axpy(1.0, assemble_into(self.b_F, self.F))
+        assemble_into(self.b_G, self.G)
         Q = self.contact.pairing.Q
         assert Q is not None
         Q.multTransposeAdd(self.b_G, b, b)
@@ -500,7 +510,7 @@ def _constrained_rows(V: fem.FunctionSpace, bcs: typing.Sequence[fem.DirichletBC
     return np.unique(np.concatenate(rows)).astype(PETSc.IntType)
 
 
-def solve_with_search(solver: typing.Any, contacts: typing.Sequence[NodeToSegment],
+def solve_with_search(solver: typing.Any, contacts: typing.Sequence[typing.Any],
                       max_rounds: int = 10) -> typing.Any:
     """Newton solves with the pairing searched between them, until a converged state keeps
     the pairing it was solved with (a fixed point of the contact search).
@@ -508,7 +518,8 @@ def solve_with_search(solver: typing.Any, contacts: typing.Sequence[NodeToSegmen
     Args:
         solver: a solver whose ``solve()`` returns a report and searches the pairing at its
             first residual (``SteadySolver``).
-        contacts: the couplings of its residual.
+        contacts: the couplings of its residual (:class:`NodeToSegment`,
+            :class:`~fenicsfriction.contact.mortar.SegmentToSegment`: their ``search()``).
         max_rounds: how many solves may be tried.
 
     Returns:
@@ -522,7 +533,7 @@ def solve_with_search(solver: typing.Any, contacts: typing.Sequence[NodeToSegmen
     for rounds in range(1, max_rounds + 1):
         report = solver.solve()
         iterations += report.iterations
-        changed = [contact.pairing.search(contact.u) for contact in contacts]
+        changed = [contact.search() for contact in contacts]
         if not any(changed):
             report.iterations = iterations
             report.rounds = rounds
