@@ -73,7 +73,11 @@ from scipy.spatial import cKDTree
 
 from fenicsfriction import _compat, laws
 from fenicsfriction.assembly import assemble_owned
-from fenicsfriction.contact.node_to_segment import ContactOperator, NodalValues
+from fenicsfriction.contact.node_to_segment import (
+    ContactOperator,
+    NodalValues,
+    discrete_gradient,
+)
 
 __all__ = ["MortarIntegrals", "SegmentToSegment", "surface_facets"]
 
@@ -581,6 +585,13 @@ class SegmentToSegment:
         frozen: keep the geometry of the first search (derivative tests).
         search: ``"solve"`` (default: the geometry searched at the start of each Newton solve
             or time step) or ``"residual"`` (at every residual evaluation).
+        step_from: the displacement u_n at the start of a midpoint step, ``u`` the step's
+            midpoint (:class:`~fenicsfriction.dynamics.DynamicsSolver` with
+            ``energy_consistent``): the elastic pressure becomes the discrete gradient of the
+            potential between the approaches :math:`n_j\cdot G_j` of the two ends
+            (:func:`~fenicsfriction.contact.node_to_segment.discrete_gradient`). ``G`` being
+            affine in u between searches, its work over the step is exactly the potential's
+            change. ``None`` (default): the pressure at ``u``.
         enforcement, formulation, penalty_T, time_step: node-to-segment's choice of the
             perturbed Lagrangian (``formulation`` its former name) is refused here: only
             ``"compliance"`` and no ``penalty_T``; ``time_step`` is accepted and unused, as
@@ -606,7 +617,8 @@ class SegmentToSegment:
                  fields: typing.Sequence[fem.Function] = (), transport: typing.Any = None,
                  weight: float = 1.0, frozen: bool = False, search: str = "solve",
                  enforcement: str = "compliance", formulation: str | None = None,
-                 penalty_T: Value | None = None, time_step: Value = 1.0):
+                 penalty_T: Value | None = None, time_step: Value = 1.0,
+                 step_from: fem.Function | None = None):
         V = u.function_space
         msh = V.mesh
         dim = msh.geometry.dim
@@ -635,7 +647,9 @@ class SegmentToSegment:
         self.pairing = MortarIntegrals(V, surface_facets(V, facet_tags, slave),
                                        surface_facets(V, facet_tags, master))
         self.mirrors: dict[fem.Function, fem.Function] = {
-            f: fem.Function(V, name=f"mortar_{f.name}") for f in (u, *fields)}
+            f: fem.Function(V, name=f"mortar_{f.name}")
+            for f in (u, *fields, *([] if step_from is None else [step_from]))}
+        self.step_from = step_from
         self.ds = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags, subdomain_id=slave,
                               metadata=_compat.nodal_quadrature(dim - 1, degree=degree))
         n = self.normal = self.pairing.normal
@@ -663,7 +677,7 @@ class SegmentToSegment:
                           * self.ds)
         dissipated = 0.0 * d
         if w is not None:
-            dissipated = (self.pressure - law.pressure(d)) * ufl.dot(n, w)
+            dissipated = (self.pressure - self._elastic) * ufl.dot(n, w)
             if self.traction is not None:
                 dissipated = dissipated - ufl.dot(self.traction, w)
         self.dissipation = weight * covered * dissipated * self.ds
@@ -674,6 +688,13 @@ class SegmentToSegment:
         ``traction``."""
         approach = ufl.dot(n, w) if w is not None else 0.0
         self.pressure = self.law.normal_traction(d, approach)
+        self._elastic = self.law.pressure(d)
+        if self.step_from is not None:  # the step's elastic pressure: φ's discrete gradient
+            start = self.mirrors[self.step_from]
+            G = self.pairing.reference
+            self._elastic = discrete_gradient(
+                self.law, ufl.dot(n, G + start), ufl.dot(n, G + 2 * self.mirrors[self.u] - start))
+            self.pressure = self.pressure - self.law.pressure(d) + self._elastic
         force = -self.pressure * n
         self.traction = None
         if self.law.has_friction:

@@ -50,7 +50,7 @@ from fenicsfriction.contact.kinematics import Projection, project
 from fenicsfriction.contact.pairing import Pairing, facet_nodes
 
 __all__ = ["FORMULATIONS", "ContactOperator", "NodalValues", "NodeToSegment",
-           "solve_with_search"]
+           "discrete_gradient", "solve_with_search"]
 
 #: the contact laws: ``"compliance"`` (normal compliance, friction regularised on the slip
 #: rate: Martins & Oden 1986) and ``"perturbed-lagrangian"`` (Pop, eq. 27: normal and
@@ -233,16 +233,7 @@ class NodeToSegment:
             x_master = [self._node(self.pairing.reference, a) + self._node(mirror, a)
                         for a in range(self.dim)]
             approaches.append(-project(X + field, x_master).gap)
-        a0, a1 = approaches
-        law = self.law
-        potential = lambda a: law.c_n * laws.penetration(a) ** (law.m_n + 1) / (law.m_n + 1)  # noqa: E731
-        jump = a1 - a0
-        # below the round-off of the gaps the quotient is 0/0: its limit instead
-        tiny = 1e-12 * ufl.max_value(ufl.max_value(abs(a0), abs(a1)), 1e-300)
-        moved = ufl.gt(abs(jump), tiny)
-        return ufl.conditional(moved, (potential(a1) - potential(a0))
-                               / ufl.conditional(moved, jump, 1.0),
-                               law.pressure(laws.penetration(0.5 * (a0 + a1))))
+        return discrete_gradient(self.law, *approaches)
 
     @functools.cached_property
     def nodal_space(self) -> fem.FunctionSpace:
@@ -352,6 +343,25 @@ class NodeToSegment:
             if f in self.mirrors:
                 at_rest[self.mirrors[f]] = ufl.zero(*self.mirrors[f].ufl_shape)
         return ContactOperator(self, derivatives, at_rest, jit_cache_dir)
+
+
+def discrete_gradient(law: laws.InterfaceLaw, start: typing.Any, end: typing.Any) -> typing.Any:
+    r"""The elastic pressure of a step whose approach :math:`a = -g` (penetration
+    :math:`d = a_+`) goes from ``start`` to ``end``: the discrete gradient (Gonzalez 1996) of
+    the compliance's potential :math:`\phi(d) = c_n d^{m_n+1}/(m_n+1)`,
+
+    .. math:: p = \frac{\phi(a_{n+1}^+) - \phi(a_n^+)}{a_{n+1} - a_n}
+              \quad (c_n ((a_n + a_{n+1})/2)_+^{m_n}\ \text{when}\ a_{n+1} = a_n),
+
+    whose work on the approach's change is exactly the potential's (UFL)."""
+    potential = lambda a: law.c_n * laws.penetration(a) ** (law.m_n + 1) / (law.m_n + 1)  # noqa: E731
+    jump = end - start
+    # below the round-off of the approaches the quotient is 0/0: its limit instead
+    moved = ufl.gt(abs(jump), 1e-12 * ufl.max_value(ufl.max_value(abs(start), abs(end)),
+                                                    1e-300))
+    return ufl.conditional(moved, (potential(end) - potential(start))
+                           / ufl.conditional(moved, jump, 1.0),
+                           law.pressure(laws.penetration(0.5 * (start + end))))
 
 
 def _derivative(form: ufl.Form, pairs: list[tuple[fem.Function, Value]],
