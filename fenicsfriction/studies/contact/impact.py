@@ -279,14 +279,13 @@ class _EnergyBalance:
             contact.update(search=not contact.searched)
         values = {k: self._scalar(f) for k, f in self.forms.items()}
         stored = sum(self._scalar(p) for p, _ in self.contact)
+        power = 0.0 if self.start is not None else self._dissipation()
         if self.last is not None:
-            t0, d0 = self.last
+            t0, power0 = self.last
             self.work += values["work"]
-            if self.start is not None:
-                self.dissipated += self._step_dissipation(t - t0)
-            else:
-                self.dissipated += 0.5 * (t - t0) * (d0 + self._dissipation())
-        self.last = (t, 0.0 if self.start is not None else self._dissipation())
+            self.dissipated += (self._step_dissipation(t - t0) if self.start is not None
+                                else 0.5 * (t - t0) * (power0 + power))
+        self.last = (t, power)
         self.u_previous.x.array[:] = self.model.u.x.array
         penetration = self.model.comm.allreduce(
             -min(0.0, float(self.model.nodal_gap().min(initial=0.0))), op=MPI.MAX)
