@@ -124,7 +124,7 @@ class PressAndDrag(_Bodies):
         """The step that resolves the contact period: :data:`STEPS_PER_PERIOD` steps a
         :meth:`contact_period`, rounded down to a divisor of t_end."""
         dt = self.contact_period(model) / STEPS_PER_PERIOD
-        return self.t_end / np.ceil(self.t_end / dt)
+        return float(self.t_end / np.ceil(self.t_end / dt))
 
     def unresolved(self, model: TwoBodyModel, dt: float) -> str | None:
         """The one-line warning that ``dt`` does not resolve the contact period (more than
