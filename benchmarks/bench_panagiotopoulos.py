@@ -3,11 +3,13 @@
 Four studies (Kalker 1986, sections 3-4 and eq. 27):
 
 * **block** — steady sliding of the block on the belt (Martins & Oden 1986's data, Q2,
-  ``--refine``), μ from 0 to just below the discrete tipping limit: for each method
-  (:class:`fenicsfriction.panagiotopoulos.PanagiotopoulosSolver`, every solve from the same
-  initial guess) the outer and Newton iterations, the wall time (median of ``--repeats``), the
-  contraction factor of the process (geometric mean of its change ratios) and the error of
-  the contact penetrations against Newton's (max over the nodes, relative to the largest);
+  ``--refine``; ``--scene block-on-slab``: Q1 on an elastic slab, the friction bound then in
+  the two-body contact coupling's forms), μ from 0 to just below the discrete tipping limit:
+  for each method (:class:`fenicsfriction.panagiotopoulos.PanagiotopoulosSolver`, every solve
+  from the same initial guess) the outer and Newton iterations, the wall time (median of
+  ``--repeats``), the contraction factor of the process (geometric mean of its change ratios)
+  and the error of the contact penetrations against Newton's (max over the nodes, relative
+  to the largest);
 * **layered** — the same block on a soft layer (E/1000, ν = 0 or 0.25; spring at H/12, so
   the tipping limit is 9.6): the μ where the process stops converging (bisection to
   ``--mu-tol`` with at most 200 outer iterations), against 1/β, β = (1 - 2ν)/(2(1 - ν)) the
@@ -39,6 +41,7 @@ from _common import save
 import fenicsfriction as ff
 from fenicsfriction.panagiotopoulos import PanagiotopoulosSolver, ProcessError
 from fenicsfriction.studies.block import LayeredBlockOnBelt
+from fenicsfriction.studies.block.slab import SCENES
 from fenicsfriction.studies.contact import closed_forms
 from fenicsfriction.studies.contact.validation import Cattaneo
 
@@ -69,8 +72,8 @@ def _contraction(changes: list[float]) -> float | None:
     return float(np.exp(np.mean(np.diff(np.log(c))))) if len(c) > 2 else None
 
 
-def block_study(comm: MPI.Comm, refine: int, repeats: int) -> dict:
-    scene = ff.BlockOnBelt(refine=refine)
+def block_study(comm: MPI.Comm, refine: int, repeats: int, scene_name: str = "block") -> dict:
+    scene = SCENES[scene_name](refine=refine)
     model = scene.build(comm, with_friction=True)
     solvers = {m: PanagiotopoulosSolver(model.residual, method=m, prefix=f"bench_{m}_",
                                         options=model.solver_options(),
@@ -95,7 +98,8 @@ def block_study(comm: MPI.Comm, refine: int, repeats: int) -> dict:
         rows.append(row)
         log.info("block mu %.3f: %s", mu, {m: (row[m]["outer"], row[m]["newton"])
                                            for m in METHODS})
-    return {"refine": refine, "dofs": model.V.dofmap.index_map.size_global * 2,
+    return {"scene": scene_name, "refine": refine,
+            "dofs": model.V.dofmap.index_map.size_global * 2,
             "tipping_limit": scene.tipping_limit, "discrete_tipping_limit": limit,
             "rows": rows}
 
@@ -211,7 +215,7 @@ def plot(block: dict, layered: list[dict], path, dpi: int) -> None:
     axes[0, 0].plot(mu, [r["panagiotopoulos"]["outer"] for r in block["rows"]], "kx-",
                     label="process: outer iterations")
     axes[0, 0].set(xlabel="μ", ylabel="iterations",
-                   title=f"Block on belt (tipping limit {block['discrete_tipping_limit']:.3f})")
+                   title=f"{block['scene']} (tipping limit {block['discrete_tipping_limit']:.3f})")
     axes[0, 0].legend(fontsize=7)
     axes[0, 1].set(xlabel="μ", ylabel="wall time [s]", title="Wall time per solve")
     axes[0, 1].legend(fontsize=7)
@@ -236,6 +240,8 @@ def plot(block: dict, layered: list[dict], path, dpi: int) -> None:
 def main() -> int:
     flags = benchmark_parser(__doc__)
     flags.add_argument("--refine", type=int, default=2, help="block mesh refinement (2)")
+    flags.add_argument("--scene", choices=tuple(SCENES), default="block",
+                       help="the block study's scene (block: on the rigid belt)")
     flags.add_argument("--repeats", type=int, default=3, help="timed runs per solve (3)")
     flags.add_argument("--mu-tol", type=float, default=0.02,
                        help="bisection tolerance of the process's limit (0.02)")
@@ -248,7 +254,7 @@ def main() -> int:
     logging.getLogger("ffcx").setLevel(logging.WARNING)
     logging.basicConfig(level=logging.INFO, stream=sys.stderr,
                         format="%(name)s: %(message)s")
-    block = block_study(comm, args.refine, args.repeats)
+    block = block_study(comm, args.refine, args.repeats, args.scene)
     layered = [layered_study(comm, nu, args.mu_tol) for nu in (0.0, 0.25)]
     de_pater = de_pater_study(comm, args.h_contact)
     mollified = mollified_study(comm, [int(v) for v in args.refine_mollified.split(",") if v])

@@ -6,7 +6,9 @@ compiles every coupling once, for the derivatives it needs (:meth:`Coupling.oper
 adds the compiled operators' residual and Jacobian to those of the integrals
 (:func:`fenicsfriction.assembly.assemble_residual`,
 :class:`fenicsfriction.assembly.CoupledMatrix`). Both interfaces are structural: a new
-coupling needs only these members, no base class.
+coupling needs only these members, no base class. A coupling with friction may also offer
+:class:`FrictionBoundCoupling`, through which the Panagiotopoulos process
+(:mod:`fenicsfriction.panagiotopoulos`) fixes its friction bound.
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ if typing.TYPE_CHECKING:
 
     from dolfinx import fem
 
-__all__ = ["Coupling", "CouplingOperator"]
+__all__ = ["Coupling", "CouplingOperator", "FrictionBoundCoupling"]
 
 
 @typing.runtime_checkable
@@ -84,3 +86,38 @@ class Coupling(typing.Protocol):
         """An upper bound of the coupling's contribution to ω² on the lumped mass, whatever
         the state (:class:`~fenicsfriction.dynamics.CentralDifference`, when it is built, for
         springs that close after the initial state)."""
+
+
+@typing.runtime_checkable
+class FrictionBoundCoupling(Coupling, typing.Protocol):
+    """A coupling whose friction bound :math:`c_T d^{m_T}` a solver can replace: what the
+    Panagiotopoulos process (:class:`fenicsfriction.panagiotopoulos.PanagiotopoulosSolver`)
+    asks of ``Residual.couplings``.
+
+    The process evaluates the bound at a frozen state by ``ufl.replace``-ing each Function of
+    :attr:`configuration` in :meth:`friction_bound` by a copy of it taken after a solve, and
+    solves the next time with the coupling :meth:`with_friction_bound` returns.
+    :class:`~fenicsfriction.contact.NodeToSegment` is one; its ``friction_bound`` and
+    ``with_friction_bound`` read and rebuild any coupling's forms ``F`` and ``G``.
+    """
+
+    @property
+    def configuration(self) -> list[fem.Function]:
+        """The Functions the coupling's geometry at its integration points is made of (the
+        displacement and whatever the coupling derives from it and its pairing, e.g. the
+        master's displacement and reference coordinates at the slave points). Copies of
+        their values give the bound at the state of the copy, whatever the pairing later."""
+
+    def friction_bound(self) -> typing.Any:
+        """The friction bound of the coupling's law at its integration points (a UFL scalar,
+        the expression labelled :data:`fenicsfriction.laws.FRICTION_BOUND` in its forms), or
+        ``None`` if it has none."""
+
+    def with_friction_bound(self, bound: typing.Any) -> FrictionBoundCoupling:
+        """The same coupling with the UFL scalar ``bound`` in place of its friction bound,
+        sharing this one's pairing (one search serves both)."""
+
+    def search(self) -> bool:
+        """Pair the surfaces at the current displacement; True if the pairing changed (the
+        process goes on when a state it converged to no longer has the pairing it was
+        solved with)."""

@@ -30,6 +30,9 @@ import typing
 
 import numpy as np
 import ufl
+from ufl.algorithms.map_integrands import map_integrand_dags
+from ufl.corealg.multifunction import MultiFunction
+from ufl.corealg.traversal import unique_pre_traversal
 from ufl.variable import Label
 
 __all__ = [
@@ -53,6 +56,7 @@ __all__ = [
     "check",
     "exp",
     "friction_bound",
+    "friction_bounds",
     "friction_traction",
     "is_speed_law",
     "maximum",
@@ -62,6 +66,7 @@ __all__ = [
     "normal_traction",
     "penetration",
     "sqrt",
+    "substitute_friction_bound",
 ]
 
 Scalar: typing.TypeAlias = typing.Any  # a float, a NumPy array or a UFL expression
@@ -141,6 +146,45 @@ nothing in the forms or their derivatives but lets a solver find it in a residua
 evaluate it elsewhere: :mod:`fenicsfriction.panagiotopoulos` freezes it at the last iterate
 (Kalker 1986, section 3) or replaces it by its mollification (Kalker 1986, eq. 27).
 """
+
+
+def _is_bound(o: typing.Any) -> bool:
+    return isinstance(o, ufl.classes.Variable) and o.ufl_operands[1] == FRICTION_BOUND
+
+
+class _BoundSubstitution(MultiFunction):
+    """Maps each labelled friction bound to ``replacement(bound expression)``."""
+
+    def __init__(self, replacement: typing.Callable[[typing.Any], typing.Any]):
+        super().__init__()
+        self.replacement = replacement
+
+    expr = MultiFunction.reuse_if_untouched
+
+    def variable(self, o: typing.Any, expression: typing.Any, label: typing.Any) -> typing.Any:
+        if _is_bound(o):
+            return self.replacement(o.ufl_operands[0])
+        return self.reuse_if_untouched(o, expression, label)
+
+
+def substitute_friction_bound(form: ufl.Form,
+                              replacement: typing.Callable[[typing.Any], typing.Any]
+                              ) -> ufl.Form:
+    """``form`` with every friction bound :math:`c_T d^{m_T}` (labelled
+    :data:`FRICTION_BOUND`) replaced by ``replacement(bound)``, e.g. the bound at a frozen
+    state, ``lambda g: ufl.replace(g, {u: u_N})``."""
+    return map_integrand_dags(_BoundSubstitution(replacement), form)
+
+
+def friction_bounds(form: ufl.Form) -> list[typing.Any]:
+    """The distinct friction bound expressions of ``form`` (labelled by
+    :func:`friction_traction`), in order of appearance."""
+    found: list = []
+    for integral in form.integrals():
+        for o in unique_pre_traversal(integral.integrand()):
+            if _is_bound(o) and o.ufl_operands[0] not in found:
+                found.append(o.ufl_operands[0])
+    return found
 
 
 # --- regularisations of |w| (Pop, eq. 15; Kalker 1986, eq. 40) -----------------------------------

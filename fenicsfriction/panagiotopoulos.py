@@ -18,7 +18,12 @@ with :data:`fenicsfriction.laws.FRICTION_BOUND`). The process replaces that labe
 expression, wherever it occurs in :attr:`Residual.form`, by the same expression evaluated at a
 frozen copy :math:`u_N` of the state (``bound_state``), or by its mollification
 (:mod:`fenicsfriction.mollification`); everything else — elasticity, normal compliance, the
-loads — stays at the current u. Each outer iteration is one Newton solve
+loads — stays at the current u. A two-body contact coupling
+(:class:`~fenicsfriction.coupling.FrictionBoundCoupling`) has its forms compiled apart: it
+hands over its bound and the Functions its geometry is made of (``configuration``: u, the
+master's mirror, the pairing's reference coordinates), and is rebuilt with the bound evaluated
+at their frozen copies, so that a later search of the pairing leaves the frozen bound where
+it was. Each outer iteration is one Newton solve
 (:class:`~fenicsfriction.steady.SteadySolver`) of that frozen residual, which is Kalker's two
 half-steps fused: the tangential traction follows the law with the bound of the last iterate
 (the tangential problem with :math:`p_n^{(I)}` fixed) while the normal state responds to it
@@ -30,7 +35,9 @@ the second.
 solved with and with the bound of the new state: the relative change of these nodal friction
 forces, :math:`\|f^{(I+1)} - f^{(I)}\| / \|f^{(I+1)}\|`, is the change of the tangential
 traction, and also exactly the coupled residual of the new state relative to its friction
-forces (the two residuals differ only by that term). The process stops when it is below
+forces (the two residuals differ only by that term). A coupling's friction is not an
+integral of its own: its nodal forces are its residual less its residual with the friction
+switched off. The process stops when it is below
 ``rtol``; it gives up (:class:`ProcessError`, the last iterate kept in ``u``) when an inner
 solve fails, when the change has not reached a new minimum for ``patience`` iterations
 (divergence or a cycle), or after ``max_iterations``.
@@ -44,18 +51,15 @@ import typing
 
 from petsc4py import PETSc
 
-import dolfinx.fem.petsc
 import numpy as np
 import ufl
 from dolfinx import fem
-from ufl.algorithms.map_integrands import map_integrand_dags
-from ufl.corealg.multifunction import MultiFunction
-from ufl.corealg.traversal import unique_pre_traversal
 
 from fenicsfriction import _compat
 from fenicsfriction.assembly import assemble_into, assemble_owned
+from fenicsfriction.coupling import FrictionBoundCoupling
 from fenicsfriction.forms import Residual
-from fenicsfriction.laws import FRICTION_BOUND, check, check_positive
+from fenicsfriction.laws import check, check_positive, friction_bounds, substitute_friction_bound
 from fenicsfriction.mollification import SurfaceMollifier
 from fenicsfriction.steady import SolveError, SteadySolver
 
@@ -65,45 +69,6 @@ __all__ = ["METHODS", "PanagiotopoulosSolver", "ProcessError", "ProcessReport",
 #: the choices of ``PanagiotopoulosSolver(method=...)``: coupled Newton on the residual itself,
 #: the process to convergence, the process stopped after one step (Johnson)
 METHODS = ("newton", "panagiotopoulos", "johnson")
-
-
-def _is_bound(o: typing.Any) -> bool:
-    return isinstance(o, ufl.classes.Variable) and o.ufl_operands[1] == FRICTION_BOUND
-
-
-class _BoundSubstitution(MultiFunction):
-    """Maps each labelled friction bound to ``replacement(bound expression)``."""
-
-    def __init__(self, replacement: typing.Callable[[typing.Any], typing.Any]):
-        super().__init__()
-        self.replacement = replacement
-
-    expr = MultiFunction.reuse_if_untouched
-
-    def variable(self, o: typing.Any, expression: typing.Any, label: typing.Any) -> typing.Any:
-        if _is_bound(o):
-            return self.replacement(o.ufl_operands[0])
-        return self.reuse_if_untouched(o, expression, label)
-
-
-def substitute_friction_bound(form: ufl.Form,
-                              replacement: typing.Callable[[typing.Any], typing.Any]
-                              ) -> ufl.Form:
-    """``form`` with every friction bound :math:`c_T d^{m_T}` (labelled
-    :data:`~fenicsfriction.laws.FRICTION_BOUND`) replaced by ``replacement(bound)``, e.g. the
-    bound at a frozen state, ``lambda g: ufl.replace(g, {u: u_N})``."""
-    return map_integrand_dags(_BoundSubstitution(replacement), form)
-
-
-def friction_bounds(form: ufl.Form) -> list[typing.Any]:
-    """The distinct friction bound expressions of ``form`` (labelled by
-    :func:`fenicsfriction.laws.friction_traction`), in order of appearance."""
-    found: list = []
-    for integral in form.integrals():
-        for o in unique_pre_traversal(integral.integrand()):
-            if _is_bound(o) and o.ufl_operands[0] not in found:
-                found.append(o.ufl_operands[0])
-    return found
 
 
 @dataclasses.dataclass
@@ -146,8 +111,10 @@ class PanagiotopoulosSolver:
 
     Args:
         residual: the problem's one residual (its ``u``: the initial guess and the result). The
-            process needs a friction term (:func:`fenicsfriction.forms.friction`) and no
-            contact couplings (their forms are compiled apart and not substituted).
+            process needs a friction term (:func:`fenicsfriction.forms.friction`) or a contact
+            coupling with friction; every coupling must be a
+            :class:`~fenicsfriction.coupling.FrictionBoundCoupling` (node-to-segment and
+            mortar contact), its bound fixed the same way as the integrals'.
         method: one of :data:`METHODS`.
         rtol: the relative change of the tangential traction at which the process stops.
         max_iterations: the most outer iterations (Newton solves of the frozen residual).
@@ -165,7 +132,8 @@ class PanagiotopoulosSolver:
 
     Attributes:
         solver: the inner SteadySolver.
-        bound_state: the frozen copy :math:`u_N` the local bound is evaluated at.
+        bound_state: the frozen copy :math:`u_N` the local bound is evaluated at (with
+            couplings, also the frozen copies of their ``configuration``).
         mollified_bound: the nodal field of the mollified bound (``None`` for r = 0).
         frozen: the frozen :class:`~fenicsfriction.forms.Residual` (``None`` for Newton).
     """
@@ -201,37 +169,62 @@ class PanagiotopoulosSolver:
         if method == "newton":
             self.solver = SteadySolver(residual, **solver_args)
             return
-        check("residual", "couplings", not residual.couplings,
-              "the process substitutes the friction bound of the residual's own integrals; "
-              "contact couplings are not supported")
+        couplings = list(residual.couplings)
+        for coupling in couplings:
+            check("residual", "couplings", isinstance(coupling, FrictionBoundCoupling),
+                  "contact couplings that expose their friction bound (configuration, "
+                  "friction_bound, with_friction_bound, search: "
+                  "fenicsfriction.coupling.FrictionBoundCoupling)")
+        coupling_bounds = [c.friction_bound() for c in couplings]
         steady = residual.steady()
         bounds = friction_bounds(steady)
-        check("residual", "form", bool(bounds),
-              "the process needs a friction term (fenicsfriction.forms.friction)")
+        check("residual", "form", bool(bounds) or any(b is not None for b in coupling_bounds),
+              "the process needs a friction term (fenicsfriction.forms.friction, or a contact "
+              "coupling with friction)")
         msh = V.mesh
         self.friction_on = fem.Constant(msh, 1.0)
         if mollification_radius > 0:
+            check("mollification_radius", mollification_radius, not couplings,
+                  "the mollified bound is built on the residual's own friction integrals; "
+                  "with contact couplings use 0")
             check("residual", "form", len(bounds) == 1,
                   f"one friction bound to mollify (found {len(bounds)})")
             self._bound = bounds[0]
             self._build_mollifier(steady, mollification_radius)
+        # the fields a bound is evaluated at, each with its frozen copy: u, and the Functions
+        # each coupling's geometry is made of (the master's mirror, the pairing's reference
+        # coordinates), so that a later search does not move a frozen bound
+        self._frozen_fields: dict[fem.Function, fem.Function] = {self.u: self.bound_state}
+        for coupling, bound in zip(couplings, coupling_bounds, strict=True):
+            if bound is not None:
+                for f in coupling.configuration:
+                    self._frozen_fields.setdefault(
+                        f, fem.Function(f.function_space, name=f"frozen_{f.name}"))
 
         def replacement(bound: typing.Any) -> typing.Any:
             # switched off (friction_on = 0) for the first, frictionless, solve
             if self.mollified_bound is not None:
                 return self.friction_on * self.mollified_bound
-            return self.friction_on * ufl.replace(bound, {self.u: self.bound_state})
+            return self.friction_on * ufl.replace(bound, self._frozen_fields)
 
+        frozen_couplings = [c if b is None else c.with_friction_bound(replacement(b))
+                            for c, b in zip(couplings, coupling_bounds, strict=True)]
         self.frozen = dataclasses.replace(
-            residual, form=substitute_friction_bound(residual.form, replacement))
+            residual, form=substitute_friction_bound(residual.form, replacement),
+            couplings=frozen_couplings)
         self.solver = SteadySolver(self.frozen, **solver_args)
         # the friction integrals of the frozen steady residual: their assembled vector is the
-        # tangential traction (as nodal forces) the bound of the moment produces
+        # tangential traction (as nodal forces) the bound of the moment produces; a coupling's
+        # friction is not an integral of its own, so its part is its compiled residual less
+        # the same without friction (friction_on = 0)
         friction = ufl.Form([i for i in steady.integrals() if friction_bounds(ufl.Form([i]))])
-        self._friction = _compat.form(substitute_friction_bound(friction, replacement),
-                                      jit_cache_dir)
-        self._used = dolfinx.fem.petsc.create_vector(self._friction)
+        self._friction = (_compat.form(substitute_friction_bound(friction, replacement),
+                                       jit_cache_dir) if friction.integrals() else None)
+        self._couplings = [op for op, b in zip(self.solver.couplings, coupling_bounds, strict=True)
+                           if b is not None]
+        self._used = self.solver.b.duplicate()
         self._new = self._used.duplicate()
+        self._frictionless, self._scratch = self._used.duplicate(), self._used.duplicate()
 
     # --- the frozen bound ----------------------------------------------------------------------
     def _build_mollifier(self, steady: ufl.Form, radius: float) -> None:
@@ -276,14 +269,47 @@ class PanagiotopoulosSolver:
     def _freeze(self) -> None:
         """Evaluate the bound at the current state and keep it for the next solve."""
         if self.mollified_bound is None:
-            self.bound_state.x.array[:] = self.u.x.array  # same layout, ghosts included
+            for field, frozen in self._frozen_fields.items():
+                frozen.x.array[:] = field.x.array  # same layout, ghosts included
             return
         _, local, _ = self.nodal_bound()
         self.mollified_bound.x.array[self._surface] = self.mollifier(local)
         self.mollified_bound.x.scatter_forward()
 
+    def _coupling_residual(self, vector: PETSc.Vec) -> PETSc.Vec:
+        """The couplings' residual at the current state, their mirrors refreshed."""
+        with vector.localForm() as local:
+            local.set(0.0)
+        for operator in self._couplings:
+            operator.add_to_residual(vector)
+        return vector
+
+    def _without_friction(self) -> None:
+        """Keep the couplings' residual with the friction switched off (``_frictionless``)."""
+        if self._couplings:
+            on = float(self.friction_on.value)
+            self.friction_on.value = 0.0
+            self._coupling_residual(self._frictionless)
+            self.friction_on.value = on
+
     def _traction(self, vector: PETSc.Vec) -> PETSc.Vec:
-        return assemble_into(vector, self._friction)
+        """The nodal friction forces of the bound of the moment: the friction integrals', and
+        the couplings' residual less :meth:`_without_friction`'s."""
+        with vector.localForm() as local:
+            local.set(0.0)
+        if self._friction is not None:
+            assemble_into(vector, self._friction)
+        if self._couplings:
+            vector.axpy(1.0, self._coupling_residual(self._scratch))
+            vector.axpy(-1.0, self._frictionless)
+        return vector
+
+    def _searched_again(self) -> bool:
+        """Search every coupling's pairing at the current state; True if one changed (the
+        state was solved with a pairing it no longer has)."""
+        assert self.frozen is not None
+        changed = [coupling.search() for coupling in self.frozen.couplings]  # every one
+        return any(changed)
 
     # --- the solve ----------------------------------------------------------------------------
     def _report(self, converged: bool, outer: int, newton: int, t0: float, changes: list,
@@ -315,6 +341,7 @@ class PanagiotopoulosSolver:
             return self._report(True, 1, inner.iterations, t0, [], inner.reason)
         changes: list[float] = []
         newton = 0
+        since = 0  # the patience counts the changes since the last change of the pairing
         outer_limit = 2 if self.method == "johnson" else self.max_iterations
         self.friction_on.value = 0.0  # p_τ(0) = 0: the frictionless normal problem first
         for outer in range(1, outer_limit + 1):
@@ -329,6 +356,7 @@ class PanagiotopoulosSolver:
                     f"Panagiotopoulos process{self._where()}: the Newton solve of outer "
                     f"iteration {outer} failed ({err.report.reason}); last change {last}; "
                     "u holds the last iterate", report) from err
+            self._without_friction()
             used = self._traction(self._used)
             self.friction_on.value = 1.0
             self._freeze()
@@ -338,12 +366,15 @@ class PanagiotopoulosSolver:
             change = new.norm() / size if size > 0 else (0.0 if new.norm() == 0 else np.inf)
             changes.append(float(change))
             if change <= self.rtol:
-                return self._report(True, outer, newton, t0, changes,
-                                    f"change {change:.3e} <= rtol {self.rtol:.1e}")
+                if self.method == "johnson" or not self._searched_again():
+                    return self._report(True, outer, newton, t0, changes,
+                                        f"change {change:.3e} <= rtol {self.rtol:.1e}")
+                since = len(changes)  # solved with a pairing it no longer has: go on
+                continue
             if self.method == "johnson" and outer == 2:
                 return self._report(False, outer, newton, t0, changes,
                                     "one step (Johnson's approximation)")
-            best = int(np.argmin(changes))
+            best = since + int(np.argmin(changes[since:]))
             if not np.isfinite(change) or len(changes) - 1 - best >= self.patience:
                 report = self._report(False, outer, newton, t0, changes,
                                       "the change stopped falling")

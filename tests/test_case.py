@@ -17,6 +17,9 @@ from scipy.integrate import dblquad
 
 from fenicsfriction import _compat
 from fenicsfriction.case import CaseModel, read_case, run_case
+from fenicsfriction.case.analyses import PairedSteadySolver
+from fenicsfriction.case.schema import CONTACT_FORMULATIONS
+from fenicsfriction.contact import FORMULATIONS
 from fenicsfriction.stability import Loci, StabilitySolver
 from fenicsfriction.steady import SteadySolver, continuation
 from fenicsfriction.studies.block import BlockOnBelt, BlockOnSlab
@@ -304,3 +307,68 @@ def test_a_gmsh_mesh_made_by_its_script_gives_the_generated_block(shared_tmp_pat
                                                                    "generated_pep_")
     assert len(ours) == 6
     assert np.abs(ours - theirs).max() <= 1e-8 * np.abs(theirs).max(), (ours, theirs)
+
+
+def stiff_slab_case(formulation: str, degree: int, refine: int) -> str:
+    """cases/block-on-slab.toml with the contact's formulation and degree, the slab 1000 times
+    the block's E and 2.5 cm thin (a rigid belt for the onset to 1e-5: docs/block-on-slab.md),
+    every cell of both bodies split ``refine`` times along each axis."""
+    text = (ROOT / "cases" / "block-on-slab.toml").read_text()
+    text = text.replace('formulation = "node-to-segment"', f'formulation = "{formulation}"')
+    text = text.replace("degree = 1 ", f"degree = {degree} ")
+    text = text.replace("divisions = [4, 3]", f"divisions = [{4 * refine}, {3 * refine}]")
+    x = next(line for line in text.splitlines() if line.startswith("x = "))
+    coarse = np.array(json.loads(x[4:]))
+    fine = np.interp(np.arange(refine * (len(coarse) - 1) + 1) / refine,
+                     np.arange(len(coarse)), coarse)
+    text = text.replace(x, f"x = {json.dumps(fine.tolist())}")
+    slab = text.index("[bodies.slab]")
+    return text[:slab] + text[slab:].replace("y = [-10.0, 0.0]", "y = [-2.5, 0.0]").replace(
+        "E = 1.4e6", "E = 1.4e9", 1)
+
+
+def test_mortar_case_onset_converges_to_the_one_body_blocks_at_second_order(shared_tmp_path):
+    """The block-on-slab case with mortar contact of degree 2 on a stiff slab, on the 4 × 3
+    and 8 × 6 block: run_case's onsets approach the mesh-converged onset of the one-body Q2
+    block on a rigid belt, 0.37046 (docs/block-stability.md: Gauss contact rule, the same on
+    8 × 6, 16 × 12 and 32 × 24; another discretisation of the interface, no mortar), from
+    above at second order: the error falls by a factor 3-5 from one mesh to the next, and the
+    Richardson extrapolation μ₂ + (μ₂ − μ₁)/3 lies within 1e-3 of it (measured 2.6e-4; each
+    onset is bisected to 1e-4, and on 8 × 6 and 16 × 12 the extrapolation is within 7e-5, so
+    what is left is the next order)."""
+    onsets = []
+    for refine in (1, 2):
+        path = write_case(shared_tmp_path, f"mortar-{refine}.toml",
+                          stiff_slab_case("mortar", 2, refine))
+        outcome = run_case(read_case(path), shared_tmp_path / f"out-{refine}", COMM)
+        assert outcome.exit_code == 0 and len(outcome.onsets) == 1
+        onsets.append(outcome.mu_crit)
+    converged = 0.37046
+    coarse, fine = (mu - converged for mu in onsets)
+    assert 0 < fine < coarse and 3 < coarse / fine < 5, onsets
+    assert abs(onsets[1] + (onsets[1] - onsets[0]) / 3 - converged) < 1e-3, onsets
+
+
+def test_the_case_files_contact_formulations_are_the_contacts():
+    assert tuple(CONTACT_FORMULATIONS) == FORMULATIONS
+
+
+def test_steady_states_with_body_contact_keep_the_pairing_they_were_solved_with():
+    """Continuation of the block-on-slab case through μ = 0, 0.1, ..., 0.4: each step slides
+    the block 4 cm along the slab (μW/K_x per 0.1), past master nodes 12.2 cm apart. A plain
+    SteadySolver searches once per solve and converges, at μ = 0.1, to a state whose pairing
+    changes when searched again (the pressures 2 % off the consistent state's); the case's
+    PairedSteadySolver never does."""
+    case = read_case(ROOT / "cases" / "block-on-slab.toml")
+    stale = {}
+    for name in ("plain", "paired"):
+        model = CaseModel(case, COMM)
+        model.initial_guess()
+        options = {"prefix": f"pairing_{name}_", "options": {"snes_atol": 4.5e-8}}
+        solver = (SteadySolver(model.residual, **options) if name == "plain"
+                  else PairedSteadySolver(model.body_contacts, model.residual, **options))
+        (contact,) = model.body_contacts
+        records = continuation(solver, model.parameters["mu"], [0.0, 0.1, 0.2, 0.3, 0.4],
+                               observe=lambda contact=contact: {"changed": contact.search()})
+        stale[name] = [r["value"] for r in records if r["changed"]]
+    assert stale["plain"] and not stale["paired"], stale

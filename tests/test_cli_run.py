@@ -75,6 +75,26 @@ GMSH = GOOD.replace('shape = "rectangle"\nsize = [2.0, 1.0]\ndivisions = [4, 2]\
     "[bodies.block]", '[mesh]\nfile = "pad.msh"\n[bodies.block]').replace(
     '"block.ymax"', '"back"').replace('"block.ymin"', '"friction"')
 
+#: the square on an elastic base instead of the rigid belt: a body-to-body contact
+TWO_BODIES = GOOD.replace('[[contacts]]\nsurface = "block.ymin"\n'
+                          'foundation = { normal = [0.0, 1.0] }', """[bodies.base]
+shape = "rectangle"
+origin = [-1.0, -0.5]
+size = [4.0, 0.5]
+divisions = [8, 1]
+E = 1e3
+nu = 0.3
+rho = 1.0
+[[supports]]
+type = "clamped"
+on = "base.ymin"
+[[contacts]]
+slave = "block.ymin"
+master = "base.ymax"
+""")
+MORTAR = TWO_BODIES.replace('master = "base.ymax"',
+                            'master = "base.ymax"\nformulation = "mortar"')
+
 #: (what is wrong, the case text, the key the line must name)
 BAD = [
     ("unknown key", GOOD.replace("mu = 0.1", "mue = 0.1"), "law.mue"),
@@ -95,6 +115,12 @@ BAD = [
      "contacts[0].surface"),
     ("facet group as a body in 2D", GMSH.replace('group = "pad"', 'group = "back"'),
      "bodies.block.group"),
+    ("unknown contact formulation", MORTAR.replace('"mortar"', '"nitsche"'),
+     "contacts[0].formulation"),
+    ("degree 2 with node-to-segment contact", TWO_BODIES.replace("degree = 1", "degree = 2"),
+     "contacts[0].formulation"),
+    ("degree 3 with mortar contact", MORTAR.replace("degree = 1", "degree = 3"),
+     "model.degree"),
 ]
 
 

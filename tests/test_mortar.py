@@ -41,9 +41,9 @@ def test_mortar_contact_passes_the_patch_test(dim, degree, passes):
 
 @pytest.mark.parametrize("dim", [2, 3])
 def test_node_to_segment_fails_the_same_patch_test(dim):
-    """The same meshes through node-to-segment contact, one pass and two: the pressure
-    deviates by percents (Taylor & Papadopoulos 1991: even two passes are exact only in
-    special cases), so the patch test above can fail."""
+    """The same meshes through node-to-segment contact, one pass and two: the displacement
+    and each pass's pressure deviate by percents (two passes pass only as the penalty
+    stiffens: Taylor & Papadopoulos 1991), so the patch test above can fail."""
     for passes in (1, 2):
         patch = PatchTest(dim, 1, formulation="node-to-segment", passes=passes)
         error = patch.solve()
@@ -82,6 +82,50 @@ def test_mortar_integrals_are_a_partition_of_unity(dim, degree):
     assert np.allclose(contact.nodal_weights[slave], area, rtol=1e-12, atol=0)
     total = MPI.COMM_WORLD.allreduce(float(area.sum()))
     assert total == pytest.approx(1.0, rel=1e-13)
+
+
+@pytest.mark.parametrize("degree", [1, 2])
+@pytest.mark.parametrize("dim", [2, 3])
+def test_sliding_leaves_the_integrals_on_the_overlap(dim, degree):
+    """The upper block slid by s = 0.37 along x (not a multiple of either mesh's size): the
+    integrals cover the overlap only, Σ A_j = 1 - s (its length or area), each row of D and M
+    still sums to A_j, the covered fraction of each node is in [0, 1], and the new pattern of
+    B is counted as a change."""
+    contact, u = _contact(dim, degree, 3, 4)
+    contact.update()
+    changes = contact.pairing.changes
+    x = u.function_space.tabulate_dof_coordinates()[:, :dim]
+    slide = 0.37
+    upper = u.x.array.reshape(-1, dim)
+    upper[x[:, -1] > 1e-12, 0] = slide  # the upper block's nodes, above z = 0 ...
+    slave = contact.pairing.slave_nodes
+    upper[slave, 0] = slide  # ... and its contact face
+    u.x.scatter_forward()
+    assert contact.search()
+    integrals = contact.pairing
+    assert integrals.changes == changes + 1
+    area = integrals.area[slave]
+    total = MPI.COMM_WORLD.allreduce(float(area.sum()))
+    assert total == pytest.approx(1.0 - slide, rel=1e-12)
+    for matrix in (integrals.D, integrals.M):
+        assert np.allclose(np.asarray(matrix.sum(axis=1)).ravel()[slave], area,
+                           rtol=1e-12, atol=1e-15)
+    fraction = integrals.coverage.x.array[slave]
+    assert np.all((fraction >= 0) & (fraction <= 1 + 1e-12))
+
+
+@pytest.mark.parametrize("formulation", ["mortar", "node-to-segment"])
+def test_gap_and_normal_mean_the_same_in_both_formulations(formulation):
+    """The upper block moved 0.01 into the lower one (flat interface z = 0): at every slave
+    node the gap is -0.01, the penetration 0.01 and the normal +z, out of the master body."""
+    msh, _, facet_tags = stacked_blocks(MPI.COMM_WORLD, 3, 2, 3, overlap=0.01)
+    u = fem.Function(_compat.vector_function_space(msh, 1))
+    contact = make_contact(formulation, u, facet_tags, SLAVE, MASTER,
+                           InterfaceLaw(c_n=1.0, m_n=1.0))
+    contact.update()
+    values = contact.nodal_values([contact.gap, contact.penetration, *contact.normal])()
+    slave = contact.nodal_weights > 0
+    assert np.allclose(values[slave], [-0.01, 0.01, 0.0, 0.0, 1.0], rtol=0, atol=1e-14)
 
 
 def _reference_integrals(degree: int) -> tuple[np.ndarray, np.ndarray]:
@@ -191,6 +235,10 @@ def test_refused_inputs_name_what_is_allowed():
     cubic = fem.Function(_compat.vector_function_space(msh, 3))
     with pytest.raises(ValueError, match="degree 1 or 2"):
         SegmentToSegment(cubic, facet_tags, SLAVE, MASTER, law)
+    cubes = _compat.create_box(MPI.COMM_WORLD, [0.0, 0.0, 0.0], [1.0, 1.0, 1.0], [2, 2, 2])
+    with pytest.raises(ValueError, match="mesh='hexahedron'.*tetrahedra"):
+        SegmentToSegment(fem.Function(_compat.vector_function_space(cubes, 1)), facet_tags,
+                         SLAVE, MASTER, law)
     u = fem.Function(_compat.vector_function_space(msh, 1))
     for options in ({"enforcement": "perturbed-lagrangian"},
                     {"formulation": "perturbed-lagrangian"}):
@@ -233,8 +281,26 @@ def test_mortar_contact_on_two_ranks_matches_one(dim, degree):
     assert np.allclose(here, alone, rtol=0, atol=1e-13)
 
 
-@pytest.mark.mpi(min_size=2)
-@pytest.mark.parametrize("dim", [2, 3])
-def test_mortar_patch_test_on_two_ranks(dim):
-    patch = PatchTest(dim, 2, passes=2)
-    assert patch.solve() < PATCH_TOLERANCE
+@pytest.mark.parametrize("degree", [1, 2])
+def test_frequency_bound_holds_the_contact_springs_largest_frequency(degree):
+    """Every slave node in contact (the blocks overlapping), linear compliance: the largest
+    ω² of the contact's stiffness B^T C B (its Jacobian, assembled) on a lumped mass is below
+    the bound, and the bound is within a small factor of it (a norm bound, not a guess)."""
+    contact, u = _contact(2, degree, 3, 4, comm=MPI.COMM_SELF, overlap=0.01)
+    operator = contact.operator({u: 1.0})
+    b = dolfinx.fem.petsc.create_vector(operator.G)
+    operator.add_to_residual(b)  # searches
+    K = operator.matrix()
+    V = contact.V
+    x = V.tabulate_dof_coordinates()[:, :2]
+    mass = b.duplicate()
+    mass.array[:] = np.repeat(1.0 + 0.5 * np.sin(7 * x[:, 0] + 3 * x[:, 1]), 2)
+    dense = K.convert("dense").getDenseArray()
+    scale = 1 / np.sqrt(mass.array)
+    largest = np.linalg.eigvalsh(scale[:, None] * dense * scale[None, :]).max()
+    bound = contact.frequency_bound(mass)
+    assert largest > 0
+    assert largest <= bound * (1 + 1e-12)
+    # ||C^1/2 B||_1 ||C^1/2 B||_inf / min(m) over-estimates the largest ω² where the nodes'
+    # weights and masses vary (by 2.0 and 2.4 here)
+    assert bound < 4 * largest, (bound, largest)

@@ -19,9 +19,10 @@ the foundation, towards the body) uses the foundation's normal, not the body's f
 the penetration is :math:`d = (u\cdot(-n_f) - g - (X - p)\cdot n_f)_+`, the law's gap plus the
 geometric one, and the slip :math:`w = \dot u_T - U(X)` with the foundation's velocity
 :math:`U` (a translation, or :math:`\omega\,a\times(X - p_a)` for a rotation about an axis
-along :math:`n_f`). Body-to-body contact is
-:class:`~fenicsfriction.contact.NodeToSegment` with the master body's velocity as ``transport``
-(one pass, or two passes with weight 1/2 each, the second with the roles swapped).
+along :math:`n_f`). Body-to-body contact is the contact coupling of the case's
+``formulation`` (:func:`fenicsfriction.contact.make_contact`: node-to-segment or mortar) with
+the master body's velocity as ``transport`` (one pass, or two passes with weight 1/2 each, the
+second with the roles swapped).
 """
 
 from __future__ import annotations
@@ -36,7 +37,7 @@ from dolfinx import fem, mesh
 
 from fenicsfriction import _compat, laws
 from fenicsfriction.case.schema import SIDES, Case, interface_law
-from fenicsfriction.contact import NodeToSegment
+from fenicsfriction.contact import make_contact
 from fenicsfriction.forms import (
     NodalSpring,
     Residual,
@@ -156,7 +157,8 @@ class CaseModel:
         parameters: name -> ``fem.Constant`` of every continuable value the model has
             (:data:`~fenicsfriction.case.schema.CONTINUABLE`).
         contacts: name -> the contact's resultant forms (:meth:`contact_forces`).
-        node_to_segment: the body-to-body contacts' :class:`NodeToSegment` passes.
+        body_contacts: the body-to-body contacts' passes (contact couplings,
+            :func:`fenicsfriction.contact.make_contact`).
         springs: the nodal springs (supports of type "spring").
     """
 
@@ -228,7 +230,7 @@ class CaseModel:
         bcs, self.springs = self._supports(terms, u, v)
         self._loads(terms, v)
         self.contacts: dict[str, dict[str, typing.Any]] = {}
-        self.node_to_segment: list[NodeToSegment] = []
+        self.body_contacts: list[typing.Any] = []
         for contact in case.contacts:
             if contact["kind"] == "foundation":
                 terms.append(self._foundation(contact, u, u_dot, v))
@@ -241,7 +243,7 @@ class CaseModel:
             isinstance(law.slip_rule, laws.EllipticSlipRule)
         self.residual = Residual(form=constant(self.thickness) * form, u=u, u_dot=u_dot,
                                  u_ddot=u_ddot, v=v, bcs=bcs, springs=self.springs,
-                                 couplings=list(self.node_to_segment),
+                                 couplings=list(self.body_contacts),
                                  friction=self.parameters["mu"] if linear_in_mu else None)
 
     # --- tags -------------------------------------------------------------------------------
@@ -404,7 +406,8 @@ class CaseModel:
         return terms
 
     def _bodies_contact(self, contact: dict, u: fem.Function, u_dot: fem.Function) -> None:
-        """Node-to-segment contact, the master body moving with the case's motion."""
+        """Contact between two bodies (the case's ``formulation``), the master body moving
+        with the case's motion."""
         slave, master = (self.surface_tag(contact[k]) for k in ("slave", "master"))
         passes = contact["passes"]
         law = self.law if self.with_friction else self.law.replace(
@@ -416,10 +419,10 @@ class CaseModel:
             transport = None
             if moving:
                 transport = (1 - 2 * k) * self.foundation_velocity(self.X)
-            pair = NodeToSegment(u, self.facet_tags, slave=s, master=m, law=law,
-                                 velocity=u_dot, fields=[u_dot], transport=transport,
-                                 weight=weight)
-            self.node_to_segment.append(pair)
+            pair = make_contact(contact["formulation"], u, self.facet_tags, slave=s, master=m,
+                                law=law, velocity=u_dot, fields=[u_dot], transport=transport,
+                                weight=weight)
+            self.body_contacts.append(pair)
             if k == 0:
                 self.contacts[contact["name"]] = {
                     "pressure": pair.pressure, "traction": pair.traction, "ds": pair.ds,

@@ -29,14 +29,17 @@ import typing
 
 from fenicsfriction import laws
 
-__all__ = ["ANALYSES", "CONTINUABLE", "Case", "CaseError", "interface_law", "read_case",
-           "read_physical_names"]
+__all__ = ["ANALYSES", "CONTACT_FORMULATIONS", "CONTINUABLE", "Case", "CaseError",
+           "interface_law", "read_case", "read_physical_names"]
 
 #: the scalar parameters a continuation can step (each one ``fem.Constant`` of the model):
 #: the law's values, the global load factor and the speed of the motion
 CONTINUABLE = ("mu", "c_n", "b_n", "g", "eps", "load_scale", "speed", "omega")
 #: the analyses a case can ask for, in the order they run
 ANALYSES = ("steady", "cea", "transient")
+#: the discretisations of a body-to-body contact (:data:`fenicsfriction.contact.FORMULATIONS`)
+#: and the displacement degrees (``model.degree``) each one takes
+CONTACT_FORMULATIONS = {"node-to-segment": (1,), "mortar": (1, 2)}
 #: the sides of the generated shapes, "BODY.SIDE": name -> (axis, 0 the lower end, 1 the upper)
 SIDES = {"xmin": (0, 0), "xmax": (0, 1), "ymin": (1, 0), "ymax": (1, 1),
          "zmin": (2, 0), "zmax": (2, 1)}
@@ -590,14 +593,21 @@ def _contact(c: _Checker, t: Table, where: str, surfaces: _Surfaces, model: Tabl
             c.fail("motion.type", "rotation", "a rigid plane foundation cannot rotate in 2D: "
                    "mesh the rotating body and use a body-to-body contact (slave, master)")
     else:
-        c.keys(t, where, ("name", "slave", "master", "passes", "moving",
+        c.keys(t, where, ("name", "slave", "master", "passes", "moving", "formulation",
                           "initial_penetration"), required=("slave", "master"))
-        if model["degree"] != 1:
-            c.fail("model.degree", model["degree"], "must be 1: body-to-body (node-to-segment) "
-                   "contact needs degree-1 elements")
+        formulation = c.choice(t, "formulation", where, tuple(CONTACT_FORMULATIONS),
+                               default="node-to-segment")
+        degree = model["degree"]
+        if degree not in CONTACT_FORMULATIONS[formulation]:
+            if any(degree in degrees for degrees in CONTACT_FORMULATIONS.values()):
+                c.fail(f"{where}.formulation", formulation, f"must be 'mortar' with "
+                       f"model.degree = {degree} (node-to-segment contact needs degree 1)")
+            c.fail("model.degree", degree, "must be 1 or 2 with a body-to-body contact "
+                   "(2 with formulation = 'mortar')")
         contact = {"kind": "bodies", "slave": surfaces.surface(t, "slave", where),
                    "master": surfaces.surface(t, "master", where),
-                   "passes": c.choice(t, "passes", where, (1, 2), default=1)}
+                   "passes": c.choice(t, "passes", where, (1, 2), default=1),
+                   "formulation": formulation}
     contact["name"] = c.string(t, "name", where, default=f"contact{where[9:-1]}")
     contact["moving"] = c.choice(t, "moving", where, (True, False), default=motion is not None)
     if contact["moving"] and motion is None:

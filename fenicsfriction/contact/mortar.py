@@ -76,6 +76,7 @@ from fenicsfriction.assembly import assemble_owned
 from fenicsfriction.contact.node_to_segment import (
     ContactOperator,
     NodalValues,
+    NodeToSegment,
     discrete_gradient,
 )
 
@@ -84,11 +85,15 @@ __all__ = ["MortarIntegrals", "SegmentToSegment", "surface_facets"]
 Value = typing.Any
 
 #: a search changes the contact geometry when a gap moves by more than this, relative to the
-#: largest penetration (or to the slave facets' size where nothing penetrates)
-GAP_TOLERANCE = 1e-8
+#: largest penetration (or to the slave facets' size where nothing penetrates): the pressures
+#: of a fixed point of the search are converged on the contact geometry to about this
+#: fraction (each round of the fixed point divides the change by 10-100 on Hertz's cylinder)
+GAP_TOLERANCE = 1e-5
 
-#: master facets are candidates of a slave facet within this many of their two radii
-SEARCH_RADIUS = 2.0
+#: master facets are candidates of a slave facet when their centroids are within this many
+#: times the sum of the two facets' radii (in-plane overlap needs 1; the rest allows for a
+#: normal separation of half the facets' size)
+SEARCH_RADIUS = 1.5
 
 #: the pieces of a split degree-2 facet: for each, its vertices among the facet's nodes
 #: (vertices first, then the midside nodes m01 (2D); m01, m12, m20 (3D)), ordered as the
@@ -101,8 +106,9 @@ _NODES = {2: np.array([[1.0, 0.0], [0.0, 1.0], [0.5, 0.5]]),
           3: np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0],
                        [0.5, 0.5, 0.0], [0.0, 0.5, 0.5], [0.5, 0.0, 0.5]])}
 
-# Gauss-Legendre, 3 points on [0, 1] (degree 5), and Strang & Fix's 6-point rule on the
-# triangle (degree 4; Dunavant 1985), barycentric, weights summing to 1
+# Gauss-Legendre, 3 points on [0, 1] (degree 5), and the 6-point rule of degree 4 on the
+# triangle (Dunavant 1985, "High degree efficient symmetrical Gaussian quadrature rules for
+# the triangle", Table I), barycentric, weights summing to 1
 _GAUSS_SEGMENT = ((np.polynomial.legendre.leggauss(3)[0] + 1) / 2,
                   np.polynomial.legendre.leggauss(3)[1] / 2)
 _A, _B = 0.445948490915965, 0.091576213509771
@@ -205,15 +211,24 @@ class _Pieces:
 
     facet: np.ndarray  # (p,) the facet of each piece
     nodes: np.ndarray  # (p, nv) global node indices of the piece's vertices
-    parent: np.ndarray  # (p, nv, nv) barycentric coordinates of its vertices in the facet
     split: np.ndarray  # (pieces per facet, nv) the pieces' vertices among the facet's nodes
+    parent: np.ndarray  # (pieces per facet, nv, nv) their barycentric coordinates in it
 
     @classmethod
     def split_facets(cls, nodes: np.ndarray, dim: int, degree: int) -> _Pieces:
         split = np.array(_PIECES[dim, degree])
         facet = np.repeat(np.arange(len(nodes)), len(split))
-        return cls(facet, nodes[:, split].reshape(-1, dim),
-                   np.tile(_NODES[dim][split], (len(nodes), 1, 1)), split)
+        return cls(facet, nodes[:, split].reshape(-1, dim), split, _NODES[dim][split])
+
+    def in_facet(self, lam: np.ndarray, pieces: np.ndarray) -> np.ndarray:
+        """The facet's barycentric coordinates of points with coordinates ``lam[q]`` in the
+        pieces ``pieces[q]``."""
+        kind = pieces % len(self.split)
+        out = np.empty_like(lam)
+        for k, parent in enumerate(self.parent):
+            chosen = kind == k
+            out[chosen] = lam[chosen] @ parent
+        return out
 
     def coordinates(self, x: np.ndarray) -> np.ndarray:
         """The pieces' vertices' coordinates, ``x`` those of the facets' nodes (f, nen, dim):
@@ -243,8 +258,9 @@ class MortarIntegrals:
             to the nearest master facet along :math:`-n`).
         slave_nodes: the owned slave nodes (local indices).
         searches, changes: how many searches ran, how many changed B's sparsity pattern.
-        time_s: seconds in ``"search"`` (gathers, normals, segmentation, integrals) and
-            ``"build"`` (B as a PETSc matrix, the reference gaps), summed over calls.
+        time_s: seconds in ``"search"`` (gathers, normals, segmentation, integrals, the
+            change test: until every rank is done) and ``"build"`` (B as a PETSc matrix, the
+            reference gaps, normals and coverage as Functions), summed over calls.
     """
 
     def __init__(self, V: fem.FunctionSpace, slave: np.ndarray, master: np.ndarray):
@@ -278,6 +294,7 @@ class MortarIntegrals:
         self.time_s = {"search": 0.0, "build": 0.0}
         self._B: scipy.sparse.csr_matrix | None = None
         self._gap: np.ndarray | None = None
+        self._searched_at: np.ndarray | None = None
 
     def _owned(self, nodes: np.ndarray) -> np.ndarray:
         return (nodes >= self.owned_range[0]) & (nodes < self.owned_range[1])
@@ -286,8 +303,14 @@ class MortarIntegrals:
         """Normals, segmentation and mortar integrals at displacement ``u``, and ``B``.
 
         Returns True if the contact geometry changed: B's sparsity pattern, or a gap at
-        ``u`` by more than :data:`GAP_TOLERANCE` (relative) from the last search's.
+        ``u`` by more than :data:`GAP_TOLERANCE` (relative) from the last search's. At the
+        state of the last search nothing is done (False).
         """
+        state = u.x.array[:self.size_local * self.dim]
+        if self._searched_at is not None and self.comm.allreduce(
+                bool(np.array_equal(state, self._searched_at)), op=MPI.LAND):
+            return False  # the state of the last search (a new solve starting from it)
+        self._searched_at = state.copy()
         t0 = time.perf_counter()
         self.searches += 1
         slave_x = self.slave_pieces.coordinates(self.slave.current(u))
@@ -303,8 +326,6 @@ class MortarIntegrals:
         B = (scipy.sparse.diags(scale) @ (D - M)).tocsr()
         B.sort_indices()
         B.eliminate_zeros()
-        t1 = time.perf_counter()
-        self.time_s["search"] += t1 - t0
         # the relative positions at u with the new geometry, uncovered nodes at their distance
         x_all = self._surface_coordinates(u)
         G = (B @ x_all) - offset
@@ -320,6 +341,8 @@ class MortarIntegrals:
         changed = pattern_changed or moved > GAP_TOLERANCE * (reach if reach > 0 else size)
         changed = bool(self.comm.allreduce(changed, op=MPI.LOR))
         pattern_changed = bool(self.comm.allreduce(pattern_changed, op=MPI.LOR))
+        t1 = time.perf_counter()  # the ranks' searches done (the collectives wait for all)
+        self.time_s["search"] += t1 - t0
         self._B, self._gap = B, gap
         self._set(self.normal, normals)
         fraction = self.coverage.x.array
@@ -357,11 +380,6 @@ class MortarIntegrals:
     def _facet_size(self) -> float:
         X = self.slave_pieces.coordinates(self.slave.reference)
         return float(np.linalg.norm(X[:, 1] - X[:, 0], axis=-1).mean()) if len(X) else 1.0
-
-    @functools.cached_property
-    def _columns(self) -> np.ndarray:
-        """The global indices of every node of both surfaces (sorted)."""
-        return np.unique(np.concatenate([self.slave.nodes.ravel(), self.master.nodes.ravel()]))
 
     @functools.cached_property
     def _surface_reference(self) -> np.ndarray:
@@ -415,27 +433,36 @@ class MortarIntegrals:
         s_index = np.repeat(np.arange(len(mine)), counts)
         m_index = (np.concatenate([np.asarray(f, dtype=np.int64) for f in found])
                    if counts.sum() else np.zeros(0, dtype=np.int64))
-        facing = np.einsum("pk,pk->p", s_normal[s_index], m_normal[m_index]) < 0
-        s_index, m_index = s_index[facing], m_index[facing]
+        # facing each other, and close enough across the slave normal to overlap
+        unit = s_normal[s_index] / np.linalg.norm(s_normal[s_index], axis=-1, keepdims=True)
+        offset = m_centre[m_index] - s_centre[s_index]
+        across = offset - np.einsum("pk,pk->p", offset, unit)[:, None] * unit
+        keep = ((np.einsum("pk,pk->p", unit, m_normal[m_index]) < 0)
+                & (np.linalg.norm(across, axis=-1) <= s_radius[s_index] + m_radius[m_index]))
+        s_index, m_index = s_index[keep], m_index[keep]
         segment = _segments_2d if d == 2 else _segments_3d
         mu, nu, weight, pair = segment(s_x[s_index], master_x[m_index])
         # reference measure: the piece's reference size over its current one
         ratio = (np.linalg.norm(_normal(s_X), axis=-1) / np.linalg.norm(s_normal, axis=-1))
-        s_of = s_index[pair]
-        m_of = m_index[pair]
-        weight = weight * ratio[s_of]
+        order = np.argsort(pair, kind="stable")  # the points of each pair together
+        mu, nu, weight, pair = mu[order], nu[order], weight[order], pair[order]
+        starts = np.flatnonzero(np.diff(pair, prepend=-1))
+        pair = pair[starts]
+        weight = weight * ratio[s_index][pair].repeat(np.diff(np.append(starts, len(order))))
         sp, mp = self.slave_pieces, self.master_pieces
-        s_piece, m_piece = mine[s_of], m_of
-        N_s = shape_functions(np.einsum("qa,qab->qb", mu, sp.parent[s_piece]), self.degree)
-        N_m = shape_functions(np.einsum("qa,qab->qb", nu, mp.parent[m_piece]), self.degree)
-        rows = sp.nodes[s_piece]  # (q, nv)
+        s_piece, m_piece = mine[s_index[pair]], m_index[pair]
+        points = np.repeat(np.arange(len(pair)), np.diff(np.append(starts, len(order))))
+        N_s = shape_functions(sp.in_facet(mu, s_piece[points]), self.degree)
+        N_m = shape_functions(mp.in_facet(nu, m_piece[points]), self.degree)
+        rows = sp.nodes[s_piece]  # (pairs, nv)
         owned = self._owned(rows)
         rows_local = rows - self.owned_range[0]
+        weighted = weight[:, None] * mu
         matrices = []
         for N, facets, nodes in ((N_s, sp.facet[s_piece], self.slave.nodes),
                                  (N_m, mp.facet[m_piece], self.master.nodes)):
-            columns = nodes[facets]  # (q, nen)
-            values = weight[:, None, None] * mu[:, :, None] * N[:, None, :]  # (q, nv, nen)
+            columns = nodes[facets]  # (pairs, nen)
+            values = np.add.reduceat(weighted[:, :, None] * N[:, None, :], starts, axis=0)
             keep = np.broadcast_to(owned[:, :, None], values.shape)
             r = np.broadcast_to(rows_local[:, :, None], values.shape)[keep]
             c = np.broadcast_to(columns[:, None, :], values.shape)[keep]
@@ -504,6 +531,11 @@ def _segments_3d(slave: np.ndarray, master: np.ndarray
         return np.stack([np.einsum("pak,pk->pa", r, e1), np.einsum("pak,pk->pa", r, e2)], -1)
 
     s2, m2 = plane(slave), plane(master)  # (p, 3, 2); the slave triangle counter-clockwise
+    # only the pairs whose bounding boxes overlap in the plane are clipped
+    overlap = np.all((m2.max(axis=1) >= s2.min(axis=1)) & (m2.min(axis=1) <= s2.max(axis=1)),
+                     axis=1)
+    candidates = np.flatnonzero(overlap)
+    s2, m2 = s2[candidates], m2[candidates]
     polygon, count = _clip(m2, s2)
     points, weights = _GAUSS_TRIANGLE
     mu_all, nu_all, w_all, pair_all = [], [], [], []
@@ -521,7 +553,7 @@ def _segments_3d(slave: np.ndarray, master: np.ndarray
     if not mu_all:
         return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=np.int64)
     return (np.concatenate(mu_all), np.concatenate(nu_all), np.concatenate(w_all),
-            np.concatenate(pair_all))
+            candidates[np.concatenate(pair_all)])
 
 
 def _cross2(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -559,8 +591,9 @@ def _clip(subject: np.ndarray, clip: np.ndarray) -> tuple[np.ndarray, np.ndarray
         candidates = np.stack([subject, crossing], axis=2).reshape(p, 2 * k, 2)
         used = np.stack([valid & inside, valid & (inside != inside_next)], axis=2).reshape(p, -1)
         count = used.sum(axis=1)
-        order = np.argsort(~used, axis=1, kind="stable")
-        subject = candidates[rows, order][:, :max(int(count.max(initial=0)), 1)]
+        subject = np.zeros((p, max(int(count.max(initial=0)), 1), 2))
+        r, c = np.nonzero(used)  # the used candidates, in order, to the front of each row
+        subject[r, (np.cumsum(used, axis=1) - 1)[r, c]] = candidates[r, c]
     return subject, count
 
 
@@ -588,7 +621,7 @@ class SegmentToSegment:
         step_from: the displacement u_n at the start of a midpoint step, ``u`` the step's
             midpoint (:class:`~fenicsfriction.dynamics.DynamicsSolver` with
             ``energy_consistent``): the elastic pressure becomes the discrete gradient of the
-            potential between the approaches :math:`n_j\cdot G_j` of the two ends
+            potential between the approaches :math:`-g_j` of the two ends
             (:func:`~fenicsfriction.contact.node_to_segment.discrete_gradient`). ``G`` being
             affine in u between searches, its work over the step is exactly the potential's
             change. ``None`` (default): the pressure at ``u``.
@@ -604,7 +637,10 @@ class SegmentToSegment:
         F, G: ``None`` and the form of the contact's virtual power on the mirrors' test
             functions (:math:`R_c = B^T G`).
         ds: the nodal measure on the slave facets, :math:`\int q\, ds = \sum_j A_j q_j`.
-        normal, gap, penetration: :math:`n_j` (a Function of V), :math:`g_j`, :math:`d_j`.
+        normal, gap, penetration: the contact normal :math:`-n_j`, out of the master body
+            (node-to-segment's orientation: ``pressure * normal + traction`` is the force on
+            the slave side with either formulation; :math:`n_j` is the Function
+            ``pairing.normal``), :math:`g_j = -n_j\cdot G_j` and :math:`d_j` (UFL, nodal).
         pressure, traction: the pressure and the friction traction (UFL, nodal; the traction
             None without friction).
         relative_velocity: :math:`w` (UFL; None without ``velocity``).
@@ -625,8 +661,13 @@ class SegmentToSegment:
         degree = _compat.element_degree(V)
         laws.check("V", degree, degree in (1, 2),
                    "mortar contact needs a Lagrange displacement space of degree 1 or 2")
-        laws.check("mesh", msh.geometry.cmap.degree, msh.geometry.cmap.degree == 1,
-                   "mortar contact needs a mesh of degree-1 (straight) geometry")
+        # the facets must be straight segments (2D: of triangles or quadrilaterals) or
+        # triangles (3D: of tetrahedra; a hexahedron's quadrilateral facet is not one)
+        simplex_facets = msh.topology.cell_type != mesh.CellType.hexahedron
+        laws.check("mesh", msh.topology.cell_type.name,
+                   simplex_facets and msh.geometry.cmap.degree == 1,
+                   "mortar contact needs a mesh of straight (degree-1) triangles or "
+                   "quadrilaterals (2D) or tetrahedra (3D)")
         if formulation is not None:
             enforcement = formulation
         laws.check("enforcement", enforcement, enforcement == "compliance",
@@ -652,10 +693,12 @@ class SegmentToSegment:
         self.step_from = step_from
         self.ds = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags, subdomain_id=slave,
                               metadata=_compat.nodal_quadrature(dim - 1, degree=degree))
-        n = self.normal = self.pairing.normal
+        # the contact normal out of the master body, -n_j, as node-to-segment's: the force on
+        # the slave side is p n + t_T with either formulation
+        n = self.normal = -self.pairing.normal
         G = self.pairing.reference + self.mirrors[u]
-        self.gap = -ufl.dot(n, G)
-        d = self.penetration = laws.penetration(ufl.dot(n, G))
+        self.gap = ufl.dot(n, G)
+        d = self.penetration = laws.penetration(-self.gap)
         w = None
         if velocity is not None:
             unmirrored = set(ufl.algorithms.extract_coefficients(velocity)) - {u, *fields}
@@ -677,25 +720,26 @@ class SegmentToSegment:
                           * self.ds)
         dissipated = 0.0 * d
         if w is not None:
-            dissipated = (self.pressure - self._elastic) * ufl.dot(n, w)
+            dissipated = (self.pressure - self._elastic) * -ufl.dot(w, n)
             if self.traction is not None:
                 dissipated = dissipated - ufl.dot(self.traction, w)
         self.dissipation = weight * covered * dissipated * self.ds
 
     def _force(self, d: typing.Any, n: typing.Any, w: typing.Any) -> typing.Any:
-        """The force on the slave side at penetration ``d``, normal ``n`` and relative
-        velocity ``w`` (None: none), :math:`-p n + t_T`; sets ``pressure`` and
-        ``traction``."""
-        approach = ufl.dot(n, w) if w is not None else 0.0
+        """The force on the slave side at penetration ``d``, contact normal ``n`` (out of
+        the master body) and relative velocity ``w`` (None: none): :math:`p n + t_T`, the
+        approach rate :math:`\\dot d = -w\\cdot n`; sets ``pressure`` and ``traction``."""
+        approach = -ufl.dot(w, n) if w is not None else 0.0
         self.pressure = self.law.normal_traction(d, approach)
         self._elastic = self.law.pressure(d)
         if self.step_from is not None:  # the step's elastic pressure: φ's discrete gradient
             start = self.mirrors[self.step_from]
             G = self.pairing.reference
-            self._elastic = discrete_gradient(
-                self.law, ufl.dot(n, G + start), ufl.dot(n, G + 2 * self.mirrors[self.u] - start))
+            self._elastic = discrete_gradient(  # of the approaches -g = -n·G at both ends
+                self.law, -ufl.dot(n, G + start),
+                -ufl.dot(n, G + 2 * self.mirrors[self.u] - start))
             self.pressure = self.pressure - self.law.pressure(d) + self._elastic
-        force = -self.pressure * n
+        force = self.pressure * n
         self.traction = None
         if self.law.has_friction:
             w_T = w - ufl.dot(w, n) * n
@@ -748,6 +792,18 @@ class SegmentToSegment:
     def commit(self) -> None:
         """Nothing to store between increments (the compliance law has no history)."""
 
+    @property
+    def configuration(self) -> list[fem.Function]:
+        """What the mortar gaps, normals and friction bound are made of: u, its mirror
+        :math:`B u`, the reference :math:`B X`, the slave nodes' normal and covered fraction
+        (:class:`~fenicsfriction.coupling.FrictionBoundCoupling`)."""
+        return [self.u, self.mirrors[self.u], self.pairing.reference, self.pairing.normal,
+                self.pairing.coverage]
+
+    # the bound is found and the form rebuilt as node-to-segment's (``F`` is None here)
+    friction_bound = NodeToSegment.friction_bound
+    with_friction_bound = NodeToSegment.with_friction_bound
+
     def search(self) -> bool:
         """The contact geometry at the current ``u``; True if it changed
         (:meth:`MortarIntegrals.search`)."""
@@ -782,4 +838,10 @@ if typing.TYPE_CHECKING:  # mypy checks that the mortar contact is a Coupling
     from fenicsfriction.coupling import Coupling
 
     def _segment_to_segment_is_a_coupling(contact: SegmentToSegment) -> Coupling:
+        return contact
+
+    from fenicsfriction.coupling import FrictionBoundCoupling
+
+    def _segment_to_segment_has_a_friction_bound(contact: SegmentToSegment
+                                                 ) -> FrictionBoundCoupling:
         return contact

@@ -33,6 +33,7 @@ residual evaluation (finite sliding); ``frozen=True`` keeps it (for derivative t
 
 from __future__ import annotations
 
+import copy
 import functools
 import time
 import typing
@@ -250,6 +251,30 @@ class NodeToSegment:
         """The values of UFL scalars at the slave nodes (compiled once, evaluated on call)."""
         return NodalValues(self, expressions)
 
+    # --- the friction bound, for the Panagiotopoulos process (FrictionBoundCoupling) --------
+    @property
+    def configuration(self) -> list[fem.Function]:
+        """u, its master mirror and the paired master nodes' reference coordinates: what the
+        gap, the normal and the friction bound at each slave node are made of."""
+        return [self.u, self.mirrors[self.u], self.pairing.reference]
+
+    def friction_bound(self) -> typing.Any:
+        """The law's friction bound :math:`c_T d^{m_T}` at the slave nodes (UFL), ``None``
+        without friction or with the perturbed Lagrangian (its bound is not the law's
+        labelled one)."""
+        bounds = [b for form in (self.F, self.G) if form is not None
+                  for b in laws.friction_bounds(form)]
+        return bounds[0] if bounds else None
+
+    def with_friction_bound(self, bound: typing.Any) -> typing.Self:
+        """A copy of this contact whose forms ``F``, ``G`` have ``bound`` (UFL) in place of
+        the friction bound; it shares the pairing and the mirrors with this one."""
+        twin = copy.copy(self)
+        twin.F, twin.G = (None if form is None
+                          else laws.substitute_friction_bound(form, lambda _: bound)
+                          for form in (self.F, self.G))
+        return twin
+
     def frequency_bound(self, lumped_mass: PETSc.Vec) -> float:
         """An upper bound of the contact springs' frequency² on the lumped mass, for linear
         compliance (m_n = 1, the stiffness c_n per unit length/area whatever the
@@ -423,6 +448,10 @@ class ContactOperator:
         #: chained Jacobian (``"jacobian"``: blocks, products, addition), summed over calls
         self.time_s = {"residual": 0.0, "jacobian": 0.0}
 
+    def create_vector(self) -> PETSc.Vec:
+        """A vector of the displacement space's layout, for :meth:`add_to_residual`."""
+        return dolfinx.fem.petsc.create_vector(self.F if self.F is not None else self.G)
+
     def add_to_residual(self, b: PETSc.Vec) -> None:
         """``b += F + Q^T G`` at the current state (the pairing searched first if due)."""
         contact = self.contact
@@ -553,7 +582,10 @@ def solve_with_search(solver: typing.Any, contacts: typing.Sequence[typing.Any],
 
 
 if typing.TYPE_CHECKING:  # mypy checks that the node-to-segment contact is a Coupling
-    from fenicsfriction.coupling import Coupling
+    from fenicsfriction.coupling import Coupling, FrictionBoundCoupling
 
     def _node_to_segment_is_a_coupling(contact: NodeToSegment) -> Coupling:
+        return contact
+
+    def _node_to_segment_has_a_friction_bound(contact: NodeToSegment) -> FrictionBoundCoupling:
         return contact
