@@ -74,6 +74,12 @@ class Coupling(typing.Protocol):
     search_pending: bool
     m_n: typing.Any
 
+    def search(self) -> bool:
+        """Look again, at the current state, for which points the coupling joins (a contact's
+        pairing, a mortar contact's geometry); True if that changed.
+        :meth:`~fenicsfriction.steady.SteadySolver.solve_searched` repeats its solve until a
+        search at the converged state returns False."""
+
     def operator(self, derivatives: dict[fem.Function, typing.Any],
                  rest: typing.Sequence[fem.Function] = (),
                  jit_cache_dir: str | None = None) -> CouplingOperator:

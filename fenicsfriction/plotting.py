@@ -332,15 +332,21 @@ def body_cells(u: fem.Function, cell_tags: typing.Any,
     """Corners, corner displacements and body tag of the 2D cells (triangles) in ``window``
     (x_min, x_max, y_min, y_max; a cell with a corner inside is kept), gathered on rank 0.
 
-    ``u`` is a degree-1 vector Function. Returns ``(X, U, body)`` of shapes (n, 3, 2), (n, 3, 2)
-    and (n,) on rank 0, ``None`` elsewhere.
+    ``u`` is a vector Function (of any degree: its values at the corners are drawn). Returns
+    ``(X, U, body)`` of shapes (n, 3, 2), (n, 3, 2) and (n,) on rank 0, ``None`` elsewhere.
     """
+    from dolfinx import fem
+
+    from fenicsfriction import _compat
+
     msh = u.function_space.mesh
-    V = u.function_space
+    V = _compat.vector_function_space(msh, 1)
+    corners = fem.Function(V)
+    corners.interpolate(u)
     num_cells = msh.topology.index_map(msh.topology.dim).size_local
     dofs = np.array([V.dofmap.cell_dofs(c) for c in range(num_cells)]).reshape(num_cells, -1)
     X = V.tabulate_dof_coordinates()[:, :2][dofs]
-    U = u.x.array.reshape(-1, 2)[dofs]
+    U = corners.x.array.reshape(-1, 2)[dofs]
     body = np.zeros(num_cells, dtype=np.int32)
     tagged = cell_tags.indices < num_cells
     body[cell_tags.indices[tagged]] = cell_tags.values[tagged]

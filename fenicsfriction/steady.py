@@ -109,7 +109,8 @@ class ContinuationError(RuntimeError):
 
 @dataclasses.dataclass
 class SolveReport:
-    """Outcome of one SNES solve (``atol``: the absolute tolerance actually used)."""
+    """Outcome of one solve (``atol``: the absolute tolerance actually used; ``iterations``
+    summed over the ``rounds`` of Newton solves the contact search needed)."""
 
     converged: bool
     reason: str
@@ -117,6 +118,7 @@ class SolveReport:
     residual_norm: float
     wall_time_s: float
     atol: float
+    rounds: int = 1
 
 
 _REASONS = {v: k for k, v in vars(PETSc.SNES.ConvergedReason).items() if not k.startswith("_")}
@@ -151,6 +153,11 @@ class SteadySolver:
             in the PETSc options (``-<prefix>pc_type lu``) overrides it. Where the Jacobian
             splits, the first two assemble the constant bulk once and only the interface at
             each iteration (docs/benchmarks.md has what each costs).
+        search_rounds: how many Newton solves :meth:`solve_searched` (each step of
+            :func:`continuation`) may run until a search of the contact couplings at the
+            converged state keeps their pairing; 1 (default): one solve, no search after it.
+            Mortar contact, whose geometry is held within a solve, needs more wherever the
+            bodies slide between solves (10 for the block on a slab).
 
     Attributes:
         snes: the PETSc SNES, exposed for monitoring or further configuration.
@@ -162,9 +169,13 @@ class SteadySolver:
 
     def __init__(self, residual: Residual, prefix: str = "steady_",
                  options: dict | None = None, jit_cache_dir: str | None = None,
-                 roundoff_safety: float = 1.0, linear_solver: str = "auto"):
+                 roundoff_safety: float = 1.0, linear_solver: str = "auto",
+                 search_rounds: int = 1):
         check("linear_solver", linear_solver, linear_solver in LINEAR_SOLVERS,
               f"use one of {', '.join(LINEAR_SOLVERS)}")
+        check("search_rounds", search_rounds,
+              isinstance(search_rounds, int) and search_rounds >= 1, "an integer >= 1")
+        self.search_rounds = search_rounds
         self.residual = residual
         self.u = residual.u
         t0 = time.perf_counter()
@@ -273,12 +284,58 @@ class SteadySolver:
         self.convergence.jacobian_assembled(A)
 
     def solve(self) -> SolveReport:
-        """Solve from the current ``u``; on failure restore ``u`` and raise :class:`SolveError`."""
-        for coupling in self.couplings:  # the contact pairing, searched at the first residual
+        """Solve from the current ``u``, the contact couplings' pairing searched at the first
+        residual; on failure restore ``u`` and raise :class:`SolveError`."""
+        saved = _compat.petsc_vec(self.u).copy()
+        report = self._newton()
+        if not report.converged:
+            saved.copy(_compat.petsc_vec(self.u))
+            self.u.x.scatter_forward()
+        saved.destroy()
+        if not report.converged:
+            raise SolveError(
+                f"Newton did not converge ({report.reason}) after {report.iterations} "
+                f"iterations, residual norm {report.residual_norm:.3e}; state restored", report)
+        return report
+
+    def solve_searched(self) -> SolveReport:
+        """:meth:`solve`, repeated from its result while a search of the contact couplings at
+        the converged state changes their pairing (up to ``search_rounds`` solves): the state
+        returned is an equilibrium of its own pairing, a fixed point of the search
+        (:func:`fenicsfriction.contact.solve_with_search` for any solver). Mortar contact,
+        whose geometry is held within a solve, needs it wherever the bodies slide between
+        solves (the block on a slab slides 2 cm between continuation steps); node-to-segment
+        contact recomputes its projections within the solve. :func:`continuation` solves so.
+
+        Raises:
+            SolveError: a solve failed (``u`` is the last converged round's, or the start), or
+                the pairing still changed after ``search_rounds`` solves.
+        """
+        if self.search_rounds == 1:
+            return self.solve()
+        t0 = time.perf_counter()
+        iterations = 0
+        for rounds in range(1, self.search_rounds + 1):
+            try:
+                report = self.solve()
+            except SolveError as err:
+                err.report.iterations += iterations
+                raise
+            iterations += report.iterations
+            report.iterations, report.rounds = iterations, rounds
+            report.wall_time_s = time.perf_counter() - t0
+            # every coupling searches (collectively), whether or not another changed
+            changed = [coupling.contact.search() for coupling in self.couplings]
+            if not any(changed):
+                return report
+        raise SolveError(f"contact search: the pairing still changed after "
+                         f"{self.search_rounds} Newton solves (search_rounds)", report)
+
+    def _newton(self) -> SolveReport:
+        """One SNES solve from the current ``u``; ``u`` takes the result if it converged."""
+        for coupling in self.couplings:
             coupling.contact.search_pending = True
-        u_vec = _compat.petsc_vec(self.u)
-        u_vec.copy(self.x)
-        saved = u_vec.copy()
+        _compat.petsc_vec(self.u).copy(self.x)
         t0 = time.perf_counter()
         self.snes.solve(None, self.x)
         reason = self.snes.getConvergedReason()
@@ -287,18 +344,9 @@ class SteadySolver:
             iterations=self.snes.getIterationNumber(),
             residual_norm=float(self.snes.getFunctionNorm()),
             wall_time_s=time.perf_counter() - t0, atol=self.convergence.atol_used)
-        finite = np.isfinite(report.residual_norm)
-        if report.converged and finite:
+        report.converged = report.converged and bool(np.isfinite(report.residual_norm))
+        if report.converged:
             self._update(self.x)
-        else:
-            saved.copy(u_vec)
-            self.u.x.scatter_forward()
-            report.converged = False
-        saved.destroy()
-        if not report.converged:
-            raise SolveError(
-                f"Newton did not converge ({report.reason}) after {report.iterations} "
-                f"iterations, residual norm {report.residual_norm:.3e}; state restored", report)
         return report
 
 
@@ -310,7 +358,8 @@ def continuation(solver: SteadySolver, parameter: fem.Constant, targets: typing.
     """Step ``parameter`` through ``targets``, solving at each value.
 
     Args:
-        solver: the steady solver (its ``u`` is the warm start and holds the result).
+        solver: the steady solver (its ``u`` is the warm start and holds the result); a
+            :class:`SteadySolver` solves each step with :meth:`SteadySolver.solve_searched`.
         parameter: the ``fem.Constant`` being continued (e.g. the friction coefficient).
         targets: the values to reach, in order; each one reached produces one record.
         observe: returns extra quantities recorded at each converged target, a dict or a
@@ -331,6 +380,9 @@ def continuation(solver: SteadySolver, parameter: fem.Constant, targets: typing.
             ``parameter`` keep the last converged state, ``error.records`` the steps so far.
     """
     check("predictor", predictor, predictor in ("secant", "none"), "use 'secant' or 'none'")
+    # a SteadySolver's solves are repeated until the contact search holds; another solver
+    # (the Panagiotopoulos process) searches in its own iterations
+    solve = getattr(solver, "solve_searched", solver.solve)
     records: list[dict] = []
     current = float(parameter.value)
     u_vec = _compat.petsc_vec(solver.u)
@@ -351,7 +403,7 @@ def continuation(solver: SteadySolver, parameter: fem.Constant, targets: typing.
                     u_vec.axpy(1.0, converged)
                     solver.u.x.scatter_forward()
                 try:
-                    report = solver.solve()
+                    report = solve()
                 except SolveError as err:
                     iterations += err.report.iterations
                     parameter.value = current

@@ -182,7 +182,10 @@ def test_cattaneo_eps_sequence_against_cattaneo_mindlin(shared_tmp_path):
     (["patch", "--n-upper", "0"], "--n-upper"),
     (["cattaneo", "--q-ratio", "1.5"], "--q-ratio"),
     (["cattaneo", "--eps-sequence", "1e-5,-1"], "--eps-sequence"),
-    (["cattaneo", "--increments", "0"], "--increments")])
+    (["cattaneo", "--increments", "0"], "--increments"),
+    (["hertz", "--degree", "2"], "--degree"),  # degree 2 is mortar's
+    (["cattaneo", "--formulation", "mortar", "--enforcement", "perturbed-lagrangian"],
+     "--enforcement")])
 def test_bad_value_is_one_line_naming_the_flag_and_exit_2(shared_tmp_path, capsys, argv, name):
     code = main(["contact", *argv, "--out", str(shared_tmp_path / "bad")])
     assert code == 2
@@ -215,8 +218,21 @@ def test_bad_value_from_a_shell_is_one_stderr_line(tmp_path, args, name):
     assert "Traceback" not in result.stderr and name in lines[0]
 
 
+def test_formulation_compliance_points_to_enforcement_in_one_line(shared_tmp_path, capsys):
+    """``--formulation`` chose the law's enforcement before it chose the discretisation: the
+    old value is answered with the flag that takes it now."""
+    with pytest.raises(SystemExit) as stop:
+        main(["contact", "cattaneo", "--formulation", "perturbed-lagrangian",
+              "--out", str(shared_tmp_path / "bad")])
+    assert stop.value.code == 2
+    lines = capsys.readouterr().err.splitlines()
+    assert len(lines) == 1 and "--enforcement perturbed-lagrangian" in lines[0], lines
+
+
 @pytest.mark.parametrize("argv", [["contact", "--help"], ["contact", "cattaneo", "--help"],
-                                  ["contact", "hertz", "--c-n", "x", "--out", "o"]])
+                                  ["contact", "hertz", "--c-n", "x", "--out", "o"],
+                                  ["contact", "patch", "--formulation", "compliance",
+                                   "--out", "o"]])
 def test_contact_help_and_flag_errors_import_no_solver(argv):
     """As for the other commands, argparse alone answers: no MPI, PETSc or dolfinx import."""
     script = ("import sys\nfrom fenicsfriction.cli import main\ntry:\n"

@@ -168,7 +168,7 @@ def test_perturbed_lagrangian_approaches_the_compliance_law_as_its_penalty_grows
     scale = np.abs(reference.traction).max()
     distances = []
     for penalty_T in (1e2, 1e3):
-        _, model = Cattaneo(formulation="perturbed-lagrangian", penalty_T=penalty_T,
+        _, model = Cattaneo(enforcement="perturbed-lagrangian", penalty_T=penalty_T,
                             **common).run()
         values = model.surface_values()
         # the same normal penalty; the tangential law moves the approach by ~1e-3

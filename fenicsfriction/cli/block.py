@@ -29,6 +29,8 @@ __all__ = ["add_parser", "run_dynamics", "run_stability", "run_steady"]
 
 #: the scenes, read from the library when a value is checked or the help printed
 _SCENES = LazyChoices("fenicsfriction.studies.block.slab", "SCENES")
+#: the block-slab contact's discretisations, likewise
+_FORMULATIONS = LazyChoices("fenicsfriction.studies.block.slab", "FORMULATIONS")
 
 
 def _scene_flag(parser: argparse.ArgumentParser) -> None:
@@ -46,7 +48,8 @@ def _continuation_flags() -> argparse.ArgumentParser:
     flags.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
     flags.add_argument("--refine", type=int, default=1, help="mesh refinement (4r × 3r cells)")
     flags.add_argument("--degree", type=int,
-                       help="Lagrange degree (block: 2, Q2; block-on-slab: 1, the only one)")
+                       help="Lagrange degree (block: 2, Q2; block-on-slab: 1, or 2 with "
+                            "--formulation mortar)")
     flags.add_argument("--E", type=float, help="Young's modulus [10³ kg cm⁻¹ s⁻²] (1.4e6)")
     flags.add_argument("--B0", type=float, help="breadth out of the plane [cm] (30.5)")
     flags.add_argument("--K-x", type=float, dest="K_x", help="driver spring [10³ kg s⁻²] (11.1)")
@@ -56,8 +59,8 @@ def _continuation_flags() -> argparse.ArgumentParser:
     flags.add_argument("--eps", type=float, help="regularisation ε [cm/s] (1e-3)")
     flags.add_argument("--regularisation", help="c1 or smooth (c1)")
     flags.add_argument("--contact-quadrature",
-                       help="gauss, gll or nodal (block: gauss; block-on-slab: nodal, its only "
-                            "rule)")
+                       help="gauss, gll or nodal (block: gauss; block-on-slab: nodal, the "
+                            "contact's own rule)")
     _slab_flags(flags)
     flags.add_argument("--max-halvings", type=int, default=8,
                        help="step halvings allowed when a continuation step fails")
@@ -67,6 +70,9 @@ def _continuation_flags() -> argparse.ArgumentParser:
 def _slab_flags(parser: argparse.ArgumentParser) -> None:
     """The slab's fields of the scene block-on-slab (None: the scene's defaults)."""
     slab = parser.add_argument_group("block-on-slab (the elastic belt)")
+    slab.add_argument("--formulation", choices=_FORMULATIONS,
+                      help="the block-slab contact: node-to-segment (nodal rule) or mortar "
+                           "(segment-to-segment integration; degree 1 or 2) (node-to-segment)")
     slab.add_argument("--slab-E", type=float, dest="slab_E",
                       help="the slab's Young's modulus [10³ kg cm⁻¹ s⁻²] (the block's E)")
     slab.add_argument("--slab-nu", type=float, help="the slab's Poisson's ratio (the block's ν)")
@@ -77,7 +83,8 @@ def _slab_flags(parser: argparse.ArgumentParser) -> None:
 
 
 #: the flags of :func:`_slab_flags`, which only the scene block-on-slab accepts
-SLAB_FLAGS = ("slab_E", "slab_nu", "slab_thickness", "slab_length", "slab_density")
+SLAB_FLAGS = ("formulation", "slab_E", "slab_nu", "slab_thickness", "slab_length",
+              "slab_density")
 
 
 def add_parser(commands: typing.Any) -> None:
@@ -130,6 +137,8 @@ def add_parser(commands: typing.Any) -> None:
     dynamics.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
     for flag, dest, kind, text in (
             ("--refine", "refine", int, "mesh refinement (1)"),
+            ("--degree", "degree", int, "Lagrange degree (block: 2; block-on-slab: 1, or 2 "
+                                        "with --formulation mortar)"),
             ("--belt-speed", "belt_speed", float, "belt speed [cm/s] (0.287)"),
             ("--b-n", "b_n", float, "normal damping [10³ kg cm^(-2-l_n) s⁻¹] (0)"),
             ("--K-x", "K_x", float, "driver spring [10³ kg s⁻²] (11.1)"),
@@ -152,7 +161,8 @@ def _scene(args: argparse.Namespace, **fixed: typing.Any) -> BlockOnBelt:
     for name in SLAB_FLAGS:
         given = getattr(args, name, None)
         check(flag(name), given, given is None or name in names,
-              f"the scene {args.scene} has no slab (use block-on-slab)")
+              f"the scene {args.scene} has no slab and no two-body contact (use "
+              "block-on-slab)")
     return scene_from_flags(scene_cls, args, **fixed)
 
 
@@ -173,7 +183,8 @@ def _build(args: argparse.Namespace) -> tuple[BlockOnBelt, BlockModel, SteadySol
     output_folder(args.out)
     model = scene.build(MPI.COMM_WORLD, with_friction=args.mu_max > 0)
     model.initial_guess()
-    solver = SteadySolver(model.residual, prefix="steady_", options=model.solver_options())
+    solver = SteadySolver(model.residual, prefix="steady_", options=model.solver_options(),
+                          search_rounds=model.search_rounds)
     return scene, model, solver, np.linspace(0.0, args.mu_max, args.steps + 1)
 
 
@@ -370,7 +381,8 @@ def run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
     out = output_folder(args.out)
     model = scene.build(comm)
     model.initial_guess()
-    steady = SteadySolver(model.residual, prefix="steady_", options=model.solver_options())
+    steady = SteadySolver(model.residual, prefix="steady_", options=model.solver_options(),
+                          search_rounds=model.search_rounds)
     model.slide_to(args.mu, steady)
     model.perturb_normal_velocity(args.perturbation)
     dynamics: CentralDifference | DynamicsSolver

@@ -1,6 +1,6 @@
-"""``fenicsfriction contact hertz|patch|cattaneo``: two elastic bodies in node-to-segment
-contact, each scene against its closed form (Hertz 1882; Taylor & Papadopoulos 1991's patch
-test; Cattaneo 1938 and Mindlin 1949).
+"""``fenicsfriction contact hertz|patch|cattaneo``: two elastic bodies in contact
+(node-to-segment or mortar, ``--formulation``), each scene against its closed form (Hertz
+1882; Taylor & Papadopoulos 1991's patch test; Cattaneo 1938 and Mindlin 1949).
 
 Each command writes to ``--out``: ``contact.json`` (the scene's summary), ``surface.csv`` (the
 slave surface's nodal values beside the closed forms), ``pressure.png``, ``deformed.png`` (2D),
@@ -33,6 +33,24 @@ __all__ = ["add_parser", "run_contact"]
 #: the logger of the model, whose debug line reports each solve of the load's approach
 _MODEL_LOGGER = "fenicsfriction.studies.contact.model"
 
+#: the contact's discretisations (:data:`fenicsfriction.contact.FORMULATIONS`, spelled here so
+#: that parsing the flags imports no dolfinx) and the enforcements of node-to-segment's law
+_FORMULATIONS = ("node-to-segment", "mortar")
+_ENFORCEMENTS = ("compliance", "perturbed-lagrangian")
+
+
+def _formulation(text: str) -> str:
+    """``--formulation``'s value; the law's enforcement, which this flag chose before, is
+    pointed to ``--enforcement``."""
+    if text in _ENFORCEMENTS:
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is an enforcement of the law now: use --enforcement {text} "
+            f"(--formulation is {' or '.join(_FORMULATIONS)})")
+    if text not in _FORMULATIONS:
+        raise argparse.ArgumentTypeError(
+            f"invalid choice: {text!r} (choose from {', '.join(_FORMULATIONS)})")
+    return text
+
 
 def _bodies_flags() -> argparse.ArgumentParser:
     """The two bodies and their interface law, shared by the contact scenes (None: the scene's
@@ -46,6 +64,14 @@ def _bodies_flags() -> argparse.ArgumentParser:
                        ("--c-n", "normal compliance coefficient: p = c_n d^m_n (1e4)"),
                        ("--m-n", "normal compliance exponent, >= 1 (1: a linear penalty)")):
         group.add_argument(flag, type=float, dest=flag[2:].replace("-", "_"), help=text)
+    discretisation = flags.add_argument_group("the contact's discretisation")
+    discretisation.add_argument(
+        "--formulation", type=_formulation, metavar="{" + ",".join(_FORMULATIONS) + "}",
+        help="node-to-segment (slave nodes on master segments, nodal rule) or mortar (the law "
+             "on mortar-weighted gaps, segment-to-segment integration) (node-to-segment)")
+    discretisation.add_argument("--degree", type=int, choices=[1, 2],
+                                help="Lagrange degree of the displacement; 2 needs "
+                                     "--formulation mortar (1)")
     flags.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
     return flags
 
@@ -63,7 +89,8 @@ def _hertz_flags(parser: argparse.ArgumentParser) -> None:
 def add_parser(commands: typing.Any) -> None:
     """``contact hertz|patch|cattaneo``: the two-body validation scenes."""
     contact = commands.add_parser(
-        "contact", help="two elastic bodies in node-to-segment contact, against closed forms",
+        "contact", help="two elastic bodies in contact (node-to-segment or mortar), against "
+                        "closed forms",
         description="Validation scenes of two-body contact: Hertz (2D cylinder, 3D sphere), "
                     "the contact patch test and Cattaneo-Mindlin's partial slip; each writes "
                     "contact.json, surface.csv, figures and bodies.xdmf to --out. PETSc "
@@ -107,10 +134,10 @@ def add_parser(commands: typing.Any) -> None:
     cattaneo.add_argument("--eps-sequence", type=floats, metavar="E1,E2,...",
                           help="Kalker's sequential process: the tangential loading again for "
                                "each ε (replaces --eps)")
-    cattaneo.add_argument("--formulation", choices=["compliance", "perturbed-lagrangian"],
-                          help="the contact law: normal compliance with regularised friction, "
-                               "or Pop's perturbed Lagrangian (penalties c_n and --penalty-T) "
-                               "(compliance)")
+    cattaneo.add_argument("--enforcement", choices=_ENFORCEMENTS,
+                          help="how the law is enforced: normal compliance with regularised "
+                               "friction, or Pop's perturbed Lagrangian (penalties c_n and "
+                               "--penalty-T; node-to-segment only) (compliance)")
     cattaneo.add_argument("--penalty-T", dest="penalty_T", type=float,
                           help="tangential penalty of the perturbed Lagrangian "
                                "[force/length^3] (1e4)")
@@ -143,6 +170,10 @@ def _solve_lines(comm: MPI.Comm) -> typing.Iterator[None]:
         logger.setLevel(level)
 
 
+def _discretisation(scene: typing.Any) -> str:
+    return f"{scene.formulation} contact, degree {scene.degree}"
+
+
 def _percent(value: float, reference: float) -> str:
     return f"{value:.5g} (closed form {reference:.5g}, {100 * (value / reference - 1):+.2f} %)"
 
@@ -150,12 +181,18 @@ def _percent(value: float, reference: float) -> str:
 def _write_fields(path: pathlib.Path, model: TwoBodyModel) -> None:
     """The displacement with the cell (body) and facet (surface) tags, for ParaView
     (collective)."""
-    from dolfinx import io
+    from dolfinx import fem, io
 
     from fenicsfriction import _compat
 
     geometry = model.geometry
     msh = geometry.mesh
+    u = model.u
+    if _compat.element_degree(u.function_space) != 1:
+        # XDMF holds fields of the mesh's coordinate degree (1): the quadratic displacement
+        # at the vertices
+        u = fem.Function(_compat.vector_function_space(msh, 1), name=model.u.name)
+        u.interpolate(model.u)
     msh.topology.create_connectivity(msh.topology.dim - 1, msh.topology.dim)
     geometry.cell_tags.name = "bodies"
     geometry.facet_tags.name = "surfaces"
@@ -163,7 +200,7 @@ def _write_fields(path: pathlib.Path, model: TwoBodyModel) -> None:
         xdmf.write_mesh(msh)
         _compat.write_meshtags(xdmf, geometry.cell_tags, msh)
         _compat.write_meshtags(xdmf, geometry.facet_tags, msh)
-        xdmf.write_function(model.u, 0.0)
+        xdmf.write_function(u, 0.0)
 
 
 def _surface_rows(values: typing.Any, columns: dict[str, np.ndarray], dim: int,
@@ -219,7 +256,8 @@ def _run_hertz(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) ->
     width = "half_width" if scene.dim == 2 else "contact_radius"
     log.info(f"hertz {scene.dim}D: {model.dofs} dofs on {comm.size} rank(s), load "
              f"{scene.load:.6g} ({'per unit length' if scene.dim == 2 else 'total'}), "
-             f"{scene.passes} pass(es); Hertz: {width.replace('_', ' ')} {a:.6g}, peak "
+             f"{scene.passes} pass(es), {_discretisation(scene)}; Hertz: "
+             f"{width.replace('_', ' ')} {a:.6g}, peak "
              f"pressure {p0:.6g}" + ("; a quarter model: each solve's force and load below "
                                      "are a quarter of the total" if scene.dim == 3 else ""))
     try:
@@ -228,9 +266,13 @@ def _run_hertz(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) ->
     except RuntimeError as err:
         return _failed(out, "hertz", scene, err, comm)
     results.write_summary(out / "contact.json", summary, comm)
+    fitted = summary[f"fitted_{width}"], summary["fitted_max_pressure"]
     log.info(f"{width.replace('_', ' ')} {_percent(summary[width], a)}; peak pressure "
-             f"{_percent(summary['max_pressure'], p0)}; {summary['newton_iterations']} Newton "
-             f"iterations in {summary['solves']} solves, {summary['wall_time_s']:.1f} s")
+             f"{_percent(summary['max_pressure'], p0)}; Hertz's ellipse fitted to the nodal "
+             "pressures: " + (f"{_percent(fitted[0], a)}, {_percent(fitted[1], p0)}"
+                              if fitted[0] is not None else "none")
+             + f"; {summary['newton_iterations']} Newton iterations in {summary['solves']} "
+             f"solves, {summary['wall_time_s']:.1f} s")
     _hertz_outputs(scene, summary, model, out, comm, log)
     return 0
 
@@ -254,8 +296,8 @@ def _run_cattaneo(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm)
     model = scene.build(comm)
     log.info(f"cattaneo: {model.dofs} dofs on {comm.size} rank(s), load {scene.load:.6g} per "
              f"unit length, μ = {scene.law.mu:g}, Q to {scene.q_ratio:g} μP in "
-             f"{scene.increments} increments, ε = {sequence if sequence else scene.law.eps}; "
-             f"Hertz half-width {a:.6g}")
+             f"{scene.increments} increments, ε = {sequence if sequence else scene.law.eps}, "
+             f"{_discretisation(scene)}; Hertz half-width {a:.6g}")
     tractions: list[tuple[np.ndarray, str]] = []
     counts: dict[float, int] = {}
 
@@ -309,7 +351,8 @@ def _run_patch(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) ->
     summaries, models = {}, {}
     for name, scene in scenes.items():
         log.info(f"patch {scene.dim}D, {name.replace('_', ' ')}: pressure {scene.pressure:g}, "
-                 f"{scene.n_upper} and {scene.n_lower} elements across the blocks")
+                 f"{scene.n_upper} and {scene.n_lower} elements across the blocks, "
+                 f"{_discretisation(scene)}")
         try:
             with _solve_lines(comm):
                 summaries[name], models[name] = scene.run(comm)

@@ -50,13 +50,14 @@ from fenicsfriction.assembly import assemble_into, assemble_owned
 from fenicsfriction.contact.kinematics import Projection, project
 from fenicsfriction.contact.pairing import Pairing, facet_nodes
 
-__all__ = ["FORMULATIONS", "ContactOperator", "NodalValues", "NodeToSegment",
+__all__ = ["ENFORCEMENTS", "ContactOperator", "NodalValues", "NodeToSegment",
            "discrete_gradient", "solve_with_search"]
 
-#: the contact laws: ``"compliance"`` (normal compliance, friction regularised on the slip
-#: rate: Martins & Oden 1986) and ``"perturbed-lagrangian"`` (Pop, eq. 27: normal and
-#: tangential penalties κ_N = c_n, κ_T with their multipliers eliminated node by node)
-FORMULATIONS = ("compliance", "perturbed-lagrangian")
+#: how the law is enforced at the slave nodes: ``"compliance"`` (normal compliance, friction
+#: regularised on the slip rate: Martins & Oden 1986) and ``"perturbed-lagrangian"`` (Pop,
+#: eq. 27: normal and tangential penalties κ_N = c_n, κ_T with their multipliers eliminated
+#: node by node)
+ENFORCEMENTS = ("compliance", "perturbed-lagrangian")
 
 Value = typing.Any
 
@@ -81,7 +82,7 @@ class NodeToSegment:
         transport: the master body's rigid velocity :math:`U_T` (a vector; default zero).
         weight: the factor of the term (1/2 for each pass of two-pass contact).
         frozen: keep the pairing of the first search (derivative tests).
-        formulation: one of :data:`FORMULATIONS`. The perturbed Lagrangian's multipliers
+        enforcement: one of :data:`ENFORCEMENTS`. The perturbed Lagrangian's multipliers
             are nodal and enter their own equations quadratically, so they are eliminated at
             each slave node: λ_N = κ_N (-g)_+ (linear compliance, ``c_n`` = κ_N, m_n = 1) and
             λ_T = κ_T times the slip increment from the last committed λ_T (:meth:`commit`),
@@ -121,7 +122,7 @@ class NodeToSegment:
                  law: laws.InterfaceLaw, velocity: typing.Any = None,
                  fields: typing.Sequence[fem.Function] = (), transport: typing.Any = None,
                  weight: float = 1.0, frozen: bool = False, search: str = "solve",
-                 formulation: str = "compliance", penalty_T: Value | None = None,
+                 enforcement: str = "compliance", penalty_T: Value | None = None,
                  time_step: Value = 1.0, step_from: fem.Function | None = None):
         V = u.function_space
         msh = V.mesh
@@ -132,14 +133,14 @@ class NodeToSegment:
             count = msh.comm.allreduce(int(np.count_nonzero(facet_tags.values == tag)))
             laws.check(name, tag, count > 0, "a facet tag present in facet_tags")
         laws.check("search", search, search in ("solve", "residual"), "'solve' or 'residual'")
-        laws.check("formulation", formulation, formulation in FORMULATIONS,
-                   f"one of {', '.join(FORMULATIONS)}")
-        if formulation == "perturbed-lagrangian":
+        laws.check("enforcement", enforcement, enforcement in ENFORCEMENTS,
+                   f"one of {', '.join(ENFORCEMENTS)}")
+        if enforcement == "perturbed-lagrangian":
             laws.check("m_n", law.m_n, law.m_n == 1, "the perturbed Lagrangian's normal "
                        "penalty is linear: m_n = 1 (c_n is the penalty eps_N)")
             laws.check("penalty_T", penalty_T, penalty_T is not None,
                        "the tangential penalty (> 0)")
-        self.formulation = formulation
+        self.enforcement = enforcement
         #: the tangential multiplier of the last committed increment (perturbed Lagrangian)
         self.traction_old = fem.Function(V, name="tangential_multiplier")
         self.u, self.V = u, V
@@ -189,7 +190,7 @@ class NodeToSegment:
             laws.check("velocity", velocity, w is not None,
                        "friction (mu != 0) needs the slave velocity")
             w_T = w - ufl.dot(w, n) * n
-            if formulation == "compliance":
+            if enforcement == "compliance":
                 self.traction = law.friction_traction(d, w_T)
             else:
                 self.traction = self._stick_penalty(d, w_T * time_step, n, penalty_T)
@@ -309,7 +310,7 @@ class NodeToSegment:
     def commit(self) -> None:
         """Store the tangential multipliers of the current state as the last increment's
         (perturbed Lagrangian; call after each converged increment)."""
-        if self.formulation != "perturbed-lagrangian" or self.traction is None:
+        if self.enforcement != "perturbed-lagrangian" or self.traction is None:
             return
         self.update(search=False)
         nodal = self._committed_traction()

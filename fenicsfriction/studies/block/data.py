@@ -183,6 +183,11 @@ class BlockOnBelt(BlockData):
               "must be an even integer >= 2")
         check("contact_quadrature", self.contact_quadrature,
               self.contact_quadrature in QUADRATURE, f"must be one of {sorted(QUADRATURE)}")
+        self.check_contact_rule()
+
+    def check_contact_rule(self) -> None:
+        """Raise ``ValueError`` if ``contact_quadrature`` does not fit the elements: the
+        nodal rule is the trapezoidal rule on degree-1 facets in 2D."""
         check("contact_quadrature", self.contact_quadrature,
               self.contact_quadrature != "nodal" or (self.degree == 1 and self.dim == 2),
               "the nodal rule is for degree 1 in 2D (trapezoidal on the facets' vertices)")

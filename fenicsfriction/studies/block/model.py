@@ -81,6 +81,8 @@ class BlockModel:
     """
 
     CONTACT = CONTACT
+    #: the steady solver's ``search_rounds`` for this model's contact couplings (none here)
+    search_rounds = 1
 
     def __init__(self, scene: BlockOnBelt, comm: MPI.Comm, with_friction: bool | None):
         """Mesh the block, tag its faces and assemble the residual's UFL terms.

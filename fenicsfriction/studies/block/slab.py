@@ -3,8 +3,10 @@ r"""The block of Martins & Oden (1986) on an elastic belt: its data.
 The block, its interface law, its weight and its driver spring are those of
 :class:`~fenicsfriction.studies.block.BlockOnBelt` (every field kept and validated alike); the
 rigid belt is replaced by a deformable slab, a second body in the same mesh, and the contact
-between them is two-body node-to-segment contact (Pop) carrying the same law of
-Martins & Oden (1986): the block's bottom is the slave surface, the slab's top the master.
+between them is two-body contact carrying the same law of Martins & Oden (1986): the block's
+bottom is the slave surface, the slab's top the master. ``formulation`` chooses its
+discretisation (:func:`fenicsfriction.contact.make_contact`): node-to-segment (Pop; the
+default) or mortar (the law on mortar-weighted gaps, segment-to-segment integration).
 
 Modelling choices, changeable through the fields where they are numbers:
 
@@ -24,10 +26,13 @@ Modelling choices, changeable through the fields where they are numbers:
   reproduces the one-body block on a rigid belt (tested). ``slab_thickness`` = 10 cm (about
   H/3), ``slab_length`` = 3 L centred under the block (a slab edge one block length away from
   each block corner), ``slab_density`` = the block's (M / (L H B0)).
-* **The block is degree 1 with the nodal contact rule.** Node-to-segment contact needs
-  degree-1 Lagrange elements; the slave side integrates with the nodal (trapezoidal) rule,
-  so the one-body reference is ``BlockOnBelt(degree=1, contact_quadrature="nodal")`` (not
-  ``"gll"``, which FFCx evaluates with five points per facet on Q1).
+* **Degree and contact rule.** Node-to-segment contact needs degree-1 Lagrange elements
+  (``degree`` = 1, the default); mortar contact takes degree 1 or 2 (nine-node Q2). Either
+  applies the law at the slave nodes, each carrying its tributary length (the contact's
+  nodal measure), so ``contact_quadrature`` is ``"nodal"`` whatever the degree. With
+  node-to-segment the one-body reference is ``BlockOnBelt(degree=1,
+  contact_quadrature="nodal")`` (not ``"gll"``, which FFCx evaluates with five points per
+  facet on Q1); ``docs/block-on-slab.md`` compares mortar with the one-body Q2 block.
 * **Mesh.** Both bodies are quadrilaterals of one mesh, disjoint (the block's bottom and the
   slab's top both at y = 0, with their own nodes). Under the block the slab's columns have the
   block's width L / (4 r); beyond it ``ceil(overhang / (2 h))`` columns of about twice that;
@@ -49,7 +54,12 @@ if typing.TYPE_CHECKING:
 
     from fenicsfriction.studies.block.slab_model import SlabModel
 
-__all__ = ["BLOCK", "SCENES", "SLAB", "SLAB_BOTTOM", "SLAB_SIDES", "SLAB_TOP", "BlockOnSlab"]
+#: the block-slab contact's discretisations (those of
+#: :data:`fenicsfriction.contact.FORMULATIONS`, which needs dolfinx to import)
+FORMULATIONS = ("node-to-segment", "mortar")
+
+__all__ = ["BLOCK", "FORMULATIONS", "SCENES", "SLAB", "SLAB_BOTTOM", "SLAB_SIDES", "SLAB_TOP",
+           "BlockOnSlab"]
 
 #: cell tags of the two bodies
 BLOCK, SLAB = 1, 2
@@ -67,11 +77,15 @@ class BlockOnSlab(BlockOnBelt):
         slab_thickness: the slab's thickness t [cm].
         slab_length: the slab's length [cm], > L, centred under the block (None: 3 L).
         slab_density: the slab's mass density [10^3 kg cm^-3] (None: the block's).
-        Other parameters: see :class:`BlockOnBelt`; ``degree`` must be 1 and ``dim`` 2.
+        formulation: the block-slab contact's discretisation, ``"node-to-segment"`` or
+            ``"mortar"``.
+        Other parameters: see :class:`BlockOnBelt`; ``degree`` 1 (or 2 with mortar),
+        ``dim`` 2.
     """
 
     degree: int = 1
     contact_quadrature: str = "nodal"
+    formulation: str = "node-to-segment"
     slab_E: float = None  # type: ignore[assignment]  # None: set by __post_init__
     slab_nu: float = None  # type: ignore[assignment]
     slab_thickness: float = 10.0
@@ -91,12 +105,13 @@ class BlockOnSlab(BlockOnBelt):
 
     def validate(self) -> None:
         super().validate()
-        check("degree", self.degree, self.degree == 1,
-              "must be 1: node-to-segment contact needs degree-1 elements")
+        check("formulation", self.formulation, self.formulation in FORMULATIONS,
+              f"one of {', '.join(FORMULATIONS)}")
+        check("degree", self.degree, self.degree in (1, 2) and (
+            self.degree == 1 or self.formulation == "mortar"),
+              "must be 1, or 2 with the mortar formulation (node-to-segment contact needs "
+              "degree-1 elements)")
         check("dim", self.dim, self.dim == 2, "must be 2 (the slab scene is plane strain)")
-        check("contact_quadrature", self.contact_quadrature,
-              self.contact_quadrature == "nodal",
-              "must be nodal: node-to-segment contact integrates the slave surface so")
         for name in ("slab_E", "slab_thickness", "slab_density"):
             value = getattr(self, name)
             check(name, value, bool(np.isfinite(value)) and value > 0,
@@ -106,6 +121,11 @@ class BlockOnSlab(BlockOnBelt):
         check("slab_length", self.slab_length,
               bool(np.isfinite(self.slab_length)) and self.slab_length > self.L,
               f"must be a finite number > L = {self.L}")
+
+    def check_contact_rule(self) -> None:
+        check("contact_quadrature", self.contact_quadrature,
+              self.contact_quadrature == "nodal",
+              "must be nodal: the two-body contact integrates the slave surface so")
 
     @property
     def discrete_tipping_limit(self) -> float:

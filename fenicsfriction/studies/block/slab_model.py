@@ -3,22 +3,26 @@ r"""The block on an elastic slab as a finite element model: the one-body
 replaced.
 
 Both bodies live in one quadrilateral mesh (cell tags ``BLOCK`` and ``SLAB``); the block's
-bottom (facet tag ``CONTACT``) is the slave surface of a
-:class:`~fenicsfriction.contact.NodeToSegment` contact whose master is the slab's top
-(``SLAB_TOP``); the slab's bottom (``SLAB_BOTTOM``) is clamped to the carrier. The residual is
-the block's (inertia, elasticity and weight over the block's cells, the driver spring), the
-slab's inertia and elasticity over its cells, and the contact as a coupling of the
-:class:`~fenicsfriction.forms.Residual`; the solvers chain it through the pairing.
+bottom (facet tag ``CONTACT``) is the slave surface of a two-body contact
+(:func:`~fenicsfriction.contact.make_contact`: node-to-segment or mortar, the scene's
+``formulation``) whose master is the slab's top (``SLAB_TOP``); the slab's bottom
+(``SLAB_BOTTOM``) is clamped to the carrier. The residual is the block's (inertia, elasticity
+and weight over the block's cells, the driver spring), the slab's inertia and elasticity over
+its cells, and the contact as a coupling of the :class:`~fenicsfriction.forms.Residual`; the
+solvers chain it through the pairing.
 
 Everything the block model reads off a state refers to the block: the resultants of the
-contact tractions on its bottom (integrated with the contact's nodal rule), its centre of mass,
-its contact nodes' states and probe. The energies are those of both bodies (the energy balance
+contact tractions on its bottom (integrated with the contact's nodal measure), its centre of
+mass, its contact nodes' states and probe, all read through the contact's public attributes
+(``penetration``, ``normal``, ``relative_velocity``, ``nodal_values``), whichever the
+formulation. The energies are those of both bodies (the energy balance
 of the dynamics needs the slab's strain and kinetic energy) and the interface powers are those
 of the contact forces on both bodies.
 """
 
 from __future__ import annotations
 
+import functools
 import typing
 
 from mpi4py import MPI
@@ -28,8 +32,7 @@ import ufl
 from dolfinx import fem, mesh
 
 from fenicsfriction import _compat, laws
-from fenicsfriction.contact import NodeToSegment
-from fenicsfriction.contact.pairing import surface_coordinates
+from fenicsfriction.contact import make_contact
 from fenicsfriction.forms import elasticity, inertia
 from fenicsfriction.meshing import vertex_rows
 from fenicsfriction.studies.block.data import CONTACT, LEFT, RIGHT, TOP
@@ -65,7 +68,7 @@ def slab_arrays(scene: BlockOnSlab) -> tuple[np.ndarray, np.ndarray, int]:
     nx, ny = 4 * s.refine, 3 * s.refine
     h = s.L / nx
     x_block = np.linspace(0.0, s.L, nx + 1)
-    rows = vertex_rows(ny, 1, s.H, s.spring_height)
+    rows = vertex_rows(ny, s.degree, s.H, s.spring_height)
     overhang = (s.slab_length - s.L) / 2
     n_side = max(1, int(np.ceil(overhang / (2 * h))))
     left = np.linspace(-overhang, 0.0, n_side + 1)
@@ -82,12 +85,16 @@ class SlabModel(BlockModel):
 
     Attributes (besides the block's):
         cell_tags: ``BLOCK`` and ``SLAB`` cells.
-        contact: the :class:`~fenicsfriction.contact.NodeToSegment` block-slab contact.
-        ds_contact: the contact's measure on the block's bottom (nodal rule).
+        contact: the block-slab contact (:func:`~fenicsfriction.contact.make_contact`).
+        ds_contact: the contact's nodal measure on the block's bottom.
     """
 
     CONTACT = CONTACT
     scene: BlockOnSlab
+    #: the steady solves are repeated until the contact search holds: the block slides along
+    #: the slab between continuation steps (μW/K_x, 2 cm per 0.05), and mortar contact holds
+    #: its geometry within a solve (:meth:`fenicsfriction.steady.SteadySolver.solve_searched`)
+    search_rounds = 10
 
     def __init__(self, scene: BlockOnSlab, comm: MPI.Comm, with_friction: bool | None):
         laws.check("g", scene.law.g, scene.law.g == 0,
@@ -155,8 +162,8 @@ class SlabModel(BlockModel):
         self.rho_slab = fem.Constant(self.msh, np.float64(s.slab_density))
         slab = inertia(self.rho_slab, u_ddot, v, self.dx_slab) \
             + elasticity(u, v, s.slab_E, s.slab_nu, self.dx_slab)
-        self.contact = NodeToSegment(
-            u, self.facet_tags, slave=CONTACT, master=SLAB_TOP, law=law, velocity=u_dot,
+        self.contact = make_contact(
+            s.formulation, u, self.facet_tags, CONTACT, SLAB_TOP, law, velocity=u_dot,
             fields=[u_dot], transport=self.belt_velocity, weight=float(self.thickness.value))
         self.ds_contact = self.contact.ds
         return slab, [self.contact]
@@ -182,7 +189,7 @@ class SlabModel(BlockModel):
     def penetration(self, n: typing.Any = None) -> typing.Any:
         """UFL penetration (-g)_+ of the slave point into the slab (``n`` is ignored: the
         normal is the master facet's)."""
-        return laws.penetration(-self.contact.projection.gap)
+        return self.contact.penetration
 
     def friction_traction(self, n: typing.Any = None) -> typing.Any:
         """UFL friction traction of the slab on the block (zero without friction)."""
@@ -196,7 +203,7 @@ class SlabModel(BlockModel):
 
     def contact_traction(self) -> typing.Any:
         """UFL traction of the slab on the block (meaningful at the slave nodes only)."""
-        return self.contact.pressure * self.contact.projection.normal + self.friction_traction()
+        return self.contact.pressure * self.contact.normal + self.friction_traction()
 
     def energy_forms(self) -> dict[str, ufl.Form]:
         """Kinetic and strain energies of the block and the slab together."""
@@ -218,8 +225,7 @@ class SlabModel(BlockModel):
         if c.traction is not None:
             forms["friction"] = ufl.inner(c.traction, jump) * c.ds
         if self.scene.law.b_n > 0:
-            forms["damping"] = self.damping_pressure() * ufl.inner(c.projection.normal, jump) \
-                * c.ds
+            forms["damping"] = self.damping_pressure() * ufl.inner(c.normal, jump) * c.ds
         return forms
 
     # --- nodal values ----------------------------------------------------------------------
@@ -228,23 +234,18 @@ class SlabModel(BlockModel):
         rank pairs, after a contact search at the current state (collective)."""
         c = self.contact
         c.update()
-        nodes = c.pairing.slave_nodes
-        nen = 2
-        u = self.residual.u.x.array.reshape(-1, 2)
-        v = self.residual.u_dot.x.array.reshape(-1, 2)
-        x_s = c.pairing.x_nodes[nodes] + u[nodes]
-        x_m = (c.pairing.reference.x.array.reshape(-1, nen, 2)[nodes]
-               + c.mirrors[self.residual.u].x.array.reshape(-1, nen, 2)[nodes])
-        v_m = c.mirrors[self.residual.u_dot].x.array.reshape(-1, nen, 2)[nodes]
-        t = x_m[:, 1] - x_m[:, 0]
-        t /= np.linalg.norm(t, axis=1)[:, None]
-        n = np.column_stack([-t[:, 1], t[:, 0]])
-        gap = ((x_s - x_m[:, 0]) * n).sum(axis=1)
-        N = surface_coordinates(x_s, x_m) if len(nodes) else np.zeros((0, nen))
-        w = v[nodes] - (N[:, :, None] * v_m).sum(axis=1) \
-            - self.scene.belt_direction * self.scene.belt_speed * np.array([1.0, 0.0])
-        d = np.maximum(-gap, 0.0)
-        return d, (w * t).sum(axis=1), np.where(d > 0, -(w * n).sum(axis=1), 0.0)
+        d, slip, rate = self._nodal_contact()[c.pairing.slave_nodes].T
+        return d, slip, np.where(d > 0, rate, 0.0)
+
+    @functools.cached_property
+    def _nodal_contact(self) -> typing.Callable[[], np.ndarray]:
+        """The contact's penetration, the relative velocity w (belt included) along the
+        tangent t = (n_y, -n_x) of the contact normal n (out of the slab: +x on the flat slab)
+        and the approach rate -w·n, at the slave nodes (compiled once)."""
+        c = self.contact
+        n, w = c.normal, c.relative_velocity
+        t = ufl.as_vector([n[1], -n[0]])
+        return c.nodal_values([c.penetration, ufl.dot(w, t), -ufl.dot(w, n)])
 
     # --- preparing a state -----------------------------------------------------------------
     def initial_guess(self) -> None:

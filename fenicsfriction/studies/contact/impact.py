@@ -102,8 +102,7 @@ class PressAndDrag(_Bodies):
     def build(self, comm: MPI.Comm = MPI.COMM_WORLD, scheme: str = "energy") -> TwoBodyModel:
         """The model the scheme integrates (``"energy"``: with the contacts' start of step)."""
         mesh = geometry.hertz_2d(comm, R=self.radius, h_contact=self.h_contact)
-        return TwoBodyModel(mesh, self.materials, self.law, passes=self.passes,
-                            density=self.density, energy_consistent=scheme == "energy")
+        return self.model(mesh, density=self.density, energy_consistent=scheme == "energy")
 
     def contact_period(self, model: TwoBodyModel) -> float:
         """2π/ω of the contact springs, ω² the bound of

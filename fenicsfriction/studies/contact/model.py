@@ -3,8 +3,10 @@ r"""Two elastic bodies pressed together: the finite element model of the contact
 Both bodies live in one mesh (:class:`fenicsfriction.studies.contact.geometry.TwoBodyMesh`),
 each with its own Hooke's law; the interface law acts between the slave surface (body 1) and the
 master surface (body 2) through node-to-segment contact
-(:class:`fenicsfriction.contact.NodeToSegment`), optionally in two passes (each surface slave in
-turn, each pass with weight 1/2).
+(:class:`fenicsfriction.contact.NodeToSegment`, degree-1 elements) or mortar contact
+(:class:`fenicsfriction.contact.mortar.SegmentToSegment`, degree 1 or 2), chosen by
+``formulation`` (:func:`fenicsfriction.contact.make_contact`), optionally in two passes (each
+surface slave in turn, each pass with weight 1/2).
 
 Friction in a quasi-static scene follows Pop's incremental formulation: the slave
 velocity of the regularised law is the increment :math:`(u - u_{old})/\Delta t` of a pseudo time
@@ -27,8 +29,9 @@ import ufl
 from dolfinx import fem, mesh
 
 from fenicsfriction import _compat, forms, laws
-from fenicsfriction.contact import NodeToSegment, facet_nodes, solve_with_search
-from fenicsfriction.contact.node_to_segment import NodalValues
+from fenicsfriction.assembly import assemble_owned
+from fenicsfriction.contact import FORMULATIONS, make_contact, solve_with_search
+from fenicsfriction.contact.node_to_segment import ENFORCEMENTS
 from fenicsfriction.laws import check
 from fenicsfriction.numerics import power_law_secant
 from fenicsfriction.steady import SteadySolver
@@ -44,7 +47,7 @@ from fenicsfriction.studies.contact.geometry import (
     TwoBodyMesh,
 )
 
-__all__ = ["Material", "SurfaceValues", "TwoBodyModel"]
+__all__ = ["Material", "SurfaceValues", "TwoBodyModel", "check_discretisation"]
 
 log = logging.getLogger(__name__)
 
@@ -61,17 +64,42 @@ class Material:
         check("nu", self.nu, -1 < self.nu < 0.5, "Poisson's ratio must be in (-1, 0.5)")
 
 
+def check_discretisation(formulation: str, degree: int, enforcement: str = "compliance") -> None:
+    """Raise ``ValueError`` naming the first of ``formulation`` (node-to-segment or mortar),
+    ``degree`` (1 or 2; 2 with mortar only) and ``enforcement`` (perturbed-lagrangian with
+    node-to-segment only) that does not fit the others."""
+    check("formulation", formulation, formulation in FORMULATIONS,
+          f"one of {', '.join(FORMULATIONS)}")
+    check("degree", degree, degree in (1, 2), "1 or 2")
+    check("degree", degree, degree == 1 or formulation == "mortar",
+          "2 needs the mortar formulation (node-to-segment contact is for degree-1 "
+          "elements)")
+    check("enforcement", enforcement, enforcement in ENFORCEMENTS,
+          f"one of {', '.join(ENFORCEMENTS)}")
+    check("enforcement", enforcement,
+          enforcement == "compliance" or formulation == "node-to-segment",
+          "the perturbed Lagrangian is node-to-segment's (formulation='node-to-segment')")
+
+
 @dataclasses.dataclass
 class SurfaceValues:
     """Nodal values on the slave surface, gathered on every rank, sorted by x, then y, z.
 
     Attributes:
         x: reference coordinates of the slave nodes (n, dim).
-        weight: each node's tributary length (2D) or area (3D).
+        weight: each node's tributary length (2D) or area (3D): the weight of the contact's
+            nodal rule.
         gap: the normal gap to the master surface (< 0: penetration).
         pressure: the contact pressure of the law at the node.
         traction: the tangential traction vector (zeros when frictionless), (n, dim).
-        force: the contact force on the node from all passes (n, dim) per unit weight.
+        force: the contact force on the node from all passes (n, dim) per unit load weight:
+            the pressure the node transmits (a uniform pressure p loads every node with p
+            times its load weight). Where the load weight is zero (the vertices of 6-node
+            triangles), per the surface's mean load weight instead.
+        load_weight: the integral of the node's shape function over the slave surface, the
+            force a unit pressure puts on the node (degree 1: ``weight``; degree 2 in 2D: 1/6
+            and 2/3 of a facet's length at its vertices and midpoint, in 3D 0 and 1/3 of a
+            triangle's area).
     """
 
     x: np.ndarray
@@ -80,6 +108,7 @@ class SurfaceValues:
     pressure: np.ndarray
     traction: np.ndarray
     force: np.ndarray
+    load_weight: np.ndarray
 
 
 class TwoBodyModel:
@@ -98,9 +127,12 @@ class TwoBodyModel:
             friction on the slip rate u̇, normal damping ``b_n``, the LOAD face under the
             traction ``shear`` in every direction: no platen, inertia carries body 1); ``None``
             (default): quasi-static.
-        formulation, penalty_T: the contact formulation (``"compliance"`` or
-            ``"perturbed-lagrangian"`` with the tangential penalty κ_T;
-            :class:`~fenicsfriction.contact.NodeToSegment`).
+        formulation: the contact's discretisation, ``"node-to-segment"`` (default) or
+            ``"mortar"`` (:data:`fenicsfriction.contact.FORMULATIONS`).
+        degree: the Lagrange degree of the displacement, 1 or 2 (2: mortar only).
+        enforcement, penalty_T: how node-to-segment contact enforces the law
+            (``"compliance"`` or ``"perturbed-lagrangian"`` with the tangential penalty κ_T;
+            :data:`fenicsfriction.contact.node_to_segment.ENFORCEMENTS`).
         fix_load_face: also fix the tangential displacement of the :data:`LOAD` face
             (removes the sliding mode of a frictionless body 1 in a full model); else the
             face carries the tangential traction ``shear``.
@@ -118,21 +150,24 @@ class TwoBodyModel:
         V, u, u_old: the displacement space, the displacement, the last increment's.
         approach: the normal displacement of the LOAD face towards body 2 (``fem.Constant``).
         shear: the tangential traction on the LOAD face (a vector ``fem.Constant``).
-        contacts: the node-to-segment couplings (one per pass).
+        contacts: the contact couplings (one per pass).
         residual, solver: the residual and its :class:`~fenicsfriction.steady.SteadySolver`.
     """
 
     def __init__(self, geometry: TwoBodyMesh, materials: tuple[Material, Material],
                  law: laws.InterfaceLaw, passes: int = 1, fix_load_face: bool = False,
                  clamp: bool = True, density: float | None = None,
-                 formulation: str = "compliance", penalty_T: float | None = None,
+                 formulation: str = "node-to-segment", degree: int = 1,
+                 enforcement: str = "compliance", penalty_T: float | None = None,
                  energy_consistent: bool = False):
         check("passes", passes, passes in (1, 2), "1 or 2")
+        check_discretisation(formulation, degree, enforcement)
+        self.formulation, self.degree, self.enforcement = formulation, degree, enforcement
         self.geometry = geometry
         msh, cell_tags, facet_tags = geometry.mesh, geometry.cell_tags, geometry.facet_tags
         self.comm: MPI.Comm = msh.comm
         self.dim = dim = msh.geometry.dim
-        self.V = V = _compat.vector_function_space(msh, 1)
+        self.V = V = _compat.vector_function_space(msh, degree)
         self.u = fem.Function(V, name="displacement")
         self.u_old = fem.Function(V, name="previous_displacement")
         u_dot, u_ddot = fem.Function(V, name="velocity"), fem.Function(V, name="acceleration")
@@ -161,23 +196,24 @@ class TwoBodyModel:
             if energy_consistent:
                 self.u_start = fem.Function(V, name="step_start")
                 options.update(step_from=self.u_start)
+        self.penalty_T = fem.Constant(msh, float(penalty_T if penalty_T is not None else 0.0))
         if law.has_friction:
             law = law.replace(mu=self.mu, eps=self.eps)
             if not self.dynamic:
                 options.update({"velocity": (self.u - self.u_old) / self.dt,
-                                "fields": [self.u_old], "time_step": self.dt})
-            self.penalty_T = fem.Constant(msh, float(penalty_T if penalty_T is not None
-                                                     else 0.0))
-            options.update({"formulation": formulation, "penalty_T": self.penalty_T})
+                                "fields": [self.u_old]})
+            if enforcement != "compliance":
+                options.update({"enforcement": enforcement, "penalty_T": self.penalty_T,
+                                "time_step": self.dt})
         pairs = [(SLAVE, MASTER), (MASTER, SLAVE)][:passes]
-        self.contacts = [NodeToSegment(self.u, facet_tags, slave, master, law,
-                                       weight=1.0 / passes, **options)
+        self.contacts = [make_contact(formulation, self.u, facet_tags, slave, master, law,
+                                      weight=1.0 / passes, **options)
                          for slave, master in pairs]
         self.residual = forms.Residual(form, self.u, u_dot, u_ddot, v,
                                        bcs=self._bcs(fix_load_face, clamp),
                                        couplings=self.contacts)
         cells = cell_tags.indices[cell_tags.values == BODY1]
-        nodes = _compat.cell_dofs(_compat.scalar_function_space(msh, "Lagrange", 1), cells)
+        nodes = _compat.cell_dofs(V, cells)
         self._body1_rows = nodes[nodes < V.dofmap.index_map.size_local]
         self._body1_dofs = nodes * dim + dim - 1  # their normal components (local, ghosts too)
 
@@ -235,6 +271,14 @@ class TwoBodyModel:
         self.approach.value = approach
         return solve_with_search(self.solver, self.contacts)
 
+    def commit(self) -> None:
+        """Store the state as the last increment's: ``u_old`` and, under the perturbed
+        Lagrangian, the contacts' tangential multipliers (call before each increment)."""
+        if self.enforcement == "perturbed-lagrangian":
+            for contact in self.contacts:
+                contact.commit()
+        self.u_old.x.array[:] = self.u.x.array
+
     def normal_force(self) -> float:
         """The contact force on body 1 along the approach (all passes, all ranks): the load."""
         return self.comm.allreduce(float(self._contact_force()[self._body1_rows, -1].sum()))
@@ -282,28 +326,39 @@ class TwoBodyModel:
         force = self._contact_force()
         owned = np.flatnonzero(weight > 0)
         x = contact.nodal_space.tabulate_dof_coordinates()[owned, :self.dim]
+        load = self._load_weight[owned]
+        loaded = load > 1e-12 * self.comm.allreduce(float(load.max(initial=0.0)), op=MPI.MAX)
+        mean = self.comm.allreduce(float(load[loaded].sum())) \
+            / self.comm.allreduce(int(np.count_nonzero(loaded)))
         local = np.column_stack([x, weight[owned], values[owned],
-                                 force[owned] / weight[owned, None]])
+                                 force[owned] / np.where(loaded, load, mean)[:, None],
+                                 np.where(loaded, load, 0.0)])
         rows = np.vstack(self.comm.allgather(local))
         rows = rows[np.lexsort(rows[:, :self.dim].T[::-1])]  # by x, then y (then z)
         d = self.dim
         return SurfaceValues(x=rows[:, :d], weight=rows[:, d], gap=rows[:, d + 1],
                              pressure=rows[:, d + 2], traction=rows[:, d + 3:2 * d + 3],
-                             force=rows[:, 2 * d + 3:])
+                             force=rows[:, 2 * d + 3:3 * d + 3], load_weight=rows[:, 3 * d + 3])
 
     @functools.cached_property
-    def _surface_nodal(self) -> NodalValues:
+    def _load_weight(self) -> np.ndarray:
+        """∫ N_k over the slave surface of each owned node (exact: P1 geometry)."""
+        q = ufl.TestFunction(self.contacts[0].nodal_space)
+        return assemble_owned(_compat.form(q * self.ds(SLAVE)))
+
+    @functools.cached_property
+    def _surface_nodal(self) -> typing.Callable[[], np.ndarray]:
         """Gap, pressure and (with friction) the traction's components at the slave nodes."""
         contact = self.contacts[0]
         traction = contact.traction
         return contact.nodal_values(
-            [contact.projection.gap, contact.pressure,
+            [contact.gap, contact.pressure,
              *([] if traction is None else [traction[k] for k in range(self.dim)])])
 
     @functools.cached_property
-    def _gap_nodal(self) -> NodalValues:
+    def _gap_nodal(self) -> typing.Callable[[], np.ndarray]:
         contact = self.contacts[0]
-        return contact.nodal_values([contact.projection.gap])
+        return contact.nodal_values([contact.gap])
 
     def nodal_gap(self) -> np.ndarray:
         """The gap at each owned node of the first pass's slave surface (0 off it), for the
@@ -320,9 +375,7 @@ class TwoBodyModel:
         owned = self.nodal_gap()
         gap.x.array[:len(owned)] = owned
         gap.x.scatter_forward()
-        facets = facet_nodes(self.V, self.geometry.facet_tags, SLAVE, outward=False)
-        edges = np.vstack([facets[:, [i, j]] for i in range(self.dim)
-                           for j in range(i + 1, self.dim)]).reshape(-1, 2)
+        edges = _surface_edges(contact.nodal_space, self.geometry.facet_tags, SLAVE)
         g = gap.x.array[edges]
         crossing = g[:, 0] * g[:, 1] < 0
         x = contact.nodal_space.tabulate_dof_coordinates()[:, :self.dim]
@@ -338,7 +391,7 @@ class TwoBodyModel:
 
     def _contact_force(self) -> np.ndarray:
         """The contact force of every pass on each node (owned nodes, (n, dim))."""
-        b = dolfinx.fem.petsc.create_vector(self._force_operators[0].F)
+        b = dolfinx.fem.petsc.create_vector(self._zero_residual)
         b.set(0.0)
         for operator in self._force_operators:
             operator.add_to_residual(b)
@@ -346,8 +399,46 @@ class TwoBodyModel:
         b.destroy()
         return force
 
+    @functools.cached_property
+    def _zero_residual(self) -> typing.Any:
+        """A compiled linear form on V, whose vectors have the residual's layout."""
+        zero = fem.Constant(self.geometry.mesh, np.zeros(self.dim))
+        return _compat.form(ufl.inner(zero, ufl.TestFunction(self.V)) * self.dx)
+
     @property
     def dofs(self) -> int:
         """Number of displacement unknowns."""
         index_map = self.V.dofmap.index_map
         return index_map.size_global * self.V.dofmap.index_map_bs
+
+
+def _surface_edges(V: fem.FunctionSpace, facet_tags: mesh.MeshTags, tag: int) -> np.ndarray:
+    """Pairs of nodes of ``V`` (local indices) joined by an edge of the linear sub-facets of
+    the facets tagged ``tag``: the facets' edges (degree 1), or the edges of the segments
+    (2D) and four triangles (3D) that the midside nodes cut each facet into (degree 2,
+    straight facets: a midside node is the midpoint of its two vertices)."""
+    msh = V.mesh
+    tdim = msh.topology.dim
+    msh.topology.create_connectivity(tdim - 1, tdim)
+    msh.topology.create_connectivity(tdim, tdim - 1)
+    f_to_c = msh.topology.connectivity(tdim - 1, tdim)
+    c_to_f = msh.topology.connectivity(tdim, tdim - 1)
+    layout = V.dofmap.dof_layout
+    x = V.tabulate_dof_coordinates()
+    edges = []
+    for facet in facet_tags.indices[facet_tags.values == tag]:
+        cell = f_to_c.links(facet)[0]
+        local = int(np.flatnonzero(c_to_f.links(cell) == facet)[0])
+        nodes = V.dofmap.cell_dofs(cell)[layout.entity_closure_dofs(tdim - 1, local)]
+        pairs = [(a, b) for i, a in enumerate(nodes) for b in nodes[i + 1:]]
+        if len(nodes) == tdim:  # degree 1: every pair is an edge
+            edges += pairs
+            continue
+        size = max(float(np.linalg.norm(x[a] - x[b])) for a, b in pairs)
+        midside = {m: (a, b) for m in nodes for a, b in pairs
+                   if np.linalg.norm(x[m] - (x[a] + x[b]) / 2) < 1e-10 * size}
+        edges += [(a, m) for m, (a, _) in midside.items()]
+        edges += [(m, b) for m, (_, b) in midside.items()]
+        middle = list(midside)
+        edges += [(m, n) for i, m in enumerate(middle) for n in middle[i + 1:]]
+    return np.array(edges, dtype=np.int32).reshape(-1, 2)

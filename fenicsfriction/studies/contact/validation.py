@@ -27,7 +27,12 @@ import numpy as np
 from fenicsfriction import laws
 from fenicsfriction.laws import check
 from fenicsfriction.studies.contact import closed_forms, geometry
-from fenicsfriction.studies.contact.model import Material, SurfaceValues, TwoBodyModel
+from fenicsfriction.studies.contact.model import (
+    Material,
+    SurfaceValues,
+    TwoBodyModel,
+    check_discretisation,
+)
 
 __all__ = ["Cattaneo", "Hertz", "Patch", "surface_comparison"]
 
@@ -47,6 +52,10 @@ class _Bodies:
             c_n d^m_n [force/length^(2+m_n)], friction, regularisation; default frictionless,
             c_n = 1e4, m_n = 1 (a linear penalty). Change it with ``scene.with_law(c_n=...)``.
         passes: 1 (body 1's surface is the slave) or 2 (each surface slave in turn).
+        formulation: the contact's discretisation: ``"node-to-segment"`` (slave nodes against
+            master segments, nodal rule; Pop) or ``"mortar"`` (the law on mortar-weighted
+            gaps, segment-to-segment integration); :func:`fenicsfriction.contact.make_contact`.
+        degree: the Lagrange degree of the displacement, 1 or 2 (2: mortar only).
     """
 
     E1: float = 1.0
@@ -56,12 +65,26 @@ class _Bodies:
     law: laws.InterfaceLaw = dataclasses.field(
         default_factory=lambda: laws.InterfaceLaw(c_n=1e4, m_n=1.0))
     passes: int = 1
+    formulation: str = "node-to-segment"
+    degree: int = 1
 
     def __post_init__(self) -> None:
         self.E_star  # noqa: B018  (validates E1, nu1, E2, nu2, naming each)
         check("law", self.law, isinstance(self.law, laws.InterfaceLaw),
               "must be a fenicsfriction.laws.InterfaceLaw (it validates its own parameters)")
         check("passes", self.passes, self.passes in (1, 2), "1 or 2")
+        check_discretisation(self.formulation, self.degree)
+
+    def model(self, mesh: geometry.TwoBodyMesh, **options: typing.Any) -> TwoBodyModel:
+        """The :class:`TwoBodyModel` of these bodies, law, passes and discretisation on
+        ``mesh`` (``options``: the model's other arguments)."""
+        return TwoBodyModel(mesh, self.materials, self.law, passes=self.passes,
+                            formulation=self.formulation, degree=self.degree, **options)
+
+    @property
+    def discretisation(self) -> dict[str, typing.Any]:
+        """The contact formulation and the degree, as the summaries record them."""
+        return {"formulation": self.formulation, "degree": self.degree}
 
     def with_law(self, **changes: typing.Any) -> typing.Self:
         """The scene with its law changed, e.g. ``scene.with_law(c_n=1e5)``."""
@@ -119,8 +142,7 @@ class Hertz(_Bodies):
             comm, R=self.radius, refine=self.refine, h_contact=self.h_contact)
         # the 2D cylinder's sliding is stopped at its loaded face; the quarter sphere's by the
         # symmetry planes
-        return TwoBodyModel(mesh, self.materials, self.law, passes=self.passes,
-                            fix_load_face=self.dim == 2)
+        return self.model(mesh, fix_load_face=self.dim == 2)
 
     def run(self, comm: MPI.Comm = MPI.COMM_WORLD, model: TwoBodyModel | None = None
             ) -> tuple[dict, TwoBodyModel]:
@@ -137,17 +159,27 @@ class Hertz(_Bodies):
         measured = (np.ptp(edge[:, 0]) / 2 if self.dim == 2
                     else float(np.mean(np.linalg.norm(edge[:, :2], axis=1))))
         width = "half_width" if self.dim == 2 else "contact_radius"
+        r = values.x[:, 0] if self.dim == 2 else np.linalg.norm(values.x[:, :2], axis=1)
+        try:  # Hertz's ellipse through every contact node's pressure
+            fitted: tuple[float | None, float | None] = closed_forms.fit_hertz_pressure(
+                np.abs(r), values.pressure)
+        except ValueError:  # fewer than two contact nodes, or no falling profile
+            fitted = (None, None)
         summary = {
             "scene": "hertz", "dim": self.dim, "load": solved["load"] / share,
             "parameters": {"radius": self.radius, "E1": self.E1, "nu1": self.nu1,
                            "E2": self.E2, "nu2": self.nu2, "c_n": self.law.c_n,
                            "m_n": self.law.m_n, "refine": self.refine, "passes": self.passes,
-                           "h_contact": model.geometry.parameters["h_contact"]},
+                           "h_contact": model.geometry.parameters["h_contact"],
+                           **self.discretisation},
             "dofs": model.dofs, "ranks": comm.size,
             width: measured, f"hertz_{width}": a,
             "max_pressure": float(values.pressure.max()), "hertz_max_pressure": p0,
             f"{width}_error": measured / a - 1,
             "max_pressure_error": float(values.pressure.max()) / p0 - 1,
+            f"fitted_{width}": fitted[0], "fitted_max_pressure": fitted[1],
+            f"fitted_{width}_error": None if fitted[0] is None else fitted[0] / a - 1,
+            "fitted_max_pressure_error": None if fitted[1] is None else fitted[1] / p0 - 1,
             "approach": solved["approach"], "newton_iterations": solved["newton_iterations"],
             "solves": solved["solves"], "wall_time_s": time.perf_counter() - t0,
         }
@@ -181,26 +213,31 @@ class Patch(_Bodies):
     def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
         mesh = (geometry.patch_2d if self.dim == 2 else geometry.patch_3d)(
             comm, n_upper=self.n_upper, n_lower=self.n_lower)
-        model = TwoBodyModel(mesh, self.materials, self.law, passes=self.passes, clamp=False)
+        model = self.model(mesh, clamp=False)
         model.rollers(range(self.dim - 1))
         return model
 
     def run(self, comm: MPI.Comm = MPI.COMM_WORLD) -> tuple[dict, TwoBodyModel]:
-        """The pressure transmitted at the slave nodes (all passes' forces per tributary
-        length/area) and its largest deviation from the pressure applied."""
+        """The pressure transmitted at the slave nodes (all passes' forces per load weight,
+        :class:`~fenicsfriction.studies.contact.model.SurfaceValues`) and its largest
+        deviation from the pressure applied, relative to it."""
         t0 = time.perf_counter()
         model = self.build(comm)
         guess = self.law.uniform_penetration(self.pressure) + self.pressure / self.E1
         solved = model.solve_for_load(self.pressure, guess=guess, rtol=1e-10)
         values = model.surface_values()
-        transmitted = values.force[:, -1]
+        # the force a uniform pressure puts on a node is the pressure times the node's load
+        # weight (zero at the vertices of 6-node triangles, whose force must then vanish)
+        transmitted = values.force[:, -1] / self.pressure
+        expected = np.where(values.load_weight > 0, 1.0, 0.0)
         summary = {
             "scene": "patch", "dim": self.dim, "load": self.pressure,
             "parameters": {"E1": self.E1, "nu1": self.nu1, "E2": self.E2, "nu2": self.nu2,
                            "c_n": self.law.c_n, "m_n": self.law.m_n, "passes": self.passes,
-                           "n_upper": self.n_upper, "n_lower": self.n_lower},
+                           "n_upper": self.n_upper, "n_lower": self.n_lower,
+                           **self.discretisation},
             "dofs": model.dofs, "ranks": comm.size,
-            "pressure_deviation": float(np.max(np.abs(transmitted / self.pressure - 1))),
+            "pressure_deviation": float(np.max(np.abs(transmitted - expected))),
             "newton_iterations": solved["newton_iterations"],
             "wall_time_s": time.perf_counter() - t0,
         }
@@ -219,16 +256,16 @@ class Cattaneo(Hertz):
             μ = 0.3, ε = 1e-6.
         q_ratio: Q / (μ P), in [0, 1).
         increments: load increments of Q (the quasi-static path; the stick zone only shrinks).
-        formulation: ``"compliance"`` (the regularised law) or ``"perturbed-lagrangian"``
+        enforcement: ``"compliance"`` (the regularised law) or ``"perturbed-lagrangian"``
             (Pop, eq. 27: penalties κ_N = the law's ``c_n`` and κ_T = ``penalty_T``
-            [force/length³]).
+            [force/length³]; node-to-segment only).
     """
 
     law: laws.InterfaceLaw = dataclasses.field(
         default_factory=lambda: laws.InterfaceLaw(c_n=1e4, m_n=1.0, mu=0.3, eps=1e-6))
     q_ratio: float = 0.5
     increments: int = 10
-    formulation: str = "compliance"
+    enforcement: str = "compliance"
     penalty_T: float = 1e4
 
     def __post_init__(self) -> None:
@@ -240,12 +277,12 @@ class Cattaneo(Hertz):
         check("q_ratio", self.q_ratio, 0 <= self.q_ratio < 1, "Q/(mu P) in [0, 1)")
         check("increments", self.increments,
               isinstance(self.increments, int) and self.increments >= 1, "an integer >= 1")
+        check_discretisation(self.formulation, self.degree, self.enforcement)
 
     def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
         mesh = geometry.hertz_2d(comm, R=self.radius, refine=self.refine,
                                  h_contact=self.h_contact)
-        return TwoBodyModel(mesh, self.materials, self.law, passes=self.passes,
-                            formulation=self.formulation, penalty_T=self.penalty_T)
+        return self.model(mesh, enforcement=self.enforcement, penalty_T=self.penalty_T)
 
     def stick_zone(self, values: SurfaceValues, tol: float = 1e-3) -> tuple[float, float]:
         """(stick half-width, slip half-width): the extent of the contact nodes whose traction
@@ -288,9 +325,7 @@ class Cattaneo(Hertz):
         model.penalty_T.value = self.penalty_T
         rows = []
         for k in range(1, self.increments + 1):
-            for contact in model.contacts:
-                contact.commit()
-            model.u_old.x.array[:] = model.u.x.array
+            model.commit()
             q = self.q_ratio * k / self.increments
             model.shear.value = np.array([q * self.law.mu * self.load / (2 * self.radius), 0.0])
             report = model.solve_at(float(model.approach.value))
@@ -317,7 +352,7 @@ class Cattaneo(Hertz):
         summary = dict(normal)
         summary.update({
             "scene": "cattaneo", "q_ratio": self.q_ratio, "mu": self.law.mu,
-            "formulation": self.formulation, "eps": tangential["eps"],
+            "enforcement": self.enforcement, "eps": tangential["eps"],
             "stick_half_width": tangential["stick_half_width"],
             "cattaneo_stick_half_width": tangential["cattaneo_stick_half_width"],
             "traction_error_l2": tangential["traction_error_l2"],
@@ -326,7 +361,7 @@ class Cattaneo(Hertz):
             "wall_time_s": time.perf_counter() - t0})
         summary["parameters"] = {**normal["parameters"], "mu": self.law.mu, "eps": self.law.eps,
                                  "increments": self.increments,
-                                 "formulation": self.formulation, "penalty_T": self.penalty_T}
+                                 "enforcement": self.enforcement, "penalty_T": self.penalty_T}
         return summary
 
     def run(self, comm: MPI.Comm = MPI.COMM_WORLD, model: TwoBodyModel | None = None,
@@ -358,12 +393,15 @@ class Cattaneo(Hertz):
         t0 = time.perf_counter()
         normal, model = self.load_normal(comm, model)
         loaded = model.u.x.array.copy()
-        multipliers = [c.traction_old.x.array.copy() for c in model.contacts]
+        # the perturbed Lagrangian's history: the tangential multipliers of the loaded state
+        multipliers = [c.traction_old.x.array.copy() for c in model.contacts] \
+            if self.enforcement == "perturbed-lagrangian" else None
         sequence = []
         for eps in eps_values:
             model.u.x.array[:] = loaded
-            for contact, values in zip(model.contacts, multipliers, strict=True):
-                contact.traction_old.x.array[:] = values
+            if multipliers is not None:
+                for contact, values in zip(model.contacts, multipliers, strict=True):
+                    contact.traction_old.x.array[:] = values
             model.shear.value = np.zeros(2)
             callback = None if on_increment is None else (
                 lambda row, eps=eps: on_increment({"eps": eps, **row}))
