@@ -64,7 +64,14 @@ def _bodies_flags() -> argparse.ArgumentParser:
                        ("--c-n", "normal compliance coefficient: p = c_n d^m_n (1e4)"),
                        ("--m-n", "normal compliance exponent, >= 1 (1: a linear penalty)")):
         group.add_argument(flag, type=float, dest=flag[2:].replace("-", "_"), help=text)
-    discretisation = flags.add_argument_group("the contact's discretisation")
+    _discretisation_flags(flags)
+    flags.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    return flags
+
+
+def _discretisation_flags(parser: argparse.ArgumentParser) -> None:
+    """``--formulation`` and ``--degree``, the contact's discretisation (every scene's)."""
+    discretisation = parser.add_argument_group("the contact's discretisation")
     discretisation.add_argument(
         "--formulation", type=_formulation, metavar="{" + ",".join(_FORMULATIONS) + "}",
         help="node-to-segment (slave nodes on master segments, nodal rule) or mortar (the law "
@@ -72,8 +79,6 @@ def _bodies_flags() -> argparse.ArgumentParser:
     discretisation.add_argument("--degree", type=int, choices=[1, 2],
                                 help="Lagrange degree of the displacement; 2 needs "
                                      "--formulation mortar (1)")
-    flags.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
-    return flags
 
 
 def _hertz_flags(parser: argparse.ArgumentParser) -> None:
@@ -141,7 +146,7 @@ def add_parser(commands: typing.Any) -> None:
     cattaneo.add_argument("--penalty-T", dest="penalty_T", type=float,
                           help="tangential penalty of the perturbed Lagrangian "
                                "[force/length^3] (1e4)")
-    press_drag.add_parser(scenes)
+    press_drag.add_parser(scenes, _discretisation_flags)
 
 
 def _named_by_flag(message: str, args: argparse.Namespace) -> str:

@@ -24,8 +24,10 @@ if typing.TYPE_CHECKING:
 __all__ = ["add_parser", "run_press_drag"]
 
 
-def add_parser(scenes: typing.Any) -> None:
-    """The ``press-drag`` scene of ``fenicsfriction contact``."""
+def add_parser(scenes: typing.Any,
+               discretisation: typing.Callable[[argparse.ArgumentParser], None]) -> None:
+    """The ``press-drag`` scene of ``fenicsfriction contact``; ``discretisation`` adds the
+    contact scenes' ``--formulation`` and ``--degree``."""
     parser = scenes.add_parser(
         "press-drag", help="the cylinder pressed and dragged, in time: its energy balance",
         description="The 2D cylinder under a load switched on at t = 0 falls onto the block; "
@@ -52,6 +54,7 @@ def add_parser(scenes: typing.Any) -> None:
     parser.add_argument("--scheme", choices=["energy", "alpha2"], default="energy",
                         help="energy: the energy-consistent midpoint step; alpha2: "
                              "generalized-α at ρ∞ = 0.8 (energy)")
+    discretisation(parser)
     parser.add_argument("--stride", type=int, default=50,
                         help="a progress line every STRIDE steps (50)")
     parser.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
