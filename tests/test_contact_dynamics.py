@@ -15,7 +15,6 @@ about; and 1 and 2 ranks integrate the same motion.
 from __future__ import annotations
 
 import dataclasses
-
 import warnings
 
 from mpi4py import MPI
