@@ -72,13 +72,7 @@ from dolfinx import fem, mesh
 from scipy.spatial import cKDTree
 
 from fenicsfriction import _compat, laws
-from fenicsfriction.assembly import assemble_owned
-from fenicsfriction.contact.node_to_segment import (
-    ContactOperator,
-    NodalValues,
-    NodeToSegment,
-    discrete_gradient,
-)
+from fenicsfriction.contact.node_to_segment import MirroredContact, discrete_gradient
 
 __all__ = ["MortarIntegrals", "SegmentToSegment", "surface_facets"]
 
@@ -597,7 +591,7 @@ def _clip(subject: np.ndarray, clip: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return subject, count
 
 
-class SegmentToSegment:
+class SegmentToSegment(MirroredContact):
     r"""The interface law between a slave and a master surface, integrated segment to
     segment (mortar): see the module's docstring for the formulation and its limits.
 
@@ -752,16 +746,6 @@ class SegmentToSegment:
         """Scalar Lagrange functions of V's degree: one value per node."""
         return _compat.scalar_function_space(self.V.mesh, "Lagrange", self.degree)
 
-    @functools.cached_property
-    def nodal_weights(self) -> np.ndarray:
-        """Each owned node's :math:`A_j = \\int \\psi_j` on the whole slave surface (0 off
-        it): the nodal rule's integral of the node's basis function."""
-        return assemble_owned(_compat.form(ufl.TestFunction(self.nodal_space) * self.ds))
-
-    def nodal_values(self, expressions: typing.Sequence[typing.Any]) -> NodalValues:
-        """The values of UFL scalars at the slave nodes (compiled once, evaluated on call)."""
-        return NodalValues(self, expressions)  # type: ignore[arg-type]
-
     def frequency_bound(self, lumped_mass: PETSc.Vec) -> float:
         """An upper bound of the contact springs' frequency² on the lumped mass, for linear
         compliance (m_n = 1) and the current B: every slave node in contact, the stiffness
@@ -800,38 +784,6 @@ class SegmentToSegment:
         return [self.u, self.mirrors[self.u], self.pairing.reference, self.pairing.normal,
                 self.pairing.coverage]
 
-    # the bound is found and the form rebuilt as node-to-segment's (``F`` is None here)
-    friction_bound = NodeToSegment.friction_bound
-    with_friction_bound = NodeToSegment.with_friction_bound
-
-    def search(self) -> bool:
-        """The contact geometry at the current ``u``; True if it changed
-        (:meth:`MortarIntegrals.search`)."""
-        return self.pairing.search(self.u)
-
-    def update(self, search: bool = True) -> None:
-        """Search the geometry at the current ``u`` (unless frozen) and refresh the mirrors."""
-        if search and not (self.frozen and self.searched):
-            self.search()
-            self.searched = True
-            self.search_pending = False
-        Q = self.pairing.Q
-        assert Q is not None, "search before the first use"
-        for f, mirror in self.mirrors.items():
-            Q.mult(_compat.petsc_vec(f), _compat.petsc_vec(mirror))
-            mirror.x.scatter_forward()
-
-    def operator(self, derivatives: dict[fem.Function, Value],
-                 rest: typing.Sequence[fem.Function] = (),
-                 jit_cache_dir: str | None = None) -> ContactOperator:
-        """The compiled residual :math:`B^T G` and its Jacobian :math:`B^T G_{,U} B` (see
-        :meth:`NodeToSegment.operator <fenicsfriction.contact.NodeToSegment.operator>`)."""
-        at_rest = {}
-        for f in rest:
-            at_rest[f] = ufl.zero(*self.u.ufl_shape)
-            if f in self.mirrors:
-                at_rest[self.mirrors[f]] = ufl.zero(*self.u.ufl_shape)
-        return ContactOperator(self, derivatives, at_rest, jit_cache_dir)  # type: ignore[arg-type]
 
 
 if typing.TYPE_CHECKING:  # mypy checks that the mortar contact is a Coupling

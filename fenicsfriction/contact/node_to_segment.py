@@ -50,7 +50,7 @@ from fenicsfriction.assembly import assemble_into, assemble_owned
 from fenicsfriction.contact.kinematics import Projection, project
 from fenicsfriction.contact.pairing import Pairing, facet_nodes
 
-__all__ = ["ENFORCEMENTS", "ContactOperator", "NodalValues", "NodeToSegment",
+__all__ = ["ENFORCEMENTS", "ContactOperator", "MirroredContact", "NodalValues", "NodeToSegment",
            "discrete_gradient", "solve_with_search"]
 
 #: how the law is enforced at the slave nodes: ``"compliance"`` (normal compliance, friction
@@ -62,7 +62,103 @@ ENFORCEMENTS = ("compliance", "perturbed-lagrangian")
 Value = typing.Any
 
 
-class NodeToSegment:
+class MirroredContact:
+    r"""What node-to-segment and mortar contact share: a contact whose forms read the fields'
+    mirrors :math:`Q f` (Functions kept up to date by :meth:`update`), its residual
+    :math:`F + Q^T G` and Jacobian chained by :class:`ContactOperator`.
+
+    A subclass sets ``u``, ``V``, ``W``, ``mirrors``, ``pairing`` (with ``search(u)`` and
+    ``Q``), ``ds`` (the nodal rule on the slave surface), ``nodal_space``, ``F`` (or None),
+    ``G``, ``m_n``, ``frozen``, ``searched`` and ``search_pending``, and gives
+    :meth:`frequency_bound`.
+    """
+
+    u: fem.Function
+    V: fem.FunctionSpace
+    mirrors: dict[fem.Function, fem.Function]
+    pairing: typing.Any
+    ds: typing.Any
+    F: typing.Any
+    G: typing.Any
+    frozen: bool
+    searched: bool
+    search_pending: bool
+    search_every_residual: bool
+    W: fem.FunctionSpace  # where the mirrors live
+    m_n: typing.Any
+    nodal_space: fem.FunctionSpace  # scalar Lagrange functions of one value per node
+
+    def frequency_bound(self, lumped_mass: PETSc.Vec) -> float:
+        """An upper bound of the contact springs' frequency² on the lumped mass (a
+        subclass's)."""
+        raise NotImplementedError
+
+    @functools.cached_property
+    def nodal_weights(self) -> np.ndarray:
+        """Each owned node's weight in the nodal rule on the slave surface, 0 off it: the
+        integral of the node's basis function (its tributary length or area for
+        node-to-segment; :math:`A_j = \\int \\psi_j` for mortar)."""
+        return assemble_owned(_compat.form(ufl.TestFunction(self.nodal_space) * self.ds))
+
+    def nodal_values(self, expressions: typing.Sequence[typing.Any]) -> NodalValues:
+        """The values of UFL scalars at the slave nodes (compiled once, evaluated on call)."""
+        return NodalValues(self, expressions)
+
+    def friction_bound(self) -> typing.Any:
+        """The law's friction bound :math:`c_T d^{m_T}` at the slave nodes (UFL), ``None``
+        without friction or with the perturbed Lagrangian (its bound is not the law's
+        labelled one)."""
+        bounds = [b for form in (self.F, self.G) if form is not None
+                  for b in laws.friction_bounds(form)]
+        return bounds[0] if bounds else None
+
+    def with_friction_bound(self, bound: typing.Any) -> typing.Self:
+        """A copy of this contact whose forms ``F``, ``G`` have ``bound`` (UFL) in place of
+        the friction bound; it shares the pairing and the mirrors with this one."""
+        twin = copy.copy(self)
+        twin.F, twin.G = (None if form is None
+                          else laws.substitute_friction_bound(form, lambda _: bound)
+                          for form in (self.F, self.G))
+        return twin
+
+    def search(self) -> bool:
+        """Pair the surfaces at the current ``u``; True if the pairing changed."""
+        return self.pairing.search(self.u)
+
+    def update(self, search: bool = True) -> None:
+        """Pair the surfaces at the current ``u`` (unless frozen) and refresh the mirrors."""
+        if search and not (self.frozen and self.searched):
+            self.search()
+            self.searched = True
+            self.search_pending = False
+        Q = self.pairing.Q
+        assert Q is not None, "search before the first use"
+        for f, mirror in self.mirrors.items():
+            Q.mult(_compat.petsc_vec(f), _compat.petsc_vec(mirror))
+            mirror.x.scatter_forward()
+
+    def operator(self, derivatives: dict[fem.Function, Value],
+                 rest: typing.Sequence[fem.Function] = (),
+                 jit_cache_dir: str | None = None) -> ContactOperator:
+        """The compiled residual and Jacobian of this contact.
+
+        Args:
+            derivatives: the fields to differentiate with and each one's weight (``{u: 1}``
+                for a stiffness, ``{u: 1, u_dot: shift}`` for a time step's Jacobian).
+            rest: fields set to zero, with their mirrors, after differentiating (``u_dot`` in
+                steady sliding and in the linearisation about it).
+        """
+        zero = ufl.zero(*self.u.ufl_shape)
+        at_rest = {}
+        for f in rest:
+            at_rest[f] = zero
+            if f in self.mirrors:
+                at_rest[self.mirrors[f]] = ufl.zero(*self.mirrors[f].ufl_shape)
+        return ContactOperator(self, derivatives, at_rest, jit_cache_dir)
+
+
+
+class NodeToSegment(MirroredContact):
     r"""Slave nodes of one tagged surface against the facets of another, same residual.
 
     A :class:`~fenicsfriction.coupling.Coupling`: what the solvers ask of ``Residual.couplings``.
@@ -242,39 +338,12 @@ class NodeToSegment:
         """Scalar degree-1 Lagrange functions on the mesh: one value per node."""
         return _compat.scalar_function_space(self.V.mesh, "Lagrange", 1)
 
-    @functools.cached_property
-    def nodal_weights(self) -> np.ndarray:
-        """Each owned node's tributary length (2D) or area (3D) on the slave surface, 0 off
-        it: the nodal rule's integral of the node's hat function."""
-        return assemble_owned(_compat.form(ufl.TestFunction(self.nodal_space) * self.ds))
-
-    def nodal_values(self, expressions: typing.Sequence[typing.Any]) -> NodalValues:
-        """The values of UFL scalars at the slave nodes (compiled once, evaluated on call)."""
-        return NodalValues(self, expressions)
-
     # --- the friction bound, for the Panagiotopoulos process (FrictionBoundCoupling) --------
     @property
     def configuration(self) -> list[fem.Function]:
         """u, its master mirror and the paired master nodes' reference coordinates: what the
         gap, the normal and the friction bound at each slave node are made of."""
         return [self.u, self.mirrors[self.u], self.pairing.reference]
-
-    def friction_bound(self) -> typing.Any:
-        """The law's friction bound :math:`c_T d^{m_T}` at the slave nodes (UFL), ``None``
-        without friction or with the perturbed Lagrangian (its bound is not the law's
-        labelled one)."""
-        bounds = [b for form in (self.F, self.G) if form is not None
-                  for b in laws.friction_bounds(form)]
-        return bounds[0] if bounds else None
-
-    def with_friction_bound(self, bound: typing.Any) -> typing.Self:
-        """A copy of this contact whose forms ``F``, ``G`` have ``bound`` (UFL) in place of
-        the friction bound; it shares the pairing and the mirrors with this one."""
-        twin = copy.copy(self)
-        twin.F, twin.G = (None if form is None
-                          else laws.substitute_friction_bound(form, lambda _: bound)
-                          for form in (self.F, self.G))
-        return twin
 
     def frequency_bound(self, lumped_mass: PETSc.Vec) -> float:
         """An upper bound of the contact springs' frequency² on the lumped mass, for linear
@@ -335,42 +404,6 @@ class NodeToSegment:
                  for a in range(self.dim)]
         return self.projection.interpolate(nodal)
 
-    def search(self) -> bool:
-        """Pair the slave nodes at the current ``u``; True if the pairing changed."""
-        return self.pairing.search(self.u)
-
-    def update(self, search: bool = True) -> None:
-        """Pair the slave nodes at the current ``u`` (unless frozen) and refresh the mirrors."""
-        if search and not (self.frozen and self.searched):
-            self.search()
-            self.searched = True
-            self.search_pending = False
-        Q = self.pairing.Q
-        assert Q is not None, "search before the first use"
-        for f, mirror in self.mirrors.items():
-            Q.mult(_compat.petsc_vec(f), _compat.petsc_vec(mirror))
-            mirror.x.scatter_forward()
-
-    def operator(self, derivatives: dict[fem.Function, Value],
-                 rest: typing.Sequence[fem.Function] = (),
-                 jit_cache_dir: str | None = None) -> ContactOperator:
-        """The compiled residual and Jacobian of this contact.
-
-        Args:
-            derivatives: the fields to differentiate with and each one's weight (``{u: 1}``
-                for a stiffness, ``{u: 1, u_dot: shift}`` for a time step's Jacobian).
-            rest: fields set to zero, with their mirrors, after differentiating (``u_dot`` in
-                steady sliding and in the linearisation about it).
-        """
-        zero = ufl.zero(*self.u.ufl_shape)
-        at_rest = {}
-        for f in rest:
-            at_rest[f] = zero
-            if f in self.mirrors:
-                at_rest[self.mirrors[f]] = ufl.zero(*self.mirrors[f].ufl_shape)
-        return ContactOperator(self, derivatives, at_rest, jit_cache_dir)
-
-
 def discrete_gradient(law: laws.InterfaceLaw, start: typing.Any, end: typing.Any) -> typing.Any:
     r"""The elastic pressure of a step whose approach :math:`a = -g` (penetration
     :math:`d = a_+`) goes from ``start`` to ``end``: the discrete gradient (Gonzalez 1996) of
@@ -424,7 +457,7 @@ class ContactOperator:
     current state when a search is due, the Jacobian chains the four blocks through ``Q``.
     """
 
-    def __init__(self, contact: NodeToSegment, derivatives: dict[fem.Function, Value],
+    def __init__(self, contact: MirroredContact, derivatives: dict[fem.Function, Value],
                  at_rest: dict, jit_cache_dir: str | None = None):
         self.contact = contact
         compile_ = lambda form: None if form is None else _compat.form(form, jit_cache_dir)  # noqa: E731
@@ -524,7 +557,7 @@ class NodalValues:
     Calling it returns an array (owned nodes, expressions), zero off the slave surface.
     """
 
-    def __init__(self, contact: NodeToSegment, expressions: typing.Sequence[typing.Any]):
+    def __init__(self, contact: MirroredContact, expressions: typing.Sequence[typing.Any]):
         self.contact = contact
         q = ufl.TestFunction(contact.nodal_space)
         self.forms = [_compat.form(e * q * contact.ds) for e in expressions]
