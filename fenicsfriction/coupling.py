@@ -62,6 +62,10 @@ class Coupling(typing.Protocol):
             solve (:class:`~fenicsfriction.steady.SteadySolver`) and each time step
             (:class:`~fenicsfriction.dynamics.DynamicsSolver`,
             :class:`~fenicsfriction.dynamics.CentralDifference`).
+        step_from: optional; a Function of ``u``'s space that
+            :class:`~fenicsfriction.dynamics.DynamicsSolver` with ``energy_consistent`` sets to
+            u_n before each step, the coupling's force then being that of the midpoint step
+            from it (:class:`~fenicsfriction.contact.NodeToSegment`).
         m_n: the exponent of its normal compliance;
             :class:`~fenicsfriction.dynamics.CentralDifference` bounds the stable step of
             springs that close later (:meth:`frequency_bound`) only when it is 1.

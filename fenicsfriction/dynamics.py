@@ -52,7 +52,7 @@ __all__ = ["DEFAULT_OPTIONS", "CentralDifference", "DynamicsError", "DynamicsSol
 
 
 class DynamicsSolver(Alpha2Integrator):
-    """Generalized-α (TSALPHA2) integration of the one residual of a FE model.
+    r"""Generalized-α (TSALPHA2) integration of the one residual of a FE model.
 
     Args:
         residual: the residual; ``u`` and ``u_dot`` hold the initial state (e.g. a steady
@@ -62,11 +62,31 @@ class DynamicsSolver(Alpha2Integrator):
         atol: absolute Newton tolerance on the residual (force units).
         predictor: start Newton from x_n + Δt ẋ_n (see
             :class:`~fenicsfriction.timestepping.Alpha2Integrator`), else from x_n.
+        energy_consistent: the energy-consistent midpoint rule: generalized-α at ρ∞ = 1
+            (``ts_alpha_radius`` 1; the residual is then evaluated at
+            :math:`u_{n+1/2} = (u_n + u_{n+1})/2`, :math:`\dot u = (u_{n+1} - u_n)/\Delta t`,
+            :math:`\ddot u = (\dot u_{n+1} - \dot u_n)/\Delta t`: Newmark's average
+            acceleration, which conserves kinetic + elastic energy of linear elasticity
+            exactly), and every coupling with a ``step_from`` Function (a contact's start of
+            step, :class:`~fenicsfriction.contact.NodeToSegment`) receives :math:`u_n` before
+            each step, so that its force is the step's discrete gradient. A friction traction
+            evaluated at the midpoint slip rate then dissipates exactly
+            :math:`-\Delta t\, t_T\cdot w_{n+1/2} \ge 0` per step (Armero & Petőcz 1999),
+            and the discrete energy balance closes to Newton's tolerance whatever ε.
     """
 
     def __init__(self, residual: Residual, prefix: str = "dynamics_",
-                 options: dict | None = None, atol: float = 1e-8, predictor: bool = True):
+                 options: dict | None = None, atol: float = 1e-8, predictor: bool = True,
+                 energy_consistent: bool = False):
         self.residual = residual
+        if energy_consistent:
+            options = {**(options or {}), "ts_alpha_radius": 1.0}
+        self.energy_consistent = energy_consistent
+        self._step_start: tuple[PETSc.Vec, float] | None = None  # x_{n-1}, t_{n-1}
+        self._mean_velocity: PETSc.Vec | None = None  # (x_n - x_{n-1}) / Δt_{n-1}
+        #: the couplings' start-of-step fields, set to u_n before each step
+        self.step_starts = [c.step_from for c in residual.couplings
+                            if energy_consistent and getattr(c, "step_from", None) is not None]
         msh = residual.V.mesh
         self.shift_v = fem.Constant(msh, 0.0)
         self.shift_a = fem.Constant(msh, 0.0)
@@ -102,8 +122,40 @@ class DynamicsSolver(Alpha2Integrator):
         if self._coupled is not None:
             self.A = self._coupled.A
         super().__init__(msh.comm, prefix, self.b, self.A, options, atol, predictor)
-        if self.couplings:  # the pairing is searched at each step's first residual
-            self.ts.setPreStep(lambda ts: _search_due(self.couplings))
+        if self.couplings or energy_consistent:  # pairing searched at a step's first residual
+            self.ts.setPreStep(self._pre_step)
+
+    def _pre_step(self, ts: PETSc.TS) -> None:
+        _search_due(self.couplings)
+        x_n, t = ts.getSolution2()[0], ts.getTime()
+        for start in self.step_starts:
+            x_n.copy(_compat.petsc_vec(start))
+            start.x.scatter_forward()
+        if not self.energy_consistent:
+            return
+        if self._step_start is None or t <= self._step_start[1]:  # a (new) run's first step
+            self._mean_velocity = None
+            self._step_start = (x_n.copy(), t)
+            return
+        x_previous, t_previous = self._step_start
+        if self._mean_velocity is None:
+            self._mean_velocity = x_n.duplicate()
+        x_n.copy(self._mean_velocity)
+        self._mean_velocity.axpy(-1.0, x_previous)
+        self._mean_velocity.scale(1.0 / (t - t_previous))
+        x_n.copy(x_previous)
+        self._step_start = (x_previous, t)
+
+    def _predict(self, snes: PETSc.SNES, x: PETSc.Vec) -> None:
+        """Newton's starting point: with the midpoint rule x_n + Δt (x_n − x_{n−1})/Δt_{n−1},
+        the last step's mean velocity (the end-of-step velocity 2(x_n − x_{n−1})/Δt − ẋ_{n−1}
+        of a sticking node flips sign from step to step: the stick dashpots ring); else
+        :meth:`Alpha2Integrator._predict`."""
+        if self._mean_velocity is None:
+            super()._predict(snes, x)
+            return
+        self.ts.getSolution2()[0].copy(x)
+        x.axpy(self.ts.getTimeStep(), self._mean_velocity)
 
     def _state(self) -> tuple[PETSc.Vec, PETSc.Vec]:
         return _compat.petsc_vec(self.residual.u), _compat.petsc_vec(self.residual.u_dot)

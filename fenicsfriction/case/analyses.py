@@ -43,13 +43,16 @@ import numpy as np
 from fenicsfriction import io, results
 from fenicsfriction.case.model import CaseModel
 from fenicsfriction.case.schema import Case
-from fenicsfriction.steady import SolveError, SolveReport, SteadySolver
+from fenicsfriction.steady import SteadySolver
 
 if typing.TYPE_CHECKING:
     from fenicsfriction.stability import Mode, StabilitySolver
 
-__all__ = ["BandSolver", "ModallyDamped", "Outcome", "PairedSteadySolver", "eigensolver",
+__all__ = ["BandSolver", "ModallyDamped", "Outcome", "eigensolver",
            "growth_rate", "run_case"]
+
+#: the most Newton solves of one steady state until a search keeps its contacts' pairing
+SEARCH_ROUNDS = 10
 
 
 @dataclasses.dataclass
@@ -146,43 +149,6 @@ class ModallyDamped:
         return sorted(modes, key=lambda m: abs(m.value))
 
 
-class PairedSteadySolver(SteadySolver):
-    """A :class:`~fenicsfriction.steady.SteadySolver` whose every solve is repeated, the
-    contacts searched again, until the converged state keeps the pairing it was solved with
-    (as :func:`fenicsfriction.contact.solve_with_search`). A solve searches the pairing once,
-    at its start; a continuation step or a jump of the onset's bisection slides the block
-    along the slab past master nodes, and the state it converges to is then solved with a
-    pairing it no longer has (on the block-on-slab case with mortar contact of degree 2, such
-    a state at μ = 0.4 grows where the consistent one is stable).
-
-    Args:
-        contacts: the body-to-body contact couplings (their ``search()``); none: a plain
-            SteadySolver.
-        residual, options: the SteadySolver's.
-        max_rounds: the most solves of one state.
-    """
-
-    def __init__(self, contacts: typing.Sequence[typing.Any], *args: typing.Any,
-                 max_rounds: int = 10, **options: typing.Any):
-        super().__init__(*args, **options)
-        self.contacts, self.max_rounds = list(contacts), max_rounds
-
-    def solve(self) -> SolveReport:
-        """Solve until the pairing holds; raises :class:`~fenicsfriction.steady.SolveError`
-        (so that a continuation halves its step) if it still changes after ``max_rounds``."""
-        iterations = 0
-        for _ in range(self.max_rounds):
-            report = super().solve()
-            iterations += report.iterations
-            changed = [contact.search() for contact in self.contacts]  # every one searched
-            report.iterations = iterations
-            if not any(changed):
-                return report
-        report.converged = False
-        raise SolveError(f"contact search: the pairing still changed after {self.max_rounds} "
-                         "Newton solves", report)
-
-
 def growth_rate(time: np.ndarray, amplitude: np.ndarray) -> float:
     """The slope of the least-squares line through log(amplitude) against time [1/s]."""
     keep = amplitude > 0
@@ -225,8 +191,12 @@ def run_case(case: Case, out: pathlib.Path, comm: MPI.Comm = MPI.COMM_WORLD,
     model.initial_guess()
     outcome = Outcome(parameter=case.parameter)
     force = max(model.load_magnitude(), 1e-300)
-    solver = PairedSteadySolver(model.body_contacts, model.residual, prefix="steady_",
-                                options={"snes_atol": 1e-10 * force})
+    # a continuation step slides the bodies past master nodes: every steady state is solved
+    # again until a search keeps its pairing (body-to-body contact; mortar holds its geometry
+    # within a solve)
+    solver = SteadySolver(model.residual, prefix="steady_",
+                          options={"snes_atol": 1e-10 * force},
+                          search_rounds=SEARCH_ROUNDS if model.body_contacts else 1)
     ndofs = model.V.dofmap.index_map.size_global * model.V.dofmap.index_map_bs
     log.info(f"{case.title}: {ndofs} dofs on {comm.size} rank(s), JIT {solver.jit_time_s:.2f} s")
 

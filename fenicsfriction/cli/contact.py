@@ -18,6 +18,7 @@ import logging
 import pathlib
 import typing
 
+from fenicsfriction.cli import press_drag
 from fenicsfriction.cli.arguments import Parser, floats
 
 if typing.TYPE_CHECKING:
@@ -63,7 +64,14 @@ def _bodies_flags() -> argparse.ArgumentParser:
                        ("--c-n", "normal compliance coefficient: p = c_n d^m_n (1e4)"),
                        ("--m-n", "normal compliance exponent, >= 1 (1: a linear penalty)")):
         group.add_argument(flag, type=float, dest=flag[2:].replace("-", "_"), help=text)
-    discretisation = flags.add_argument_group("the contact's discretisation")
+    _discretisation_flags(flags)
+    flags.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
+    return flags
+
+
+def _discretisation_flags(parser: argparse.ArgumentParser) -> None:
+    """``--formulation`` and ``--degree``, the contact's discretisation (every scene's)."""
+    discretisation = parser.add_argument_group("the contact's discretisation")
     discretisation.add_argument(
         "--formulation", type=_formulation, metavar="{" + ",".join(_FORMULATIONS) + "}",
         help="node-to-segment (slave nodes on master segments, nodal rule) or mortar (the law "
@@ -71,8 +79,6 @@ def _bodies_flags() -> argparse.ArgumentParser:
     discretisation.add_argument("--degree", type=int, choices=[1, 2],
                                 help="Lagrange degree of the displacement; 2 needs "
                                      "--formulation mortar (1)")
-    flags.add_argument("--out", type=pathlib.Path, required=True, help="output folder")
-    return flags
 
 
 def _hertz_flags(parser: argparse.ArgumentParser) -> None:
@@ -140,6 +146,7 @@ def add_parser(commands: typing.Any) -> None:
     cattaneo.add_argument("--penalty-T", dest="penalty_T", type=float,
                           help="tangential penalty of the perturbed Lagrangian "
                                "[force/length^3] (1e4)")
+    press_drag.add_parser(scenes, _discretisation_flags)
 
 
 def _named_by_flag(message: str, args: argparse.Namespace) -> str:
@@ -409,7 +416,8 @@ def run_contact(args: argparse.Namespace, log: logging.Logger) -> int:
     """``contact hertz|patch|cattaneo``: the scene, its summary and its outputs."""
     from mpi4py import MPI
 
-    run = {"hertz": _run_hertz, "patch": _run_patch, "cattaneo": _run_cattaneo}[args.scene]
+    run = {"hertz": _run_hertz, "patch": _run_patch, "cattaneo": _run_cattaneo,
+           "press-drag": press_drag.run_press_drag}[args.scene]
     try:
         return run(args, log, MPI.COMM_WORLD)
     except ValueError as err:  # the scenes and meshes name their fields: name the flags

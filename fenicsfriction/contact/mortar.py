@@ -72,8 +72,7 @@ from dolfinx import fem, mesh
 from scipy.spatial import cKDTree
 
 from fenicsfriction import _compat, laws
-from fenicsfriction.assembly import assemble_owned
-from fenicsfriction.contact.node_to_segment import ContactOperator, NodalValues, NodeToSegment
+from fenicsfriction.contact.node_to_segment import MirroredContact, discrete_gradient
 
 __all__ = ["MortarIntegrals", "SegmentToSegment", "surface_facets"]
 
@@ -592,7 +591,7 @@ def _clip(subject: np.ndarray, clip: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return subject, count
 
 
-class SegmentToSegment:
+class SegmentToSegment(MirroredContact):
     r"""The interface law between a slave and a master surface, integrated segment to
     segment (mortar): see the module's docstring for the formulation and its limits.
 
@@ -613,6 +612,13 @@ class SegmentToSegment:
         frozen: keep the geometry of the first search (derivative tests).
         search: ``"solve"`` (default: the geometry searched at the start of each Newton solve
             or time step) or ``"residual"`` (at every residual evaluation).
+        step_from: the displacement u_n at the start of a midpoint step, ``u`` the step's
+            midpoint (:class:`~fenicsfriction.dynamics.DynamicsSolver` with
+            ``energy_consistent``): the elastic pressure becomes the discrete gradient of the
+            potential between the approaches :math:`-g_j` of the two ends
+            (:func:`~fenicsfriction.contact.node_to_segment.discrete_gradient`). ``G`` being
+            affine in u between searches, its work over the step is exactly the potential's
+            change. ``None`` (default): the pressure at ``u``.
         enforcement, formulation, penalty_T, time_step: node-to-segment's choice of the
             perturbed Lagrangian (``formulation`` its former name) is refused here: only
             ``"compliance"`` and no ``penalty_T``; ``time_step`` is accepted and unused, as
@@ -641,7 +647,8 @@ class SegmentToSegment:
                  fields: typing.Sequence[fem.Function] = (), transport: typing.Any = None,
                  weight: float = 1.0, frozen: bool = False, search: str = "solve",
                  enforcement: str = "compliance", formulation: str | None = None,
-                 penalty_T: Value | None = None, time_step: Value = 1.0):
+                 penalty_T: Value | None = None, time_step: Value = 1.0,
+                 step_from: fem.Function | None = None):
         V = u.function_space
         msh = V.mesh
         dim = msh.geometry.dim
@@ -675,7 +682,9 @@ class SegmentToSegment:
         self.pairing = MortarIntegrals(V, surface_facets(V, facet_tags, slave),
                                        surface_facets(V, facet_tags, master))
         self.mirrors: dict[fem.Function, fem.Function] = {
-            f: fem.Function(V, name=f"mortar_{f.name}") for f in (u, *fields)}
+            f: fem.Function(V, name=f"mortar_{f.name}")
+            for f in (u, *fields, *([] if step_from is None else [step_from]))}
+        self.step_from = step_from
         self.ds = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags, subdomain_id=slave,
                               metadata=_compat.nodal_quadrature(dim - 1, degree=degree))
         # the contact normal out of the master body, -n_j, as node-to-segment's: the force on
@@ -705,7 +714,7 @@ class SegmentToSegment:
                           * self.ds)
         dissipated = 0.0 * d
         if w is not None:
-            dissipated = (self.pressure - law.pressure(d)) * -ufl.dot(w, n)
+            dissipated = (self.pressure - self._elastic) * -ufl.dot(w, n)
             if self.traction is not None:
                 dissipated = dissipated - ufl.dot(self.traction, w)
         self.dissipation = weight * covered * dissipated * self.ds
@@ -716,6 +725,14 @@ class SegmentToSegment:
         approach rate :math:`\\dot d = -w\\cdot n`; sets ``pressure`` and ``traction``."""
         approach = -ufl.dot(w, n) if w is not None else 0.0
         self.pressure = self.law.normal_traction(d, approach)
+        self._elastic = self.law.pressure(d)
+        if self.step_from is not None:  # the step's elastic pressure: φ's discrete gradient
+            start = self.mirrors[self.step_from]
+            G = self.pairing.reference
+            self._elastic = discrete_gradient(  # of the approaches -g = -n·G at both ends
+                self.law, -ufl.dot(n, G + start),
+                -ufl.dot(n, G + 2 * self.mirrors[self.u] - start))
+            self.pressure = self.pressure - self.law.pressure(d) + self._elastic
         force = self.pressure * n
         self.traction = None
         if self.law.has_friction:
@@ -728,16 +745,6 @@ class SegmentToSegment:
     def nodal_space(self) -> fem.FunctionSpace:
         """Scalar Lagrange functions of V's degree: one value per node."""
         return _compat.scalar_function_space(self.V.mesh, "Lagrange", self.degree)
-
-    @functools.cached_property
-    def nodal_weights(self) -> np.ndarray:
-        """Each owned node's :math:`A_j = \\int \\psi_j` on the whole slave surface (0 off
-        it): the nodal rule's integral of the node's basis function."""
-        return assemble_owned(_compat.form(ufl.TestFunction(self.nodal_space) * self.ds))
-
-    def nodal_values(self, expressions: typing.Sequence[typing.Any]) -> NodalValues:
-        """The values of UFL scalars at the slave nodes (compiled once, evaluated on call)."""
-        return NodalValues(self, expressions)  # type: ignore[arg-type]
 
     def frequency_bound(self, lumped_mass: PETSc.Vec) -> float:
         """An upper bound of the contact springs' frequency² on the lumped mass, for linear
@@ -777,38 +784,6 @@ class SegmentToSegment:
         return [self.u, self.mirrors[self.u], self.pairing.reference, self.pairing.normal,
                 self.pairing.coverage]
 
-    # the bound is found and the form rebuilt as node-to-segment's (``F`` is None here)
-    friction_bound = NodeToSegment.friction_bound
-    with_friction_bound = NodeToSegment.with_friction_bound
-
-    def search(self) -> bool:
-        """The contact geometry at the current ``u``; True if it changed
-        (:meth:`MortarIntegrals.search`)."""
-        return self.pairing.search(self.u)
-
-    def update(self, search: bool = True) -> None:
-        """Search the geometry at the current ``u`` (unless frozen) and refresh the mirrors."""
-        if search and not (self.frozen and self.searched):
-            self.search()
-            self.searched = True
-            self.search_pending = False
-        Q = self.pairing.Q
-        assert Q is not None, "search before the first use"
-        for f, mirror in self.mirrors.items():
-            Q.mult(_compat.petsc_vec(f), _compat.petsc_vec(mirror))
-            mirror.x.scatter_forward()
-
-    def operator(self, derivatives: dict[fem.Function, Value],
-                 rest: typing.Sequence[fem.Function] = (),
-                 jit_cache_dir: str | None = None) -> ContactOperator:
-        """The compiled residual :math:`B^T G` and its Jacobian :math:`B^T G_{,U} B` (see
-        :meth:`NodeToSegment.operator <fenicsfriction.contact.NodeToSegment.operator>`)."""
-        at_rest = {}
-        for f in rest:
-            at_rest[f] = ufl.zero(*self.u.ufl_shape)
-            if f in self.mirrors:
-                at_rest[self.mirrors[f]] = ufl.zero(*self.u.ufl_shape)
-        return ContactOperator(self, derivatives, at_rest, jit_cache_dir)  # type: ignore[arg-type]
 
 
 if typing.TYPE_CHECKING:  # mypy checks that the mortar contact is a Coupling

@@ -50,8 +50,8 @@ from fenicsfriction.assembly import assemble_into, assemble_owned
 from fenicsfriction.contact.kinematics import Projection, project
 from fenicsfriction.contact.pairing import Pairing, facet_nodes
 
-__all__ = ["ENFORCEMENTS", "ContactOperator", "NodalValues", "NodeToSegment",
-           "solve_with_search"]
+__all__ = ["ENFORCEMENTS", "ContactOperator", "MirroredContact", "NodalValues", "NodeToSegment",
+           "discrete_gradient", "solve_with_search"]
 
 #: how the law is enforced at the slave nodes: ``"compliance"`` (normal compliance, friction
 #: regularised on the slip rate: Martins & Oden 1986) and ``"perturbed-lagrangian"`` (Pop,
@@ -62,7 +62,103 @@ ENFORCEMENTS = ("compliance", "perturbed-lagrangian")
 Value = typing.Any
 
 
-class NodeToSegment:
+class MirroredContact:
+    r"""What node-to-segment and mortar contact share: a contact whose forms read the fields'
+    mirrors :math:`Q f` (Functions kept up to date by :meth:`update`), its residual
+    :math:`F + Q^T G` and Jacobian chained by :class:`ContactOperator`.
+
+    A subclass sets ``u``, ``V``, ``W``, ``mirrors``, ``pairing`` (with ``search(u)`` and
+    ``Q``), ``ds`` (the nodal rule on the slave surface), ``nodal_space``, ``F`` (or None),
+    ``G``, ``m_n``, ``frozen``, ``searched`` and ``search_pending``, and gives
+    :meth:`frequency_bound`.
+    """
+
+    u: fem.Function
+    V: fem.FunctionSpace
+    mirrors: dict[fem.Function, fem.Function]
+    pairing: typing.Any
+    ds: typing.Any
+    F: typing.Any
+    G: typing.Any
+    frozen: bool
+    searched: bool
+    search_pending: bool
+    search_every_residual: bool
+    W: fem.FunctionSpace  # where the mirrors live
+    m_n: typing.Any
+    nodal_space: fem.FunctionSpace  # scalar Lagrange functions of one value per node
+
+    def frequency_bound(self, lumped_mass: PETSc.Vec) -> float:
+        """An upper bound of the contact springs' frequency² on the lumped mass (a
+        subclass's)."""
+        raise NotImplementedError
+
+    @functools.cached_property
+    def nodal_weights(self) -> np.ndarray:
+        """Each owned node's weight in the nodal rule on the slave surface, 0 off it: the
+        integral of the node's basis function (its tributary length or area for
+        node-to-segment; :math:`A_j = \\int \\psi_j` for mortar)."""
+        return assemble_owned(_compat.form(ufl.TestFunction(self.nodal_space) * self.ds))
+
+    def nodal_values(self, expressions: typing.Sequence[typing.Any]) -> NodalValues:
+        """The values of UFL scalars at the slave nodes (compiled once, evaluated on call)."""
+        return NodalValues(self, expressions)
+
+    def friction_bound(self) -> typing.Any:
+        """The law's friction bound :math:`c_T d^{m_T}` at the slave nodes (UFL), ``None``
+        without friction or with the perturbed Lagrangian (its bound is not the law's
+        labelled one)."""
+        bounds = [b for form in (self.F, self.G) if form is not None
+                  for b in laws.friction_bounds(form)]
+        return bounds[0] if bounds else None
+
+    def with_friction_bound(self, bound: typing.Any) -> typing.Self:
+        """A copy of this contact whose forms ``F``, ``G`` have ``bound`` (UFL) in place of
+        the friction bound; it shares the pairing and the mirrors with this one."""
+        twin = copy.copy(self)
+        twin.F, twin.G = (None if form is None
+                          else laws.substitute_friction_bound(form, lambda _: bound)
+                          for form in (self.F, self.G))
+        return twin
+
+    def search(self) -> bool:
+        """Pair the surfaces at the current ``u``; True if the pairing changed."""
+        return self.pairing.search(self.u)
+
+    def update(self, search: bool = True) -> None:
+        """Pair the surfaces at the current ``u`` (unless frozen) and refresh the mirrors."""
+        if search and not (self.frozen and self.searched):
+            self.search()
+            self.searched = True
+            self.search_pending = False
+        Q = self.pairing.Q
+        assert Q is not None, "search before the first use"
+        for f, mirror in self.mirrors.items():
+            Q.mult(_compat.petsc_vec(f), _compat.petsc_vec(mirror))
+            mirror.x.scatter_forward()
+
+    def operator(self, derivatives: dict[fem.Function, Value],
+                 rest: typing.Sequence[fem.Function] = (),
+                 jit_cache_dir: str | None = None) -> ContactOperator:
+        """The compiled residual and Jacobian of this contact.
+
+        Args:
+            derivatives: the fields to differentiate with and each one's weight (``{u: 1}``
+                for a stiffness, ``{u: 1, u_dot: shift}`` for a time step's Jacobian).
+            rest: fields set to zero, with their mirrors, after differentiating (``u_dot`` in
+                steady sliding and in the linearisation about it).
+        """
+        zero = ufl.zero(*self.u.ufl_shape)
+        at_rest = {}
+        for f in rest:
+            at_rest[f] = zero
+            if f in self.mirrors:
+                at_rest[self.mirrors[f]] = ufl.zero(*self.mirrors[f].ufl_shape)
+        return ContactOperator(self, derivatives, at_rest, jit_cache_dir)
+
+
+
+class NodeToSegment(MirroredContact):
     r"""Slave nodes of one tagged surface against the facets of another, same residual.
 
     A :class:`~fenicsfriction.coupling.Coupling`: what the solvers ask of ``Residual.couplings``.
@@ -90,6 +186,12 @@ class NodeToSegment:
         penalty_T: the tangential penalty κ_T [force/length³] (perturbed Lagrangian).
         time_step: the increment's duration, slip increment = velocity × time_step
             (perturbed Lagrangian; 1 with a quasi-static velocity (u - u_old)/1).
+        step_from: the displacement u_n at the start of a time step of the midpoint rule
+            (:class:`~fenicsfriction.dynamics.DynamicsSolver` with ``energy_consistent``),
+            ``u`` then holding the step's midpoint (u_n + u_{n+1})/2: the elastic pressure
+            becomes the discrete gradient of the compliance's potential between the two ends
+            (:meth:`_discrete_gradient`), so that the step's normal force does exactly the
+            work φ(d_{n+1}) − φ(d_n); ``None`` (default): the pressure at ``u``.
         search: when the pairing is searched again: ``"solve"`` (default) once at the start
             of each Newton solve or time step (:func:`solve_with_search` repeats a solve until
             its converged state keeps its pairing), ``"residual"`` at every residual
@@ -117,7 +219,7 @@ class NodeToSegment:
                  fields: typing.Sequence[fem.Function] = (), transport: typing.Any = None,
                  weight: float = 1.0, frozen: bool = False, search: str = "solve",
                  enforcement: str = "compliance", penalty_T: Value | None = None,
-                 time_step: Value = 1.0):
+                 time_step: Value = 1.0, step_from: fem.Function | None = None):
         V = u.function_space
         msh = V.mesh
         dim = msh.geometry.dim
@@ -148,7 +250,9 @@ class NodeToSegment:
         owned = slave_nodes[slave_nodes < V.dofmap.index_map.size_local]
         self.pairing = Pairing(V, self.W, owned, facet_nodes(V, facet_tags, master))
         self.mirrors: dict[fem.Function, fem.Function] = {
-            f: fem.Function(self.W, name=f"master_{f.name}") for f in (u, *fields)}
+            f: fem.Function(self.W, name=f"master_{f.name}")
+            for f in (u, *fields, *([] if step_from is None else [step_from]))}
+        self.step_from = step_from
         self.ds = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags,
                               subdomain_id=slave, metadata=_compat.nodal_quadrature(dim - 1))
         self.searched = False
@@ -172,6 +276,10 @@ class NodeToSegment:
         self.relative_velocity = w
         approach = -ufl.dot(w, n) if w is not None else 0.0
         self.pressure = law.normal_traction(d, approach)
+        elastic = law.pressure(d)
+        if step_from is not None:  # the step's elastic pressure: φ's discrete gradient
+            elastic = self._discrete_gradient(X)
+            self.pressure = self.pressure - law.pressure(d) + elastic
         force = self.pressure * n
         self.traction = None
         if law.has_friction:
@@ -192,26 +300,43 @@ class NodeToSegment:
         self.potential = weight * law.c_n * d ** (law.m_n + 1) / (law.m_n + 1) * self.ds
         dissipated = 0.0 * d
         if w is not None:
-            damping = self.pressure - law.pressure(d)
+            damping = self.pressure - elastic
             dissipated = damping * approach
             if self.traction is not None:
                 dissipated = dissipated - ufl.dot(self.traction, w)
         self.dissipation = weight * dissipated * self.ds
 
+    def _discrete_gradient(self, X: typing.Any) -> typing.Any:
+        r"""The elastic pressure of a midpoint step from :math:`u_n` (``step_from``) to
+        :math:`u_{n+1} = 2u - u_n`: the discrete gradient of the potential
+        :math:`\phi(d) = c_n d^{m_n+1}/(m_n+1)` (Gonzalez 1996, "Time integration and
+        discrete Hamiltonian systems"; for contact, Laursen & Chawla 1997 and Armero &
+        Petőcz 1998),
+
+        .. math:: p = \frac{\phi(d(g_{n+1})) - \phi(d(g_n))}{g_n - g_{n+1}}
+                  \quad (\phi'(d(g_{n+1/2}))\ \text{when}\ g_{n+1} = g_n),
+
+        a quotient in the gap (:math:`d = (-g)_+`), both ends' gaps projected on the same
+        master facet (the step's pairing). Along the midpoint normal, whose
+        :math:`n\cdot(\Delta u_s - \sum_a N_a(\xi)\, \Delta u_a)` is the gradient of the
+        gap at the midpoint applied to the step, its work is
+        :math:`\phi(d_{n+1}) - \phi(d_n)` up to the change of that gradient across the step
+        (none where the master facet translates). A midpoint pressure misses it wherever a
+        node enters or leaves contact within the step (φ' is not smooth at d = 0)."""
+        assert self.step_from is not None
+        u, start = self.u, self.step_from
+        approaches = []  # -g at both ends: d = (-g)_+
+        for field, mirror in ((start, self.mirrors[start]),
+                              (2 * u - start, 2 * self.mirrors[u] - self.mirrors[start])):
+            x_master = [self._node(self.pairing.reference, a) + self._node(mirror, a)
+                        for a in range(self.dim)]
+            approaches.append(-project(X + field, x_master).gap)
+        return discrete_gradient(self.law, *approaches)
+
     @functools.cached_property
     def nodal_space(self) -> fem.FunctionSpace:
         """Scalar degree-1 Lagrange functions on the mesh: one value per node."""
         return _compat.scalar_function_space(self.V.mesh, "Lagrange", 1)
-
-    @functools.cached_property
-    def nodal_weights(self) -> np.ndarray:
-        """Each owned node's tributary length (2D) or area (3D) on the slave surface, 0 off
-        it: the nodal rule's integral of the node's hat function."""
-        return assemble_owned(_compat.form(ufl.TestFunction(self.nodal_space) * self.ds))
-
-    def nodal_values(self, expressions: typing.Sequence[typing.Any]) -> NodalValues:
-        """The values of UFL scalars at the slave nodes (compiled once, evaluated on call)."""
-        return NodalValues(self, expressions)
 
     # --- the friction bound, for the Panagiotopoulos process (FrictionBoundCoupling) --------
     @property
@@ -219,23 +344,6 @@ class NodeToSegment:
         """u, its master mirror and the paired master nodes' reference coordinates: what the
         gap, the normal and the friction bound at each slave node are made of."""
         return [self.u, self.mirrors[self.u], self.pairing.reference]
-
-    def friction_bound(self) -> typing.Any:
-        """The law's friction bound :math:`c_T d^{m_T}` at the slave nodes (UFL), ``None``
-        without friction or with the perturbed Lagrangian (its bound is not the law's
-        labelled one)."""
-        bounds = [b for form in (self.F, self.G) if form is not None
-                  for b in laws.friction_bounds(form)]
-        return bounds[0] if bounds else None
-
-    def with_friction_bound(self, bound: typing.Any) -> typing.Self:
-        """A copy of this contact whose forms ``F``, ``G`` have ``bound`` (UFL) in place of
-        the friction bound; it shares the pairing and the mirrors with this one."""
-        twin = copy.copy(self)
-        twin.F, twin.G = (None if form is None
-                          else laws.substitute_friction_bound(form, lambda _: bound)
-                          for form in (self.F, self.G))
-        return twin
 
     def frequency_bound(self, lumped_mass: PETSc.Vec) -> float:
         """An upper bound of the contact springs' frequency² on the lumped mass, for linear
@@ -296,40 +404,23 @@ class NodeToSegment:
                  for a in range(self.dim)]
         return self.projection.interpolate(nodal)
 
-    def search(self) -> bool:
-        """Pair the slave nodes at the current ``u``; True if the pairing changed."""
-        return self.pairing.search(self.u)
+def discrete_gradient(law: laws.InterfaceLaw, start: typing.Any, end: typing.Any) -> typing.Any:
+    r"""The elastic pressure of a step whose approach :math:`a = -g` (penetration
+    :math:`d = a_+`) goes from ``start`` to ``end``: the discrete gradient (Gonzalez 1996) of
+    the compliance's potential :math:`\phi(d) = c_n d^{m_n+1}/(m_n+1)`,
 
-    def update(self, search: bool = True) -> None:
-        """Pair the slave nodes at the current ``u`` (unless frozen) and refresh the mirrors."""
-        if search and not (self.frozen and self.searched):
-            self.search()
-            self.searched = True
-            self.search_pending = False
-        Q = self.pairing.Q
-        assert Q is not None, "search before the first use"
-        for f, mirror in self.mirrors.items():
-            Q.mult(_compat.petsc_vec(f), _compat.petsc_vec(mirror))
-            mirror.x.scatter_forward()
+    .. math:: p = \frac{\phi(a_{n+1}^+) - \phi(a_n^+)}{a_{n+1} - a_n}
+              \quad (c_n ((a_n + a_{n+1})/2)_+^{m_n}\ \text{when}\ a_{n+1} = a_n),
 
-    def operator(self, derivatives: dict[fem.Function, Value],
-                 rest: typing.Sequence[fem.Function] = (),
-                 jit_cache_dir: str | None = None) -> ContactOperator:
-        """The compiled residual and Jacobian of this contact.
-
-        Args:
-            derivatives: the fields to differentiate with and each one's weight (``{u: 1}``
-                for a stiffness, ``{u: 1, u_dot: shift}`` for a time step's Jacobian).
-            rest: fields set to zero, with their mirrors, after differentiating (``u_dot`` in
-                steady sliding and in the linearisation about it).
-        """
-        zero = ufl.zero(*self.u.ufl_shape)
-        at_rest = {}
-        for f in rest:
-            at_rest[f] = zero
-            if f in self.mirrors:
-                at_rest[self.mirrors[f]] = ufl.zero(*self.mirrors[f].ufl_shape)
-        return ContactOperator(self, derivatives, at_rest, jit_cache_dir)
+    whose work on the approach's change is exactly the potential's (UFL)."""
+    potential = lambda a: law.c_n * laws.penetration(a) ** (law.m_n + 1) / (law.m_n + 1)  # noqa: E731
+    jump = end - start
+    # below the round-off of the approaches the quotient is 0/0: its limit instead
+    moved = ufl.gt(abs(jump), 1e-12 * ufl.max_value(ufl.max_value(abs(start), abs(end)),
+                                                    1e-300))
+    return ufl.conditional(moved, (potential(end) - potential(start))
+                           / ufl.conditional(moved, jump, 1.0),
+                           law.pressure(laws.penetration(0.5 * (start + end))))
 
 
 def _derivative(form: ufl.Form, pairs: list[tuple[fem.Function, Value]],
@@ -366,7 +457,7 @@ class ContactOperator:
     current state when a search is due, the Jacobian chains the four blocks through ``Q``.
     """
 
-    def __init__(self, contact: NodeToSegment, derivatives: dict[fem.Function, Value],
+    def __init__(self, contact: MirroredContact, derivatives: dict[fem.Function, Value],
                  at_rest: dict, jit_cache_dir: str | None = None):
         self.contact = contact
         compile_ = lambda form: None if form is None else _compat.form(form, jit_cache_dir)  # noqa: E731
@@ -466,7 +557,7 @@ class NodalValues:
     Calling it returns an array (owned nodes, expressions), zero off the slave surface.
     """
 
-    def __init__(self, contact: NodeToSegment, expressions: typing.Sequence[typing.Any]):
+    def __init__(self, contact: MirroredContact, expressions: typing.Sequence[typing.Any]):
         self.contact = contact
         q = ufl.TestFunction(contact.nodal_space)
         self.forms = [_compat.form(e * q * contact.ds) for e in expressions]

@@ -17,7 +17,8 @@ if typing.TYPE_CHECKING:
     from fenicsfriction.studies.contact.model import SurfaceValues, TwoBodyModel
     from fenicsfriction.studies.contact.validation import Hertz
 
-__all__ = ["deformed_figure", "patch_pressure_figure", "pressure_figure", "traction_figure"]
+__all__ = ["deformed_figure", "energy_balance_figure", "patch_pressure_figure",
+           "pressure_figure", "traction_figure"]
 
 #: half-widths of the window of the deformed figure around the contact, in contact half-widths
 WINDOW = (2.5, 1.2)
@@ -110,3 +111,26 @@ def deformed_figure(model: TwoBodyModel, path: PathLike, half_width: float | Non
             title += f" (displacements ×{scale:.3g})"
     if cells is not None:
         plotting.plot_contact_deformed(cells, path, window, scale, title, marks)
+
+
+def energy_balance_figure(records: typing.Sequence[dict], summary: dict, path: PathLike) -> None:
+    """The cylinder pressed and dragged (:class:`~.impact.PressAndDrag`): the energies, the
+    work of the loads and the dissipated energy against time (left), and the drift of the
+    balance over the largest work (right). Call on rank 0."""
+    t = np.array([r["time"] for r in records])
+    keys = ("kinetic", "elastic", "contact_energy", "work", "dissipated")
+    work = max(max(abs(r["work"]) for r in records), np.finfo(float).tiny)
+    balance = np.array([r["balance"] for r in records])
+    with plotting.saved_figure(path, ncols=2, figsize=(11, 4.2)) as (left, right):
+        for key in keys:
+            left.plot(t, [r[key] for r in records], label=key.replace("_", " "))
+        left.set_xlabel("t")
+        left.set_ylabel("energy")
+        left.legend(fontsize=8)
+        right.plot(t, (balance - balance[0]) / work)
+        right.set_xlabel("t")
+        right.set_ylabel("(balance − initial) / largest work")
+        error = summary.get("energy_balance_error")
+        right.set_title(f"{summary.get('scheme')}, dt = {summary.get('dt'):.3g}: "
+                        + ("no work yet" if error is None else f"error {error:.2e}"),
+                        fontsize=9)

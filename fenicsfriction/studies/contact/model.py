@@ -136,6 +136,9 @@ class TwoBodyModel:
         fix_load_face: also fix the tangential displacement of the :data:`LOAD` face
             (removes the sliding mode of a frictionless body 1 in a full model); else the
             face carries the tangential traction ``shear``.
+        energy_consistent: a dynamic model integrated by the energy-consistent midpoint rule
+            (``DynamicsSolver(energy_consistent=True)``): the contacts' ``step_from`` is
+            ``u_start``, the step's start.
 
     The normal load is applied through the approach: the :data:`LOAD` face is moved by
     ``approach`` towards body 2 (a rigid platen), and :meth:`solve_for_load` finds the approach
@@ -155,7 +158,8 @@ class TwoBodyModel:
                  law: laws.InterfaceLaw, passes: int = 1, fix_load_face: bool = False,
                  clamp: bool = True, density: float | None = None,
                  formulation: str = "node-to-segment", degree: int = 1,
-                 enforcement: str = "compliance", penalty_T: float | None = None):
+                 enforcement: str = "compliance", penalty_T: float | None = None,
+                 energy_consistent: bool = False):
         check("passes", passes, passes in (1, 2), "1 or 2")
         check_discretisation(formulation, degree, enforcement)
         self.formulation, self.degree, self.enforcement = formulation, degree, enforcement
@@ -189,6 +193,9 @@ class TwoBodyModel:
         options: dict = {}
         if self.dynamic:
             options.update(velocity=u_dot, fields=[u_dot])
+            if energy_consistent:
+                self.u_start = fem.Function(V, name="step_start")
+                options.update(step_from=self.u_start)
         self.penalty_T = fem.Constant(msh, float(penalty_T if penalty_T is not None else 0.0))
         if law.has_friction:
             law = law.replace(mu=self.mu, eps=self.eps)
