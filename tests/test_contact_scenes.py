@@ -130,10 +130,10 @@ def test_mortar_slab_steady_state_on_two_ranks_is_the_serial_one():
 
 def test_mortar_hertz_line_contact_against_hertz():
     """The cylinder on the block with mortar contact (P1, h = a/10) against Hertz (Johnson
-    1985, chapter 4). The peak nodal pressure and the ellipse fitted through every contact
-    node's pressure are within 1 % of p0 (measured +0.19 % and +0.02 %) and the fitted
-    half-width within 3 % (+2.1 %: the nodes next to the edge carry weighted averages of a
-    pressure that falls to zero inside their support). Where the weighted gaps change sign
+    1985, chapter 4). The peak transmitted pressure (nodal force over load weight) and the
+    ellipse fitted through the nodes' transmitted pressures are within 1 % of p0 (measured
+    +0.17 % both) and the fitted half-width within 1 % of a (-0.05 %; Hertz's parabolic
+    profile itself is good to ~0.2 % here). Where the weighted gaps change sign
     is one element inside the edge (measured -10.05 % = -1.0 h): a weighted gap averages the
     gap over the node's two elements, and outside the contact the gap grows like
     (x - a)^{3/2} to far more than the penetration p/c_n, so a node whose support straddles
@@ -143,7 +143,7 @@ def test_mortar_hertz_line_contact_against_hertz():
     a, _ = scene.closed_form()
     assert abs(summary["max_pressure_error"]) < 0.01
     assert abs(summary["fitted_max_pressure_error"]) < 0.01
-    assert abs(summary["fitted_half_width_error"]) < 0.03
+    assert abs(summary["fitted_half_width_error"]) < 0.01
     assert -1.5 * 0.01 < summary["half_width"] - a < 0
 
 
