@@ -695,10 +695,7 @@ class SegmentToSegment(MirroredContact):
         d = self.penetration = laws.penetration(-self.gap)
         w = None
         if velocity is not None:
-            unmirrored = set(ufl.algorithms.extract_coefficients(velocity)) - {u, *fields}
-            laws.check("fields", [f.name for f in fields], not unmirrored,
-                       "every Function the velocity depends on besides u (missing: "
-                       f"{', '.join(sorted(f.name for f in unmirrored))})")
+            self._check_mirrored(velocity, fields)
             w = ufl.replace(velocity, {f: self.mirrors[f] for f in (u, *fields)})
             if transport is not None:
                 w = w - ufl.as_vector(transport)

@@ -93,6 +93,14 @@ class MirroredContact:
         subclass's)."""
         raise NotImplementedError
 
+    def _check_mirrored(self, velocity: typing.Any, fields: typing.Sequence[fem.Function]
+                        ) -> None:
+        """Refuse a velocity that depends on a Function without a mirror (not u or a field)."""
+        unmirrored = set(ufl.algorithms.extract_coefficients(velocity)) - {self.u, *fields}
+        laws.check("fields", [f.name for f in fields], not unmirrored,
+                   "every Function the velocity depends on besides u (missing: "
+                   f"{', '.join(sorted(f.name for f in unmirrored))})")
+
     @functools.cached_property
     def nodal_weights(self) -> np.ndarray:
         """Each owned node's weight in the nodal rule on the slave surface, 0 off it: the
@@ -266,10 +274,7 @@ class NodeToSegment(MirroredContact):
         d = self.penetration = laws.penetration(-self.projection.gap)
         w = None
         if velocity is not None:
-            unmirrored = set(ufl.algorithms.extract_coefficients(velocity)) - {u, *fields}
-            laws.check("fields", [f.name for f in fields], not unmirrored,
-                       "every Function the velocity depends on besides u (missing: "
-                       f"{', '.join(sorted(f.name for f in unmirrored))})")
+            self._check_mirrored(velocity, fields)
             w = velocity - self._master_value(velocity, fields)
             if transport is not None:
                 w = w - ufl.as_vector(transport)
