@@ -5,19 +5,19 @@ holds (SciPy), checking the exact point-to-facet distance of the nearest few
 (:data:`CANDIDATES`). A rank holds only the master facets near its slave nodes, not the whole
 master surface: its slave nodes are split once into at most :data:`BOXES` groups (coordinate
 bisection), and at each search every rank all-gathers the groups' bounding boxes at the current
-configuration, each enlarged by the group's search radius, and the bounding box of its own
-master facets' centroids (O(ranks) numbers). Two ranks whose boxes overlap are neighbours: each
-sends the other (point to point) the master facets whose centroids fall in the other's enlarged
-boxes -- their global node indices, reference and current coordinates. A slave node's
-candidates are exact when its radius covers them: the search checks that every node's
-:data:`CANDIDATES`-th nearest centroid is closer than its group's radius, and repeats the
-exchange with larger radii where it is not (each group's radius is then kept for the next
-search, so one exchange is the rule). The candidates are the nearest :data:`CANDIDATES`
-centroids, extended to all centroids as close as the last one, and among them the closest facet
-wins, ties going to the facet whose reference centroid comes first in (x, y, z) order: the
-choice depends on the geometry only, not on which facets a rank holds, so the pairing is the
-same on any number of ranks and with the whole surface gathered (``exchange="all"``, the
-reference the tests compare with).
+configuration with each group's search radius, and the bounding box of its own master facets'
+centroids (O(ranks) numbers). Two ranks whose boxes come within a radius of each other are
+neighbours: each sends the other (point to point) the master facets whose centroids lie within
+the radius of one of the other's boxes -- their global node indices, reference and current
+coordinates. A slave node's candidates are exact when its radius covers them: the search
+checks that every node's :data:`CANDIDATES`-th nearest centroid is closer than its group's
+radius, and repeats the exchange with larger radii where it is not (each group's radius is
+then kept for the next search, so one exchange is the rule). The candidates are the nearest
+:data:`CANDIDATES` centroids, extended to all centroids as close as the last one, and among
+them the closest facet wins, ties going to the facet whose reference centroid comes first in
+(x, y, z) order: the choice depends on the geometry only, not on which facets a rank holds, so
+the pairing is the same on any number of ranks and with the whole surface gathered
+(``exchange="all"``, the reference the tests compare with).
 
 The pairing is the sparse 0/1 operator ``Q`` that carries the displacements of the master
 nodes of each slave node's facet to the slave node (rows: the node's ``dim * nodes_per_facet``
@@ -196,17 +196,26 @@ def _groups(x: np.ndarray, count: int) -> np.ndarray:
     return group
 
 
-def _in_boxes(points: np.ndarray, boxes: np.ndarray) -> np.ndarray:
-    """Whether each point lies in any of the closed ``boxes`` (b, 2, dim): lower, upper."""
-    inside = np.zeros(len(points), dtype=bool)
-    for lower, upper in boxes:
-        inside |= np.all((points >= lower) & (points <= upper), axis=1)
-    return inside
+def _box_distance(points: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
+    """The distance of each point to the box [lower, upper] (0 inside)."""
+    return np.linalg.norm(np.maximum(np.maximum(lower - points, points - upper), 0.0), axis=-1)
 
 
-def _overlap(a: np.ndarray, boxes: np.ndarray) -> bool:
-    """Whether box ``a`` (2, dim) meets any of ``boxes`` (b, 2, dim)."""
-    return bool(np.any(np.all((boxes[:, 0] <= a[1]) & (boxes[:, 1] >= a[0]), axis=1)))
+def _near_boxes(points: np.ndarray, boxes: np.ndarray) -> np.ndarray:
+    """Whether each point is within the radius of any of ``boxes`` (b, 3, dim): lower corner,
+    upper corner and the radius (in every column)."""
+    near = np.zeros(len(points), dtype=bool)
+    for lower, upper, radius in boxes:
+        near |= _box_distance(points, lower, upper) <= radius[0]
+    return near
+
+
+def _boxes_meet(a: np.ndarray, boxes: np.ndarray) -> bool:
+    """Whether box ``a`` (2, dim) comes within the radius of any of ``boxes`` (b, 3, dim)."""
+    if not len(boxes):
+        return False
+    gap = np.maximum(np.maximum(boxes[:, 0] - a[1], a[0] - boxes[:, 1]), 0.0)
+    return bool(np.any(np.linalg.norm(gap, axis=1) <= boxes[:, 2, 0]))
 
 
 class Pairing:
@@ -280,19 +289,19 @@ class Pairing:
         return _Facets.join(pieces, self.nodes_per_facet, self.dim)
 
     def _boxes(self, x_slave: np.ndarray) -> np.ndarray:
-        """The groups' bounding boxes (g, 2, dim) at ``x_slave``, enlarged by their radii
-        (empty groups: none)."""
+        """The groups' bounding boxes at ``x_slave`` with their radii (g, 3, dim): lower and
+        upper corners, the radius repeated (empty groups: none)."""
         boxes = []
         for g, radius in enumerate(self._radius):
             x = x_slave[self._group == g]
             if len(x):
-                boxes.append([x.min(axis=0) - radius, x.max(axis=0) + radius])
-        return np.array(boxes, dtype=float).reshape(-1, 2, self.dim)
+                boxes.append([x.min(axis=0), x.max(axis=0), np.full(self.dim, radius)])
+        return np.array(boxes, dtype=float).reshape(-1, 3, self.dim)
 
     def _neighbour_facets(self, local: _Facets, x_slave: np.ndarray) -> tuple[_Facets, bool]:
-        """The master facets of every rank whose centroids lie in this rank's enlarged boxes,
-        and whether those boxes hold the whole master surface (the candidates are then
-        complete whatever the radii)."""
+        """The master facets of every rank whose centroids lie within the radius of one of
+        this rank's boxes, and whether those hold the whole master surface (the candidates are
+        then complete whatever the radii)."""
         centroid = local.current.mean(axis=1)
         mine = np.array([centroid.min(axis=0), centroid.max(axis=0)]) if len(centroid) else \
             np.full((2, self.dim), np.nan)
@@ -303,19 +312,22 @@ class Pairing:
         whole = (np.array([np.nanmin(masters[present, 0], axis=0),
                            np.nanmax(masters[present, 1], axis=0)])
                  if present.any() else np.zeros((2, self.dim)))
-        complete = bool(len(boxes)) and bool(np.any(np.all(
-            (boxes[:, 0] <= whole[0]) & (boxes[:, 1] >= whole[1]), axis=1)))
+        # the farthest corner of the whole surface's box within some box's radius
+        corners = np.array([[whole[i, k] for k, i in enumerate(bits)]
+                            for bits in np.ndindex(*(2,) * self.dim)])
+        complete = bool(any(np.all(_box_distance(corners, b[0], b[1]) <= b[2, 0])
+                            for b in boxes))
         rank = self.comm.rank
         requests = []
         for q, (_, their_boxes) in enumerate(everyone):
-            if q != rank and present[rank] and _overlap(mine, their_boxes):
-                rows = np.flatnonzero(_in_boxes(centroid, their_boxes))
+            if q != rank and present[rank] and _boxes_meet(mine, their_boxes):
+                rows = np.flatnonzero(_near_boxes(centroid, their_boxes))
                 requests.append(self.comm.isend(local.take(rows), dest=q, tag=7026))
         pieces: list[_Facets] = []
         for q, (theirs, _) in enumerate(everyone):
             if q == rank:
-                pieces.append(local.take(np.flatnonzero(_in_boxes(centroid, boxes))))
-            elif present[q] and _overlap(theirs, boxes):
+                pieces.append(local.take(np.flatnonzero(_near_boxes(centroid, boxes))))
+            elif present[q] and _boxes_meet(theirs, boxes):
                 pieces.append(self.comm.recv(source=q, tag=7026))
         MPI.Request.waitall(requests)
         return _Facets.join(pieces, self.nodes_per_facet, self.dim), complete
@@ -350,12 +362,12 @@ class Pairing:
             ok = complete or bool(np.all(reach * (1 + 1e-9) < self._radius[self._group]))
             if self.comm.allreduce(ok, op=MPI.LAND):
                 break
-            # each group's radius: at least its farthest candidate among the facets held now
+            # each group's radius: beyond its farthest candidate among the facets held now
             # (those of all facets are no farther), or four times larger if too few were held
             for g in range(len(self._radius)):
                 need = reach[self._group == g].max(initial=0.0)
                 self._radius[g] = 4 * self._radius[g] if not np.isfinite(need) else max(
-                    self._radius[g], 1.25 * need)
+                    self._radius[g], 1.1 * need)
         self.held = len(held.global_nodes)
         nodes, reference = self._closest(held, x_slave, candidates)
         if self.Q is not None:
