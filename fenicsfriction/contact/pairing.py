@@ -201,12 +201,19 @@ def _box_distance(points: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> n
     return np.linalg.norm(np.maximum(np.maximum(lower - points, points - upper), 0.0), axis=-1)
 
 
-def _near_boxes(points: np.ndarray, boxes: np.ndarray) -> np.ndarray:
+def _near_boxes(tree: cKDTree | None, points: np.ndarray, boxes: np.ndarray) -> np.ndarray:
     """Whether each point is within the radius of any of ``boxes`` (b, 3, dim): lower corner,
-    upper corner and the radius (in every column)."""
+    upper corner and the radius (in every column). ``tree``: a k-d tree of ``points``, whose
+    balls around the boxes' centres pick the points to check exactly."""
     near = np.zeros(len(points), dtype=bool)
-    for lower, upper, radius in boxes:
-        near |= _box_distance(points, lower, upper) <= radius[0]
+    if tree is None or not len(boxes):
+        return near
+    centre = (boxes[:, 0] + boxes[:, 1]) / 2
+    reach = np.linalg.norm(boxes[:, 1] - boxes[:, 0], axis=1) / 2 + boxes[:, 2, 0]
+    for (lower, upper, radius), ball in zip(boxes, tree.query_ball_point(centre, reach * 1.01),
+                                            strict=True):
+        rows = np.asarray(ball, dtype=np.int64)
+        near[rows[_box_distance(points[rows], lower, upper) <= radius[0]]] = True
     return near
 
 
@@ -318,15 +325,16 @@ class Pairing:
         complete = bool(any(np.all(_box_distance(corners, b[0], b[1]) <= b[2, 0])
                             for b in boxes))
         rank = self.comm.rank
+        tree = cKDTree(centroid) if len(centroid) else None
         requests = []
         for q, (_, their_boxes) in enumerate(everyone):
             if q != rank and present[rank] and _boxes_meet(mine, their_boxes):
-                rows = np.flatnonzero(_near_boxes(centroid, their_boxes))
+                rows = np.flatnonzero(_near_boxes(tree, centroid, their_boxes))
                 requests.append(self.comm.isend(local.take(rows), dest=q, tag=7026))
         pieces: list[_Facets] = []
         for q, (theirs, _) in enumerate(everyone):
             if q == rank:
-                pieces.append(local.take(np.flatnonzero(_near_boxes(centroid, boxes))))
+                pieces.append(local.take(np.flatnonzero(_near_boxes(tree, centroid, boxes))))
             elif present[q] and _boxes_meet(theirs, boxes):
                 pieces.append(self.comm.recv(source=q, tag=7026))
         MPI.Request.waitall(requests)
