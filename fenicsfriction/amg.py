@@ -36,7 +36,7 @@ from dolfinx import fem
 from fenicsfriction.laws import check
 
 __all__ = ["AMG_TYPES", "LINEAR_SOLVER_PATHS", "amg_options", "attach_near_nullspace",
-           "bodies", "choose_linear_solver", "rigid_body_modes", "uses_amg"]
+           "bodies", "choose_linear_solver", "requested_amg", "rigid_body_modes", "uses_amg"]
 
 #: the AMG preconditioners :func:`amg_options` configures (PETSc ``pc_type``)
 AMG_TYPES = ("gamg", "hypre")
@@ -47,15 +47,16 @@ LINEAR_SOLVER_PATHS = ("lu", "condensed", "reused-lu", "amg")
 #: ``"auto"`` solves by AMG from this many unknowns per rank on in 3D where the alternative
 #: is a sparse LU at every Newton iteration (contact-free dynamics, a Jacobian that does not
 #: split). Measured on the 3D block's steady continuation (Q2, μ = 0 → 0.5 in 5 steps, 13
-#: Newton iterations, one run, load average 10 on 2 cores): LU/AMG wall time 0.86 at 18,525
-#: unknowns (38 s / 44 s), 2.1 at 42,075 (536 s / 259 s): the crossover near 2.5e4
+#: Newton iterations, load average 6-15 on 2 cores): LU/AMG wall time 0.85 at 18,525
+#: unknowns (38.0 s / 44.5 s, one run), 2.1 at 42,075 (536 s / 259 s, two runs): the
+#: crossover near 2.5e4
 AMG_MIN_UNKNOWNS_3D = 25_000
 
 #: and from this many where the steady Jacobian splits and the LU of its bulk is reused
-#: (:mod:`fenicsfriction.reused_lu`): the reused LU was 4.0x faster than AMG at 18,525
-#: unknowns (17 s / 68 s) and 3.5x / 2.3x at 42,075 (75 s / 259 s and 96 s / 222 s, two runs),
-#: its time growing like n^1.8 against AMG's n^1.2: extrapolated, the crossover lies near
-#: 2.5e5 (not measured: beyond it MUMPS's fill, n^(4/3), is the limit before its time)
+#: (:mod:`fenicsfriction.reused_lu`): the reused LU was 3.4x faster than AMG at 18,525
+#: unknowns (12.9 s / 44.5 s), 3.5x and 2.3x at 42,075 (two runs) and 2.9x at 80,073 (273 s /
+#: 784 s), its time growing like n^2.0 against AMG's n^1.7 there. This bound is not a
+#: measured time crossover: it is where MUMPS's fill (n^(4/3)) rather than its time decides
 AMG_MIN_UNKNOWNS_3D_REUSED_LU = 250_000
 
 #: in 2D from this many: MUMPS's fill grows like n log n there and the condensation onto the
@@ -208,6 +209,14 @@ def amg_options(dim: int, preconditioner: str = "gamg", symmetric: bool = False)
             "pc_hypre_boomeramg_coarsen_type": "HMIS",
             "pc_hypre_boomeramg_interp_type": "ext+i",
             "pc_hypre_boomeramg_agg_nl": 1}
+
+
+def requested_amg(prefix: str) -> str | None:
+    """The AMG preconditioner the options database asks for under ``prefix``
+    (``-<prefix>pc_type gamg`` or ``hypre``, e.g. from the command line), else ``None``: a
+    solver then takes the AMG path with that preconditioner's defaults."""
+    pc_type = PETSc.Options(prefix).getString("pc_type", "")
+    return pc_type if pc_type in AMG_TYPES else None
 
 
 def uses_amg(ksp: PETSc.KSP) -> bool:

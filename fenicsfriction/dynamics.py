@@ -37,7 +37,13 @@ import ufl
 from dolfinx import fem
 
 from fenicsfriction import _compat
-from fenicsfriction.amg import amg_options, attach_near_nullspace, choose_linear_solver, uses_amg
+from fenicsfriction.amg import (
+    amg_options,
+    attach_near_nullspace,
+    choose_linear_solver,
+    requested_amg,
+    uses_amg,
+)
 from fenicsfriction.assembly import (
     BulkWatcher,
     CoupledMatrix,
@@ -83,7 +89,8 @@ class DynamicsSolver(Alpha2Integrator):
             preconditioned by GAMG with the bodies' rigid-body near-nullspace,
             :mod:`fenicsfriction.amg`) or ``"auto"`` (default: AMG beyond the measured
             crossover of :func:`~fenicsfriction.amg.choose_linear_solver`, else the LU). A PC
-            chosen in the PETSc options (``-<prefix>pc_type``) overrides it.
+            chosen in the PETSc options overrides it (``-<prefix>pc_type lu``: the LU;
+            ``gamg`` or ``hypre``: the AMG path with that preconditioner).
 
     Attributes:
         linear_solver: the path in effect (``"lu"`` or ``"amg"``).
@@ -139,11 +146,14 @@ class DynamicsSolver(Alpha2Integrator):
         if self._coupled is not None:
             self.A = self._coupled.A
         dim = msh.geometry.dim
+        amg_type = requested_amg(prefix)
+        if amg_type is not None:  # -<prefix>pc_type gamg|hypre: the AMG path, its defaults
+            linear_solver = "amg"
         if linear_solver == "auto":
             linear_solver = choose_linear_solver(dim, self.b.getSize(), msh.comm.size, False,
                                                  contact=bool(self.couplings))
         if linear_solver == "amg":
-            options = {**amg_options(dim), **(options or {})}
+            options = {**amg_options(dim, amg_type or "gamg"), **(options or {})}
         super().__init__(msh.comm, prefix, self.b, self.A, options, atol, predictor)
         self.linear_solver, self.near_nullspace = "lu", None
         if uses_amg(self.ts.getSNES().getKSP()):

@@ -42,6 +42,7 @@ from fenicsfriction.amg import (
     amg_options,
     attach_near_nullspace,
     choose_linear_solver,
+    requested_amg,
     uses_amg,
 )
 from fenicsfriction.assembly import (
@@ -167,9 +168,10 @@ class SteadySolver:
             condensed while the dense Schur complement is small against
             the Jacobian (:data:`AUTO_CONDENSE_MAX_FILL`: in 2D), the reused LU beyond (3D),
             the LU where the Jacobian does not split. A PC chosen
-            in the PETSc options (``-<prefix>pc_type lu``) overrides it. Where the Jacobian
-            splits, the first two and AMG assemble the constant bulk once and only the
-            interface at each iteration (docs/solvers.md has what each costs).
+            in the PETSc options overrides it: ``-<prefix>pc_type lu`` the direct path,
+            ``-<prefix>pc_type gamg`` or ``hypre`` the AMG path with that preconditioner.
+            Where the Jacobian splits, the first two and AMG assemble the constant bulk once
+            and only the interface at each iteration (docs/solvers.md has what each costs).
         search_rounds: how many Newton solves :meth:`solve_searched` (each step of
             :func:`continuation`) may run until a search of the contact couplings at the
             converged state keeps their pairing; 1 (default): one solve, no search after it.
@@ -215,6 +217,9 @@ class SteadySolver:
             self.A = self._coupled.A
         comm = self.u.function_space.mesh.comm
         dim = self.u.function_space.mesh.geometry.dim
+        amg_type = requested_amg(prefix)
+        if amg_type is not None:  # -<prefix>pc_type gamg|hypre: the AMG path, its defaults
+            linear_solver = "amg"
         split = (None if linear_solver == "lu" or self.couplings
                  else interface_split(jacobian, self.u))
         if linear_solver == "auto" and choose_linear_solver(
@@ -239,7 +244,8 @@ class SteadySolver:
         self.snes.setFunction(self._F, self.b)
         self.snes.setJacobian(self._J, self.A)
         defaults = {**DEFAULT_OPTIONS, **(KRYLOV_OPTIONS if self.preconditioner else {}),
-                    **(amg_options(dim) if linear_solver == "amg" else {}), **(options or {})}
+                    **(amg_options(dim, amg_type or "gamg") if linear_solver == "amg" else {}),
+                    **(options or {})}
         with options_with_defaults(prefix, defaults):
             self.snes.setFromOptions()
             self.snes.getKSP().setFromOptions()

@@ -201,6 +201,16 @@ def test_auto_takes_amg_beyond_the_crossover(monkeypatch):
     finally:
         opts.delValue("amgautolu_pc_type")
     assert direct.linear_solver == "lu" and direct.near_nullspace is None
+    # and an AMG preconditioner asked for on the command line takes the AMG path's defaults
+    monkeypatch.setattr(amg, "AMG_MIN_UNKNOWNS_3D_REUSED_LU", 10**9)
+    opts["amgautohypre_pc_type"] = "hypre"
+    try:
+        hypre = ff.SteadySolver(model.residual, prefix="amgautohypre_",
+                                options=model.solver_options())
+    finally:
+        opts.delValue("amgautohypre_pc_type")
+    assert hypre.linear_solver == "amg" and hypre.snes.getKSP().getType() == "gmres"
+    assert hypre.snes.getKSP().getPC().getHYPREType() == "boomeramg"
 
 
 def test_an_unknown_linear_solver_is_refused_by_name():
