@@ -119,12 +119,14 @@ def test_dynamics_by_amg_steps_like_the_lu():
 
 
 def test_krylov_counts_do_not_grow_with_the_mesh():
-    """GMRES + GAMG with the rigid modes on the 3D block (Q2) at h, h/2, h/3 (945, 5,967 and
-    18,525 unknowns): the mean Krylov count per Newton iteration grows by at most 1.5x (a
-    one-level preconditioner's grows like 1/h: 3x)."""
+    """GMRES + GAMG with the rigid modes on the 3D block (Q1) at h, h/2, h/3 (945, 5,967 and
+    18,525 unknowns; measured 12.3, 15.0 and 16.3 Krylov iterations per Newton iteration):
+    the mean count grows by at most 1.5x, where a one-level preconditioner's grows like
+    1/h (3x)."""
     counts = []
-    for refine in (1, 2, 3):
-        model = ff.BlockOnBelt(refine=refine, dim=3).build(MPI.COMM_WORLD, with_friction=True)
+    for refine in (2, 4, 6):
+        model = ff.BlockOnBelt(refine=refine, dim=3, degree=1).build(MPI.COMM_WORLD,
+                                                                     with_friction=True)
         model.initial_guess()
         model.mu.value = 0.3
         solver = ff.SteadySolver(model.residual, prefix=f"amgcount{refine}_",
