@@ -268,7 +268,7 @@ class SteadySolver:
         if uses_amg(self.snes.getKSP()):  # also when chosen by the options only
             self.near_nullspace = attach_near_nullspace(self.A, self.u.function_space)
             self.linear_solver = "amg"
-        #: defaults in place during each solve: AMG's levels are configured at the first
+        # defaults in place during each solve: AMG configures its levels at the first
         self._solve_defaults = defaults if self.linear_solver == "amg" else {}
         if (self.preconditioner is not None or self.linear_solver == "amg") and split is not None:
             # the bulk's Jacobian is constant: assembled once, the interface at each iteration
