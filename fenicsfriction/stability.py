@@ -64,7 +64,7 @@ import numpy as np
 import scipy.optimize
 
 from fenicsfriction import _compat
-from fenicsfriction._eig_prototype import rigid_body_modes
+from fenicsfriction.amg import amg_options, rigid_body_modes, uses_amg
 from fenicsfriction.assembly import (
     BulkWatcher,
     CoupledMatrix,
@@ -94,19 +94,14 @@ DEFAULT_OPTIONS = {
 }
 
 #: the spectral transformation's inner solve by Krylov + AMG (over :data:`DEFAULT_OPTIONS`):
-#: GMRES, as P(σ) is not symmetric (friction), preconditioned by GAMG smoothing by SOR (on the
-#: 3D block at 5,967 unknowns 21 GMRES iterations and 0.55x the CPU time of GAMG's default
-#: Chebyshev smoother, 30 iterations; hypre's BoomerAMG took 1.7x; docs/benchmarks.md). The
-#: multigrid's level options are read when it is set up, at the solve: the solvers keep these
-#: defaults in the options database through it.
-AMG_OPTIONS = {
-    "st_ksp_type": "gmres",
-    "st_ksp_gmres_restart": 100,
-    "st_ksp_max_it": 5000,
-    "st_pc_type": "gamg",
-    "st_mg_levels_ksp_type": "richardson",
-    "st_mg_levels_pc_type": "sor",
-}
+#: the steady solvers' AMG path (:func:`fenicsfriction.amg.amg_options`: GMRES, as P(σ) is not
+#: symmetric with friction, preconditioned by GAMG with Chebyshev/Jacobi smoothing) under the
+#: ST's prefix, with room for the tighter inner tolerance. GAMG's level options are read when
+#: it is set up, at the solve: the solvers keep these defaults in the database through it.
+#: (SOR smoothing took 0.55x the CPU time on the 3D block at 5,967 unknowns but met a singular
+#: diagonal block at 42,075.)
+AMG_OPTIONS = {f"st_{key}": value for key, value in amg_options(3).items()
+               if key not in ("ksp_rtol", "ksp_max_it")} | {"st_ksp_max_it": 5000}
 
 #: the inner solves' relative tolerance is this times the eigen tolerance (``pep_tol``,
 #: ``eps_tol``) unless ``st_ksp_rtol`` is set
@@ -114,10 +109,6 @@ INNER_RTOL_FACTOR = 1e-2
 
 #: ``inner="auto"`` solves 3D problems above this many unknowns by AMG (2D always by LU)
 AMG_ABOVE_3D = 200_000
-
-#: the preconditioner types that take the block size and near-nullspace of P(σ)
-_MULTIGRID = ("gamg", "hypre", "ml")
-
 
 def choose_inner(inner: str, size: int, block_size: int) -> str:
     """``"direct"`` or ``"amg"``: ``inner`` itself, or for ``"auto"`` AMG on 3D problems
@@ -150,7 +141,10 @@ class ShiftInvert:
         for a symmetric positive definite shifted matrix."""
         if inner != "amg":
             return {}
-        return {**AMG_OPTIONS, "st_ksp_type": "cg"} if symmetric else AMG_OPTIONS
+        if not symmetric:
+            return AMG_OPTIONS
+        return {**{f"st_{key}": value for key, value in amg_options(3, symmetric=True).items()
+                   if key not in ("ksp_rtol", "ksp_max_it")}, "st_ksp_max_it": 5000}
 
     def configure(self, opts: PETSc.Options, eigen_tol: float) -> None:
         """After ``setFromOptions``: the inner relative tolerance :data:`INNER_RTOL_FACTOR` ×
@@ -161,7 +155,7 @@ class ShiftInvert:
     @property
     def multigrid(self) -> bool:
         """Whether the inner preconditioner is a multigrid (else a factorisation or other)."""
-        return self.st.getKSP().getPC().getType() in _MULTIGRID
+        return uses_amg(self.st.getKSP())
 
     @property
     def path(self) -> str:
