@@ -26,10 +26,14 @@ PETSc/SLEPc options live under the prefix (default ``stability_``).
 :math:`P(\sigma)` that carries the block size and the rigid-body near-nullspace
 (:func:`fenicsfriction.amg.rigid_body_modes`); ``"auto"`` takes AMG for 3D problems of more
 than :data:`AMG_ABOVE_3D` unknowns, where the LU's fill (memory ~ n^{4/3}) stops fitting, and
-the LU otherwise. TOAR's Krylov basis is only as accurate as the inner solves, so their relative
-tolerance is tied to the eigen tolerance, ``st_ksp_rtol`` = :data:`INNER_RTOL_FACTOR` ×
-``pep_tol``, and every returned pair's residual is measured against the full operators: a pair
-computed with too loose an inner solve is flagged (``accurate`` False), never passed silently.
+the LU otherwise: where both fit, the LU is an order of magnitude cheaper, since TOAR needs
+~50 inner solves each to 1e-12 (docs/benchmarks.md, "Eigenvalues at scale"). TOAR's Krylov
+basis is only as accurate as the inner solves, so their relative tolerance is tied to the
+eigen tolerance, ``st_ksp_rtol`` = :data:`INNER_RTOL_FACTOR` × ``pep_tol``, and every returned pair's residual is measured against the full operators. The
+residual is a backward error: it flags the pairs an inner solve too loose has spoiled where the
+eigenvalue is well conditioned (the flutter pair of the block at 1e-4), but a badly conditioned
+one (the block's soft-spring mode: 40 % off at 1e-4 with a residual of 1e-9) can pass it, so
+the inner tolerance, not the check, is the safeguard and should not be loosened.
 Any option set in the PETSc database (``-stability_st_pc_type hypre``, ``-stability_st_ksp_rtol
 ...``) overrides these choices.
 
@@ -107,8 +111,11 @@ AMG_OPTIONS = {f"st_{key}": value for key, value in amg_options(3).items()
 #: ``eps_tol``) unless ``st_ksp_rtol`` is set
 INNER_RTOL_FACTOR = 1e-2
 
-#: ``inner="auto"`` solves 3D problems above this many unknowns by AMG (2D always by LU)
-AMG_ABOVE_3D = 200_000
+#: ``inner="auto"`` solves 3D problems above this many unknowns by AMG (2D always by LU): on
+#: the 3D block the LU path took 18x less CPU time at 5,967 unknowns and its stage's peak memory
+#: was 4.4 GiB at 135,975; growing like n^(4/3) it nears 20 GiB at 4e5 (docs/benchmarks.md,
+#: "Eigenvalues at scale"), so AMG is the path only where the LU no longer fits
+AMG_ABOVE_3D = 400_000
 
 def choose_inner(inner: str, size: int, block_size: int) -> str:
     """``"direct"`` or ``"amg"``: ``inner`` itself, or for ``"auto"`` AMG on 3D problems
