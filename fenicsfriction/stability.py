@@ -33,7 +33,8 @@ eigen tolerance, ``st_ksp_rtol`` = :data:`INNER_RTOL_FACTOR` × ``pep_tol``, and
 returned pair's residual is measured against the full operators. The residual is a backward
 error: it flags the pairs an inner solve too loose has spoiled where the eigenvalue is well
 conditioned (the flutter pair of the block at 1e-4), but a badly conditioned one (the block's
-soft-spring mode: 40 % off at 1e-4 with a residual of 1e-9) can pass it, so the inner tolerance, not the check, is the safeguard and should not be loosened.
+soft-spring mode: 40 % off at 1e-4 with a residual of 1e-9) can pass it, so the inner
+tolerance, not the check, is the safeguard and should not be loosened.
 Any option set in the PETSc database (``-stability_st_pc_type hypre``, ``-stability_st_ksp_rtol
 ...``) overrides these choices.
 
