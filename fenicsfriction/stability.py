@@ -113,9 +113,9 @@ AMG_OPTIONS = {f"st_{key}": value for key, value in amg_options(3).items()
 INNER_RTOL_FACTOR = 1e-2
 
 #: ``inner="auto"`` solves 3D problems above this many unknowns by AMG (2D always by LU): on
-#: the 3D block the LU path took 18x less CPU time at 5,967 unknowns and its stage's peak memory
-#: was 4.4 GiB at 135,975; growing like n^(4/3) it nears 20 GiB at 4e5 (docs/benchmarks.md,
-#: "Eigenvalues at scale"), so AMG is the path only where the LU no longer fits
+#: the 3D block the LU path took 13-18x less CPU time where both ran (6e3-4e4 unknowns), and
+#: its stage's peak memory, 4.4 GiB at 135,975, reaches 24 GiB near 4.9e5 if it grows like
+#: n^(4/3) (docs/benchmarks.md, "Eigenvalues at scale"): AMG only where the LU may not fit
 AMG_ABOVE_3D = 400_000
 
 def choose_inner(inner: str, size: int, block_size: int) -> str:
