@@ -143,7 +143,9 @@ def run_size(refine: int, comm: MPI.Comm, direct_max_dofs: int, paths: list[str]
     if "amg" in results and "direct" in results:
         amg, direct = (np.array(results[k]["values"]) for k in ("amg", "direct"))
         if len(amg) == len(direct):
-            record["relative_difference"] = (np.abs(amg - direct) / np.abs(direct)).tolist()
+            # to the nearest AMG eigenvalue: the flutter pair's ±Re λ have equal moduli
+            nearest = np.abs(amg[None, :] - direct[:, None]).min(axis=1)
+            record["relative_difference"] = (nearest / np.abs(direct)).tolist()
             record["max_relative_difference"] = float(max(record["relative_difference"]))
             record["time_ratio_amg_over_direct"] = \
                 results["amg"]["time_s"] / results["direct"]["time_s"]
