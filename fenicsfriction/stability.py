@@ -5,8 +5,8 @@ The operators are the Gateaux derivatives of the one residual at the steady stat
 couples normal displacement into tangential force (Martins & Oden 1986, eq. 31). Re λ > 0 means the
 steady sliding is dynamically unstable.
 
-SLEPc PEP (TOAR) with shift-and-invert about a real shift σ > 0 (MUMPS LU) computes the
-eigenvalues nearest σ; the number requested grows until every eigenvalue with
+SLEPc PEP (TOAR) with shift-and-invert about a real shift σ > 0 computes the eigenvalues
+nearest σ; the number requested grows until every eigenvalue with
 :math:`|\lambda| \le \omega_{max}` has been found, so all modes whose frequency and growth rate
 lie in that disc — those that can go unstable in the band of interest — are caught. In the real
 PETSc build, complex eigenvalues come in conjugate pairs; only Im λ >= 0 is kept. Each
@@ -18,6 +18,25 @@ eigenpair carries its relative residual
 and is flagged when that exceeds ``residual_tol``. Dirichlet dofs have 1 on the diagonal of
 :math:`\bar K` and 0 in M and C, so their eigenvalues are infinite and never near the shift.
 PETSc/SLEPc options live under the prefix (default ``stability_``).
+
+**The inner solves** of shift-and-invert, with :math:`P(\sigma) = \sigma^2 M + \sigma C + \bar K`
+(the matrix SLEPc's spectral transformation assembles), are chosen by ``inner``:
+``"direct"`` factorises it (MUMPS LU, then one triangular solve per Krylov step of TOAR);
+``"amg"`` solves it by GMRES preconditioned by PETSc's GAMG, built on a copy of
+:math:`P(\sigma)` that carries the block size and the rigid-body near-nullspace
+(:func:`fenicsfriction.amg.rigid_body_modes`); ``"auto"`` takes AMG for 3D problems of more
+than :data:`AMG_ABOVE_3D` unknowns, where the LU's fill (memory ~ n^{4/3}) stops fitting, and
+the LU otherwise: where both fit, the LU is an order of magnitude cheaper, since TOAR needs
+~50 inner solves each to 1e-12 (docs/benchmarks.md, "Eigenvalues at scale"). TOAR's Krylov
+basis is only as accurate as the inner solves, so their relative tolerance is tied to the
+eigen tolerance, ``st_ksp_rtol`` = :data:`INNER_RTOL_FACTOR` × ``pep_tol``, and every
+returned pair's residual is measured against the full operators. The residual is a backward
+error: it flags the pairs an inner solve too loose has spoiled where the eigenvalue is well
+conditioned (the flutter pair of the block at 1e-4), but a badly conditioned one (the block's
+soft-spring mode: 40 % off at 1e-4 with a residual of 1e-9) can pass it, so the inner
+tolerance, not the check, is the safeguard and should not be loosened.
+Any option set in the PETSc database (``-stability_st_pc_type hypre``, ``-stability_st_ksp_rtol
+...``) overrides these choices.
 
 **The friction switch** of complex eigenvalue analysis: ``friction_stiffness=False`` drops the
 friction part of :math:`\bar K` (the derivative of the friction force with respect to the
@@ -50,6 +69,7 @@ import numpy as np
 import scipy.optimize
 
 from fenicsfriction import _compat
+from fenicsfriction.amg import amg_options, rigid_body_modes, uses_amg
 from fenicsfriction.assembly import (
     BulkWatcher,
     CoupledMatrix,
@@ -63,7 +83,8 @@ from fenicsfriction.numerics import bisect
 from fenicsfriction.petsc_options import options_with_defaults
 from fenicsfriction.results import Record
 
-__all__ = ["EigenSolveError", "Eigensolver", "Loci", "Mode", "Onset", "StabilitySolver", "mac",
+__all__ = ["AMG_ABOVE_3D", "AMG_OPTIONS", "INNER_RTOL_FACTOR", "EigenSolveError", "Eigensolver",
+           "Loci", "Mode", "Onset", "ShiftInvert", "StabilitySolver", "choose_inner", "mac",
            "relative_residual", "track", "unstable_intervals"]
 
 DEFAULT_OPTIONS = {
@@ -76,6 +97,104 @@ DEFAULT_OPTIONS = {
     "st_pc_type": "lu",
     "st_pc_factor_mat_solver_type": "mumps",
 }
+
+#: the spectral transformation's inner solve by Krylov + AMG (over :data:`DEFAULT_OPTIONS`):
+#: the steady solvers' AMG path (:func:`fenicsfriction.amg.amg_options`: GMRES, as P(σ) is not
+#: symmetric with friction, preconditioned by GAMG with Chebyshev/Jacobi smoothing) under the
+#: ST's prefix, with room for the tighter inner tolerance. GAMG's level options are read when
+#: it is set up, at the solve: the solvers keep these defaults in the database through it.
+#: (SOR smoothing took 0.55x the CPU time on the 3D block at 5,967 unknowns but met a singular
+#: diagonal block at 42,075.)
+AMG_OPTIONS = {f"st_{key}": value for key, value in amg_options(3).items()
+               if key not in ("ksp_rtol", "ksp_max_it")} | {"st_ksp_max_it": 5000}
+
+#: the inner solves' relative tolerance is this times the eigen tolerance (``pep_tol``,
+#: ``eps_tol``) unless ``st_ksp_rtol`` is set
+INNER_RTOL_FACTOR = 1e-2
+
+#: ``inner="auto"`` solves 3D problems above this many unknowns by AMG (2D always by LU): on
+#: the 3D block the LU path took 13-18x less CPU time where both ran (6e3-4e4 unknowns), and
+#: its stage's peak memory, 4.4 GiB at 135,975, reaches 24 GiB near 4.9e5 if it grows like
+#: n^(4/3) (docs/benchmarks.md, "Eigenvalues at scale"): AMG only where the LU may not fit
+AMG_ABOVE_3D = 400_000
+
+def choose_inner(inner: str, size: int, block_size: int) -> str:
+    """``"direct"`` or ``"amg"``: ``inner`` itself, or for ``"auto"`` AMG on 3D problems
+    (``block_size`` 3) of more than :data:`AMG_ABOVE_3D` unknowns (``size``)."""
+    check("inner", inner, inner in ("auto", "direct", "amg"), "must be auto, direct or amg")
+    if inner != "auto":
+        return inner
+    return "amg" if block_size == 3 and size > AMG_ABOVE_3D else "direct"
+
+
+class ShiftInvert:
+    """The inner solves of a SLEPc spectral transformation with shift-and-invert (module
+    docstring, "The inner solves"): the options of the chosen path and, for a multigrid
+    preconditioner, the matrix it is built from with its block size and near-nullspace.
+
+    Args:
+        st: the ST of a PEP or EPS (its options prefix set).
+
+    Attributes:
+        preconditioner: the matrix the multigrid was last built from (None without one).
+    """
+
+    def __init__(self, st: SLEPc.ST):
+        self.st = st
+        self.preconditioner: PETSc.Mat | None = None
+
+    @staticmethod
+    def options(inner: str, symmetric: bool = False) -> dict:
+        """The options of a path (``"direct"`` or ``"amg"``) over :data:`DEFAULT_OPTIONS`; CG
+        for a symmetric positive definite shifted matrix."""
+        if inner != "amg":
+            return {}
+        if not symmetric:
+            return AMG_OPTIONS
+        return {**{f"st_{key}": value for key, value in amg_options(3, symmetric=True).items()
+                   if key not in ("ksp_rtol", "ksp_max_it")}, "st_ksp_max_it": 5000}
+
+    def configure(self, opts: PETSc.Options, eigen_tol: float) -> None:
+        """After ``setFromOptions``: the inner relative tolerance :data:`INNER_RTOL_FACTOR` ×
+        ``eigen_tol`` unless ``st_ksp_rtol`` is set in ``opts`` (the solver's prefix)."""
+        if self.multigrid and not opts.hasName("st_ksp_rtol"):
+            self.st.getKSP().setTolerances(rtol=INNER_RTOL_FACTOR * eigen_tol)
+
+    @property
+    def multigrid(self) -> bool:
+        """Whether the inner preconditioner is a multigrid (else a factorisation or other)."""
+        return uses_amg(self.st.getKSP())
+
+    @property
+    def path(self) -> str:
+        """``"amg"`` (a multigrid preconditioner) or ``"direct"``."""
+        return "amg" if self.multigrid else "direct"
+
+    def update(self, shift: float, operators: typing.Sequence[PETSc.Mat],
+               near_nullspace: PETSc.NullSpace | None) -> None:
+        """Before a solve with new values: a new factorisation, or for a multigrid the matrix
+        :math:`\\sum_k s^k A_k` of ``operators`` (lowest degree first; s = ``shift``) with
+        the first one's block size and ``near_nullspace``, as the preconditioning matrix
+        (SLEPc assembles its own copy as the operator, without them)."""
+        pc = self.st.getKSP().getPC()
+        pc.reset()
+        if not self.multigrid:
+            return
+        if self.preconditioner is not None:
+            self.preconditioner.destroy()
+        P = operators[0].copy()
+        for k, A in enumerate(operators[1:], start=1):
+            P.axpy(shift**k, A, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        if near_nullspace is not None:
+            P.setNearNullSpace(near_nullspace)
+        self.preconditioner = P
+        self.st.setPreconditionerMat(P)
+
+    def destroy(self) -> None:
+        """Free the preconditioning matrix (collective)."""
+        if self.preconditioner is not None:
+            self.preconditioner.destroy()
+            self.preconditioner = None
 
 
 class EigenSolveError(RuntimeError):
@@ -156,6 +275,8 @@ class StabilitySolver:
         residual_tol: eigenpairs with a larger relative residual are flagged inaccurate.
         friction_stiffness: keep the friction part of K̄ (see the module docstring).
         friction_damping: keep the friction part of C.
+        inner: the inner solves of shift-and-invert, ``"direct"``, ``"amg"`` or ``"auto"``
+            (module docstring, "The inner solves"); options in the database override it.
 
     Raises:
         ValueError: a friction part is dropped but the residual has no friction constant
@@ -166,11 +287,14 @@ class StabilitySolver:
         K, C, M: the assembled PETSc matrices (after :meth:`assemble`).
         frictionless: the names ("K", "C") of the operators assembled without their friction
             part.
+        shift_invert: the inner solves (:class:`ShiftInvert`); ``shift_invert.path`` is the
+            one in use, ``"direct"`` or ``"amg"``.
     """
 
     def __init__(self, residual: Residual, prefix: str = "stability_",
                  options: dict | None = None, residual_tol: float = 1e-8,
-                 friction_stiffness: bool = True, friction_damping: bool = True):
+                 friction_stiffness: bool = True, friction_damping: bool = True,
+                 inner: str = "auto"):
         check("residual_tol", residual_tol, residual_tol > 0, "must be > 0")
         dropped = [name for name, kept in (("friction_stiffness", friction_stiffness),
                                            ("friction_damping", friction_damping)) if not kept]
@@ -213,13 +337,20 @@ class StabilitySolver:
         self.pep.setOperators([self.K, self.C, self.M])
         self.pep.setProblemType(SLEPc.PEP.ProblemType.GENERAL)
         self.pep.setWhichEigenpairs(SLEPc.PEP.Which.TARGET_MAGNITUDE)
-        with options_with_defaults(prefix, {**DEFAULT_OPTIONS, **(options or {})}) as opts:
+        path = choose_inner(inner, self.K.getSize()[0], residual.V.dofmap.index_map_bs)
+        self.shift_invert = ShiftInvert(self.pep.getST())
+        self._prefix = prefix
+        self._defaults = {**DEFAULT_OPTIONS, **ShiftInvert.options(path), **(options or {})}
+        with options_with_defaults(prefix, self._defaults) as opts:
             self.pep.setFromOptions()
+            self.shift_invert.configure(opts, self.pep.getTolerances()[0])
             # the subspace sizes set by the user, else PETSc's choice for each nev: given at
             # every setDimensions, as slepc4py >= 3.20 keeps the previous ncv when none is
             self._subspace = {key: opts.getInt(f"pep_{key}", PETSc.DECIDE)
                               for key in ("ncv", "mpd")}
         self._norms = (1.0, 1.0, 1.0)
+        if self.shift_invert.multigrid:
+            self.K.setNearNullSpace(rigid_body_modes(residual.V))
 
     def _assemble(self, name: str) -> None:
         """Assemble the integrals of K̄ (nodal springs included), C or M (``name``)."""
@@ -290,6 +421,7 @@ class StabilitySolver:
         radius = max_modulus + abs(shift)
         self.assemble()
         self.pep.setOperators([self.K, self.C, self.M])  # values changed: set up again
+        self.shift_invert.update(shift, (self.K, self.C, self.M), self.K.getNearNullSpace())
         self.pep.setTarget(shift)
         n = self.K.getSize()[0]
         while True:
@@ -297,7 +429,8 @@ class StabilitySolver:
             if ncv != PETSc.DECIDE:  # the user's subspace, large enough for a doubled nev
                 ncv = min(max(ncv, 2 * nev), n)
             self.pep.setDimensions(nev=min(nev, n), ncv=ncv, mpd=mpd)
-            self.pep.solve()
+            with options_with_defaults(self._prefix, self._defaults):  # the multigrid's
+                self.pep.solve()
             count = self.pep.getConverged()
             values = [self.pep.getEigenpair(i) for i in range(count)]
             covered = count > 0 and max(abs(v - shift) for v in values) > radius

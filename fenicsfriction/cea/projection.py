@@ -2,7 +2,10 @@
 the symmetric, frictionless problem (what brake codes call modal CEA, ANSYS's QRDAMP).
 
 The basis Φ holds the m lowest modes of :math:`K_s \\phi = \\omega^2 M \\phi` (SLEPc EPS, GHEP,
-shift-and-invert with a MUMPS LU), :math:`K_s` the symmetric part of the stiffness, normalised
+shift-and-invert with a MUMPS LU, or with CG preconditioned by GAMG: ``inner``, chosen as the
+stability solver's, :class:`~fenicsfriction.stability.ShiftInvert`, the multigrid taking K's
+block size and the near-nullspace attached to K), :math:`K_s` the symmetric part of the
+stiffness, normalised
 :math:`\\Phi^T M \\Phi = I`. Each pencil of a parameter sweep is then projected,
 :math:`\\Phi^T A \\Phi` (m × m, replicated on every rank), solved densely
 (:mod:`~fenicsfriction.cea.dense`) and its eigenvectors lifted back, :math:`w = \\Phi q`; the
@@ -26,7 +29,13 @@ from fenicsfriction.cea.band import Band
 from fenicsfriction.cea.dense import quadratic_eig
 from fenicsfriction.laws import check
 from fenicsfriction.petsc_options import options_with_defaults
-from fenicsfriction.stability import EigenSolveError, Mode, relative_residual
+from fenicsfriction.stability import (
+    EigenSolveError,
+    Mode,
+    ShiftInvert,
+    choose_inner,
+    relative_residual,
+)
 
 __all__ = ["DEFAULT_OPTIONS", "ModalBasis", "symmetric_part"]
 
@@ -42,10 +51,13 @@ DEFAULT_OPTIONS = {
 
 
 def symmetric_part(K: PETSc.Mat) -> PETSc.Mat:
-    """:math:`(K + K^T)/2`, a new matrix."""
+    """:math:`(K + K^T)/2`, a new matrix (with K's near-nullspace, for a multigrid)."""
     Ks = K.transpose(PETSc.Mat())
     Ks.axpy(1.0, K, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
     Ks.scale(0.5)
+    near_nullspace = K.getNearNullSpace()
+    if near_nullspace is not None and near_nullspace.handle:
+        Ks.setNearNullSpace(near_nullspace)
     return Ks
 
 
@@ -62,16 +74,21 @@ class ModalBasis:
             σ keeps it regular when K_s is singular (free bodies).
         prefix: PETSc options prefix of the EPS (and its ST/KSP/PC).
         options: defaults over :data:`DEFAULT_OPTIONS` (user options in the database win).
+        inner: the inner solves of shift-and-invert, ``"direct"``, ``"amg"`` (CG + GAMG on
+            K - σM, positive definite for σ below the lowest mode) or ``"auto"``
+            (:func:`~fenicsfriction.stability.choose_inner`).
 
     Attributes:
         eps: the SLEPc EPS used.
+        shift_invert: its inner solves; ``shift_invert.path`` is ``"direct"`` or ``"amg"``.
         omega2: the eigenvalues ω² [rad²/s²] of the modes, increasing.
         phi: this rank's rows of Φ (n_local × m), M-orthonormal columns.
     """
 
     def __init__(self, K: PETSc.Mat, M: PETSc.Mat, modes: int | None = None,
                  max_frequency: float | None = None, shift: float = 0.0,
-                 prefix: str = "cea_basis_", options: dict | None = None):
+                 prefix: str = "cea_basis_", options: dict | None = None,
+                 inner: str = "auto"):
         check("modes", modes, modes is not None or max_frequency is not None,
               "give a number of modes or a max_frequency")
         if modes is not None:
@@ -86,14 +103,21 @@ class ModalBasis:
         self.eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
         self.eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
         self.eps.setTarget(shift)
-        with options_with_defaults(prefix, {**DEFAULT_OPTIONS, **(options or {})}):
+        path = choose_inner(inner, n, K.getBlockSize())
+        self.shift_invert = ShiftInvert(self.eps.getST())
+        defaults = {**DEFAULT_OPTIONS, **ShiftInvert.options(path, symmetric=True),
+                    **(options or {})}
+        with options_with_defaults(prefix, defaults) as opts:
             self.eps.setFromOptions()
+            self.shift_invert.configure(opts, self.eps.getTolerances()[0])
+        self.shift_invert.update(-shift, (K, M), K.getNearNullSpace())
         request = min(modes or 16, n)
         limit = math.inf if max_frequency is None else (2 * math.pi * max_frequency) ** 2
         while True:
             # ncv and mpd given each time: slepc4py >= 3.20 keeps the previous ones otherwise
             self.eps.setDimensions(nev=request, ncv=PETSc.DECIDE, mpd=PETSc.DECIDE)
-            self.eps.solve()
+            with options_with_defaults(prefix, defaults):  # the multigrid's level options
+                self.eps.solve()
             count = self.eps.getConverged()
             values = sorted(self.eps.getEigenvalue(i).real for i in range(count))
             enough = count >= request if max_frequency is None else \
