@@ -53,6 +53,9 @@ linearised: the search is a fixed point on the contact geometry
 holds), so Newton converges quadratically to the solution of the frozen geometry only. A slave
 node that no master facet covers (farther than the search radius) has no force; its gap is the
 distance to the nearest master facet's centroid.
+
+Parallel: no rank gathers either surface; each holds the slave facets touching its owned
+slave nodes and the master facets near them (:class:`MortarIntegrals`).
 """
 
 from __future__ import annotations
