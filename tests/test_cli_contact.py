@@ -187,6 +187,8 @@ def test_cattaneo_eps_sequence_against_cattaneo_mindlin(shared_tmp_path):
     (["cattaneo", "--eps-sequence", "1e-5,-1"], "--eps-sequence"),
     (["cattaneo", "--increments", "0"], "--increments"),
     (["hertz", "--degree", "2"], "--degree"),  # degree 2 is mortar's
+    (["hertz", "--partition", "metis"], "--partition"),
+    (["patch", "--partition", "metis"], "--partition"),
     (["cattaneo", "--formulation", "mortar", "--enforcement", "perturbed-lagrangian"],
      "--enforcement")])
 def test_bad_value_is_one_line_naming_the_flag_and_exit_2(shared_tmp_path, capsys, argv, name):

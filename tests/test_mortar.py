@@ -163,8 +163,8 @@ def test_mortar_integrals_of_one_segment_on_two(degree):
     contact.update()
     integrals = contact.pairing
     x = contact.V.tabulate_dof_coordinates()[:, 0]
-    slave = np.unique(integrals.slave.nodes)
-    master = np.unique(integrals.master.nodes)
+    slave = np.unique(integrals.slave_local)
+    master = np.unique(integrals.master_local)
     slave, master = slave[np.argsort(x[slave])], master[np.argsort(x[master])]
     D = integrals.D.toarray()[np.ix_(slave, slave)]
     M = integrals.M.toarray()[np.ix_(slave, master)]

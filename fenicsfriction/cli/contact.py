@@ -91,6 +91,12 @@ def _hertz_flags(parser: argparse.ArgumentParser) -> None:
                              "at the contact)")
 
 
+def _partition_flag(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--partition", help="how the mesh is cut over the ranks: graph "
+                        "(dolfinx's partitioner) or contact (both bodies across the contact "
+                        "plane) (graph)")
+
+
 def add_parser(commands: typing.Any) -> None:
     """``contact hertz|patch|cattaneo``: the two-body validation scenes."""
     contact = commands.add_parser(
@@ -110,6 +116,7 @@ def add_parser(commands: typing.Any) -> None:
                     "block to the load --load: contact half-width (radius) and peak pressure "
                     "against Hertz's.")
     hertz.add_argument("--dim", type=int, choices=[2, 3], default=2, help="2 or 3 (2)")
+    _partition_flag(hertz)
     _hertz_flags(hertz)
     hertz.add_argument("--passes", type=int, choices=[1, 2], default=1,
                        help="1: the cylinder's surface is the slave; 2: each surface in turn")
@@ -118,6 +125,7 @@ def add_parser(commands: typing.Any) -> None:
         description="Two stacked blocks with non-matching meshes under a uniform pressure "
                     "must transmit it uniformly (Taylor & Papadopoulos 1991).")
     patch.add_argument("--dim", type=int, choices=[2, 3], default=2, help="2 or 3 (2)")
+    _partition_flag(patch)
     patch.add_argument("--passes", choices=["1", "2", "both"], default="both",
                        help="one pass, two passes, or both side by side (both)")
     patch.add_argument("--pressure", type=float, help="the pressure applied (0.01)")

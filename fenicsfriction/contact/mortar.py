@@ -53,6 +53,9 @@ linearised: the search is a fixed point on the contact geometry
 holds), so Newton converges quadratically to the solution of the frozen geometry only. A slave
 node that no master facet covers (farther than the search radius) has no force; its gap is the
 distance to the nearest master facet's centroid.
+
+Parallel: no rank gathers either surface; each holds the slave facets touching its owned
+slave nodes and the master facets near them (:class:`MortarIntegrals`).
 """
 
 from __future__ import annotations
@@ -73,6 +76,7 @@ from scipy.spatial import cKDTree
 
 from fenicsfriction import _compat, laws
 from fenicsfriction.contact.node_to_segment import MirroredContact, discrete_gradient
+from fenicsfriction.contact.pairing import EXCHANGES, FacetExchange, _Facets
 
 __all__ = ["MortarIntegrals", "SegmentToSegment", "surface_facets"]
 
@@ -169,37 +173,6 @@ def surface_facets(V: fem.FunctionSpace, facet_tags: mesh.MeshTags, tag: int) ->
 
 
 @dataclasses.dataclass
-class _Surface:
-    """The facets of one surface on all ranks: their global node indices and reference
-    coordinates, and which rows of the gathered pieces to keep (a facet on a process boundary
-    may be listed by two ranks)."""
-
-    local: np.ndarray  # (f_local, nen) local node indices of this rank's facets
-    nodes: np.ndarray  # (f, nen) global node indices, gathered
-    reference: np.ndarray  # (f, nen, dim)
-    first: np.ndarray
-
-    @classmethod
-    def gather(cls, V: fem.FunctionSpace, local: np.ndarray, x: np.ndarray) -> _Surface:
-        comm = V.mesh.comm
-        nen, dim = local.shape[1], x.shape[1]
-        global_nodes = V.dofmap.index_map.local_to_global(local.ravel()).reshape(local.shape)
-        pieces = comm.allgather((global_nodes.astype(np.int64), x[local]))
-        nodes = np.concatenate([p[0] for p in pieces]).reshape(-1, nen)
-        reference = np.concatenate([p[1] for p in pieces]).reshape(-1, nen, dim)
-        _, first = np.unique(np.sort(nodes, axis=1), axis=0, return_index=True)
-        first = np.sort(first)
-        return cls(local, nodes[first], reference[first], first)
-
-    def current(self, u: fem.Function) -> np.ndarray:
-        """The nodes' current coordinates at displacement ``u`` (an all-gather)."""
-        dim = self.reference.shape[-1]
-        displacement = u.x.array.reshape(-1, dim)[self.local]
-        moved = np.concatenate(u.function_space.mesh.comm.allgather(displacement))
-        return self.reference + moved.reshape(-1, *self.reference.shape[1:])[self.first]
-
-
-@dataclasses.dataclass
 class _Pieces:
     """The linear pieces of a surface's facets (the facets themselves for degree 1)."""
 
@@ -233,13 +206,22 @@ class _Pieces:
 class MortarIntegrals:
     """The mortar integrals of one slave surface against a master surface, and ``B``.
 
-    Both surfaces are gathered on every rank (node indices and reference coordinates once,
-    displacements at each search); each rank integrates the slave pieces that touch its owned
-    slave nodes and builds their rows of ``B``.
+    No rank holds either surface whole. Each rank holds the slave facets that touch its owned
+    slave nodes (its own, and those that the ranks holding their cells send it, point to
+    point) and the master facets near them, obtained at each search from the ranks holding
+    them as node-to-segment's search does (:class:`~fenicsfriction.contact.pairing.
+    FacetExchange`, the points being the centroids of the slave pieces): a master facet is
+    held when its centroid is within the radius of a slave piece's box, and each piece's
+    radius must reach beyond every master piece it could be segmented with and beyond the
+    master piece nearest to each of its nodes. Each rank integrates the slave pieces that
+    touch its owned slave nodes and builds their rows of ``B``; its arrays are as long as
+    its own nodes and the surfaces' nodes it holds.
 
     Args:
         V: the displacement space (Lagrange vectors of degree 1 or 2).
         slave, master: the surfaces' facets (:func:`surface_facets`, local node indices).
+        exchange: ``"neighbours"`` (default) or ``"all"``: the whole master surface
+            all-gathered on every rank (the reference the tests compare with).
 
     Attributes:
         Q: ``B`` (rows: the owned slave nodes' dofs; columns: all dofs of V), a PETSc matrix
@@ -251,30 +233,47 @@ class MortarIntegrals:
         reference: a Function of V, :math:`B X` (plus, at uncovered slave nodes, their gap
             to the nearest master facet along :math:`-n`).
         slave_nodes: the owned slave nodes (local indices).
+        slave_local, master_local: this rank's facets of either surface (local node indices).
+        held: how many master facets this rank held at the last search.
         searches, changes: how many searches ran, how many changed B's sparsity pattern.
-        time_s: seconds in ``"search"`` (gathers, normals, segmentation, integrals, the
-            change test: until every rank is done) and ``"build"`` (B as a PETSc matrix, the
-            reference gaps, normals and coverage as Functions), summed over calls.
+        time_s: seconds in ``"search"`` (exchanges, normals, segmentation, integrals, the
+            change test: until every rank is done), of which ``"exchange"`` obtaining the
+            facets, and ``"build"`` (B as a PETSc matrix, the reference gaps, normals and
+            coverage as Functions), summed over calls.
     """
 
-    def __init__(self, V: fem.FunctionSpace, slave: np.ndarray, master: np.ndarray):
+    def __init__(self, V: fem.FunctionSpace, slave: np.ndarray, master: np.ndarray,
+                 exchange: str = "neighbours"):
+        laws.check("exchange", exchange, exchange in EXCHANGES, f"one of {', '.join(EXCHANGES)}")
         self.V = V
+        self.exchange = exchange
         self.comm: MPI.Comm = V.mesh.comm
         self.dim = dim = V.mesh.geometry.dim
         self.degree = _compat.element_degree(V)
-        x = V.tabulate_dof_coordinates()[:, :dim]
-        self.slave = _Surface.gather(V, slave, x)
-        self.master = _Surface.gather(V, master, x)
-        self.slave_pieces = _Pieces.split_facets(self.slave.nodes, dim, self.degree)
-        self.master_pieces = _Pieces.split_facets(self.master.nodes, dim, self.degree)
+        self.x_nodes = V.tabulate_dof_coordinates()[:, :dim]
         index_map = V.dofmap.index_map
         self.owned_range = np.array(index_map.local_range, dtype=np.int64)
         self.size_local, self.size_global = index_map.size_local, index_map.size_global
+        self.slave_local, self.master_local = slave, master
+        self._slave_global = self._global(slave)
+        self._master_global = self._global(master)
         on_slave = np.unique(slave)
         self.slave_nodes = on_slave[on_slave < self.size_local].astype(np.int32)
-        # the slave pieces that touch an owned node: this rank's rows
-        mine = self._owned(self.slave_pieces.nodes)
-        self.mine = np.flatnonzero(mine.any(axis=1))
+        # the slave facets each rank sends to the owners of their nodes, and whence it receives
+        owner = np.full(len(self.x_nodes), self.comm.rank, dtype=np.int64)
+        owner[self.size_local:] = np.asarray(index_map.owners, dtype=np.int64)
+        self._sends = {int(q): np.flatnonzero((owner[slave] == q).any(axis=1))
+                       for q in np.unique(owner[slave]) if q != self.comm.rank}
+        counts = self.comm.alltoall([q in self._sends for q in range(self.comm.size)])
+        self._sources = [q for q, sends in enumerate(counts) if sends]
+        self._mine_facets = np.flatnonzero((owner[slave] == self.comm.rank).any(axis=1))
+        reference = self._slave_facets(None)
+        self.slave_pieces = _Pieces.split_facets(reference.global_nodes, dim, self.degree)
+        self.mine = np.flatnonzero(self._owned(self.slave_pieces.nodes).any(axis=1))
+        centres = self.slave_pieces.coordinates(reference.reference)[self.mine].mean(axis=1)
+        self._exchange = FacetExchange(self.comm, centres, master.shape[1])
+        self._tributary = self._tributaries(reference)
+        self._facet_size = self._mean_size(reference)
         self.Q: PETSc.Mat | None = None
         self.D = self.M = scipy.sparse.csr_matrix((self.size_local, self.size_global))
         self.area = np.zeros(self.size_local)
@@ -283,15 +282,81 @@ class MortarIntegrals:
                                                                    self.degree),
                                      name="mortar_coverage")
         self.reference = fem.Function(V, name="mortar_reference")
+        self.held = 0
+        self._master_radius = 0.0
         self.searches = 0
         self.changes = 0
-        self.time_s = {"search": 0.0, "build": 0.0}
+        self.time_s = {"search": 0.0, "build": 0.0, "exchange": 0.0}
         self._B: scipy.sparse.csr_matrix | None = None
         self._gap: np.ndarray | None = None
         self._searched_at: np.ndarray | None = None
 
+    def _global(self, local: np.ndarray) -> np.ndarray:
+        index_map = self.V.dofmap.index_map
+        return index_map.local_to_global(local.ravel()).reshape(local.shape).astype(np.int64)
+
     def _owned(self, nodes: np.ndarray) -> np.ndarray:
         return (nodes >= self.owned_range[0]) & (nodes < self.owned_range[1])
+
+    def _facets(self, local: np.ndarray, global_nodes: np.ndarray,
+                u: fem.Function | None) -> _Facets:
+        reference = self.x_nodes[local]
+        if u is None:
+            return _Facets(global_nodes, reference, reference)
+        return _Facets(global_nodes, reference,
+                       reference + u.x.array.reshape(-1, self.dim)[local])
+
+    def _slave_facets(self, u: fem.Function | None) -> _Facets:
+        """The slave facets that touch this rank's owned nodes, at displacement ``u`` (None:
+        the reference): its own, and those the ranks holding them send (point to point)."""
+        nen = self.slave_local.shape[1]
+        facets = self._facets(self.slave_local, self._slave_global, u)
+        requests = [self.comm.isend(facets.take(rows), dest=q, tag=7027)
+                    for q, rows in self._sends.items()]
+        pieces = [facets.take(self._mine_facets)]
+        pieces += [self.comm.recv(source=q, tag=7027) for q in self._sources]
+        MPI.Request.waitall(requests)
+        return _Facets.join(pieces, nen, self.dim)
+
+    def _master_facets(self, u: fem.Function, slave_x: np.ndarray) -> _Facets:
+        """The master facets near this rank's slave pieces ``slave_x`` (current), or all of
+        them (``exchange="all"``)."""
+        local = self._facets(self.master_local, self._master_global, u)
+        nen = self.master_local.shape[1]
+        pieces = _Pieces.split_facets(self._master_global, self.dim, self.degree)
+        x = pieces.coordinates(local.current)
+        centre = local.current.mean(axis=1)
+        # the farthest a master piece's vertex is from its centroid (the segmentation's ball
+        # depends on it), and a piece's centroid from its facet's centroid (the one the
+        # exchange measures): over all ranks
+        m_radius = float(np.linalg.norm(x - x.mean(axis=1)[:, None], axis=-1).max(initial=0.0))
+        spread = float(np.linalg.norm(local.current - centre[:, None], axis=-1).max(initial=0.0))
+        self._master_radius = m_radius = self.comm.allreduce(m_radius, op=MPI.MAX)
+        spread = self.comm.allreduce(spread, op=MPI.MAX)
+        if self.exchange == "all":
+            return _Facets.join(self.comm.allgather(local), nen, self.dim)
+        s_x = slave_x[self.mine]
+        s_centre = s_x.mean(axis=1)
+        s_radius = np.linalg.norm(s_x - s_centre[:, None], axis=-1).max(axis=1, initial=0.0)
+        segment = SEARCH_RADIUS * (s_radius + m_radius) + spread
+
+        def need(held: _Facets) -> tuple[np.ndarray, None]:
+            # the segmentation's ball, and the ball of the master pieces that may be the
+            # nearest to a node of the piece (the nearest held is at most that far)
+            if not len(held.global_nodes):
+                return np.full(len(s_centre), np.inf), None
+            m = _Pieces.split_facets(held.global_nodes, self.dim, self.degree)
+            tree = cKDTree(m.coordinates(held.current).mean(axis=1))
+            nearest = tree.query(s_centre)[0] if len(s_centre) else np.zeros(0)
+            return np.maximum(segment, 2 * s_radius + nearest + spread), None
+
+        if self.searches == 1:
+            self._exchange.radius[:] = self.comm.allreduce(
+                float(segment.max(initial=0.0)), op=MPI.MAX) * 1.1 or 1.0
+        spent = self._exchange.seconds
+        held, _ = self._exchange.hold(local, s_centre, need)
+        self.time_s["exchange"] += self._exchange.seconds - spent
+        return held
 
     def search(self, u: fem.Function) -> bool:
         """Normals, segmentation and mortar integrals at displacement ``u``, and ``B``.
@@ -307,23 +372,34 @@ class MortarIntegrals:
         self._searched_at = state.copy()
         t0 = time.perf_counter()
         self.searches += 1
-        slave_x = self.slave_pieces.coordinates(self.slave.current(u))
-        slave_X = self.slave_pieces.coordinates(self.slave.reference)
-        master_x = self.master_pieces.coordinates(self.master.current(u))
+        te = time.perf_counter()
+        slave = self._slave_facets(u)
+        self.time_s["exchange"] += time.perf_counter() - te
+        slave_x = self.slave_pieces.coordinates(slave.current)
+        slave_X = self.slave_pieces.coordinates(slave.reference)
+        master = self._master_facets(u, slave_x)
+        self.held = len(master.global_nodes)
+        self.master_pieces = _Pieces.split_facets(master.global_nodes, self.dim, self.degree)
+        master_x = self.master_pieces.coordinates(master.current)
+        # the columns: the surfaces' nodes this rank holds, in global order
+        columns = np.unique(np.concatenate([slave.global_nodes.ravel(),
+                                            master.global_nodes.ravel()]))
         normals = self._nodal_normals(slave_x)
-        D, M, nearest = self._integrals(slave_x, slave_X, master_x)
-        self.D, self.M = D, M
-        self.area = np.asarray(D.sum(axis=1)).ravel()
-        covered = self.area > 0
+        D, M, nearest = self._integrals(slave_x, slave_X, master_x, slave, master, columns,
+                                        u)
+        area = np.asarray(D.sum(axis=1)).ravel()
+        self.area = area
+        covered = area > 0
         offset = np.where(covered, 0.0, nearest)[:, None] * normals
-        scale = np.where(covered, 1.0 / np.where(covered, self.area, 1.0), 0.0)
+        scale = np.where(covered, 1.0 / np.where(covered, area, 1.0), 0.0)
         B = (scipy.sparse.diags(scale) @ (D - M)).tocsr()
         B.sort_indices()
         B.eliminate_zeros()
         # the relative positions at u with the new geometry, uncovered nodes at their distance
-        x_all = self._surface_coordinates(u)
-        G = (B @ x_all) - offset
+        G = (B @ _rows(columns, slave, master, "current")) - offset
         gap = -np.einsum("jk,jk->j", normals, G)[self.slave_nodes]
+        B_reference = B @ _rows(columns, slave, master, "reference")
+        B, self.D, self.M = (_to_global(A, columns, self.size_global) for A in (B, D, M))
         pattern_changed = self._B is None or not (
             np.array_equal(self._B.indptr, B.indptr) and np.array_equal(self._B.indices,
                                                                         B.indices))
@@ -343,8 +419,7 @@ class MortarIntegrals:
         fraction[:] = 0.0
         fraction[self.slave_nodes] = (self.area / self._tributary)[self.slave_nodes]
         self.coverage.x.scatter_forward()
-        X_all = self._surface_reference
-        self._set(self.reference, (B @ X_all) - offset)
+        self._set(self.reference, B_reference - offset)
         if pattern_changed:
             self.changes += 1
         self._build(B)
@@ -357,11 +432,10 @@ class MortarIntegrals:
         f.x.array.reshape(-1, self.dim)[:self.size_local] = owned
         f.x.scatter_forward()
 
-    @functools.cached_property
-    def _tributary(self) -> np.ndarray:
+    def _tributaries(self, slave: _Facets) -> np.ndarray:
         """Each owned node's integral of its test function :math:`\\psi_j` over the whole
         slave surface (reference): a third (half in 2D) of its pieces' sizes."""
-        X = self.slave_pieces.coordinates(self.slave.reference)
+        X = self.slave_pieces.coordinates(slave.reference)
         share = np.linalg.norm(_normal(X), axis=-1) / (2.0 if self.dim == 3 else 1.0) / self.dim
         total = np.zeros(self.size_local)
         nodes = self.slave_pieces.nodes
@@ -370,25 +444,16 @@ class MortarIntegrals:
             np.add.at(total, nodes[owned, a] - self.owned_range[0], share[owned])
         return np.where(total > 0, total, 1.0)
 
-    @functools.cached_property
-    def _facet_size(self) -> float:
-        X = self.slave_pieces.coordinates(self.slave.reference)
-        return float(np.linalg.norm(X[:, 1] - X[:, 0], axis=-1).mean()) if len(X) else 1.0
-
-    @functools.cached_property
-    def _surface_reference(self) -> np.ndarray:
-        return self._dense_columns(self.slave.reference, self.master.reference)
-
-    def _surface_coordinates(self, u: fem.Function) -> np.ndarray:
-        return self._dense_columns(self.slave.current(u), self.master.current(u))
-
-    def _dense_columns(self, slave: np.ndarray, master: np.ndarray) -> np.ndarray:
-        """Nodal vectors of both surfaces as rows of a (size_global, dim) array (zero off
-        them), the columns of D and M."""
-        x = np.zeros((self.size_global, self.dim))
-        x[self.slave.nodes.ravel()] = slave.reshape(-1, self.dim)
-        x[self.master.nodes.ravel()] = master.reshape(-1, self.dim)
-        return x
+    def _mean_size(self, slave: _Facets) -> float:
+        """The mean length of a slave piece's first side over the whole surface: each facet
+        counted by the rank that owns its smallest node."""
+        X = self.slave_pieces.coordinates(slave.reference)
+        counted = np.repeat(self._owned(slave.global_nodes.min(axis=1, initial=-1)),
+                            len(self.slave_pieces.split))
+        total = self.comm.allreduce(float(np.linalg.norm(X[counted, 1] - X[counted, 0],
+                                                         axis=-1).sum()))
+        count = self.comm.allreduce(int(np.count_nonzero(counted)))
+        return total / count if count else 1.0
 
     def _nodal_normals(self, slave_x: np.ndarray) -> np.ndarray:
         """The owned nodes' unit normals: the sum of their slave pieces' area vectors."""
@@ -401,10 +466,12 @@ class MortarIntegrals:
         size = np.linalg.norm(normals, axis=1)
         return normals / np.where(size > 0, size, 1.0)[:, None]
 
-    def _integrals(self, slave_x: np.ndarray, slave_X: np.ndarray, master_x: np.ndarray
+    def _integrals(self, slave_x: np.ndarray, slave_X: np.ndarray, master_x: np.ndarray,
+                   slave: _Facets, master: _Facets, columns: np.ndarray, u: fem.Function
                    ) -> tuple[scipy.sparse.csr_matrix, scipy.sparse.csr_matrix, np.ndarray]:
-        """D, M of the owned slave nodes, and each owned node's distance to the nearest
-        master piece's centroid (the gap of an uncovered node)."""
+        """D, M of the owned slave nodes (columns: the surfaces' nodes held, ``columns``
+        their global indices), and each owned node's distance to the nearest master piece's
+        centroid (the gap of an uncovered node)."""
         d = self.dim
         mine = self.mine
         s_x, s_X = slave_x[mine], slave_X[mine]
@@ -415,13 +482,14 @@ class MortarIntegrals:
         tree = cKDTree(m_centre)
         nearest = np.zeros(self.size_local)
         if len(self.slave_nodes):
-            x_nodes = self._surface_coordinates_owned(slave_x)
+            x_nodes = (self.x_nodes[self.slave_nodes]
+                       + u.x.array.reshape(-1, self.dim)[self.slave_nodes])
             nearest[self.slave_nodes] = tree.query(x_nodes)[0]
-        shape = (self.size_local, self.size_global)
+        shape = (self.size_local, len(columns))
         if not len(mine):
             empty = scipy.sparse.csr_matrix(shape)
             return empty, empty, nearest
-        radius = SEARCH_RADIUS * (s_radius + m_radius.max(initial=0.0))
+        radius = SEARCH_RADIUS * (s_radius + self._master_radius)
         found = tree.query_ball_point(s_centre, r=radius)
         counts = np.fromiter((len(f) for f in found), dtype=np.int64, count=len(found))
         s_index = np.repeat(np.arange(len(mine)), counts)
@@ -453,23 +521,15 @@ class MortarIntegrals:
         rows_local = rows - self.owned_range[0]
         weighted = weight[:, None] * mu
         matrices = []
-        for N, facets, nodes in ((N_s, sp.facet[s_piece], self.slave.nodes),
-                                 (N_m, mp.facet[m_piece], self.master.nodes)):
-            columns = nodes[facets]  # (pairs, nen)
+        for N, facets, nodes in ((N_s, sp.facet[s_piece], slave.global_nodes),
+                                 (N_m, mp.facet[m_piece], master.global_nodes)):
+            held = np.searchsorted(columns, nodes[facets])  # (pairs, nen)
             values = np.add.reduceat(weighted[:, :, None] * N[:, None, :], starts, axis=0)
             keep = np.broadcast_to(owned[:, :, None], values.shape)
             r = np.broadcast_to(rows_local[:, :, None], values.shape)[keep]
-            c = np.broadcast_to(columns[:, None, :], values.shape)[keep]
+            c = np.broadcast_to(held[:, None, :], values.shape)[keep]
             matrices.append(scipy.sparse.csr_matrix((values[keep], (r, c)), shape=shape))
         return matrices[0], matrices[1], nearest
-
-    def _surface_coordinates_owned(self, slave_x: np.ndarray) -> np.ndarray:
-        """The current coordinates of the owned slave nodes (from their pieces' vertices)."""
-        x = np.zeros((self.size_local, self.dim))
-        nodes = self.slave_pieces.nodes
-        owned = self._owned(nodes)
-        x[nodes[owned] - self.owned_range[0]] = slave_x[owned]
-        return x[self.slave_nodes]
 
     def _build(self, B: scipy.sparse.csr_matrix) -> None:
         """B on the dofs (each node's block of ``dim`` components) as a PETSc matrix."""
@@ -483,6 +543,24 @@ class MortarIntegrals:
             (sizes, sizes), csr=(B_dofs.indptr.astype(PETSc.IntType),
                                  B_dofs.indices.astype(PETSc.IntType), B_dofs.data),
             comm=self.comm)
+
+
+def _rows(columns: np.ndarray, slave: _Facets, master: _Facets, which: str) -> np.ndarray:
+    """The nodal coordinates (``"current"`` or ``"reference"``) of the surfaces' nodes held,
+    one row per entry of ``columns`` (their global indices, sorted)."""
+    x = np.zeros((len(columns), slave.reference.shape[-1]))
+    for facets in (slave, master):
+        x[np.searchsorted(columns, facets.global_nodes.ravel())] = \
+            getattr(facets, which).reshape(-1, x.shape[1])
+    return x
+
+
+def _to_global(A: scipy.sparse.csr_matrix, columns: np.ndarray, size: int
+               ) -> scipy.sparse.csr_matrix:
+    """``A`` with its columns (indices into ``columns``) renumbered to ``columns``' global
+    indices, of which there are ``size`` (sorted ``columns`` keep each row sorted)."""
+    return scipy.sparse.csr_matrix((A.data, columns[A.indices], A.indptr),
+                                   shape=(A.shape[0], size))
 
 
 def _segments_2d(slave: np.ndarray, master: np.ndarray
@@ -619,6 +697,8 @@ class SegmentToSegment(MirroredContact):
             (:func:`~fenicsfriction.contact.node_to_segment.discrete_gradient`). ``G`` being
             affine in u between searches, its work over the step is exactly the potential's
             change. ``None`` (default): the pressure at ``u``.
+        exchange: how each rank obtains the master facets near its slave facets:
+            ``"neighbours"`` (default) or ``"all"`` (:class:`MortarIntegrals`).
         enforcement, formulation, penalty_T, time_step: node-to-segment's choice of the
             perturbed Lagrangian (``formulation`` its former name) is refused here: only
             ``"compliance"`` and no ``penalty_T``; ``time_step`` is accepted and unused, as
@@ -648,7 +728,7 @@ class SegmentToSegment(MirroredContact):
                  weight: float = 1.0, frozen: bool = False, search: str = "solve",
                  enforcement: str = "compliance", formulation: str | None = None,
                  penalty_T: Value | None = None, time_step: Value = 1.0,
-                 step_from: fem.Function | None = None):
+                 step_from: fem.Function | None = None, exchange: str = "neighbours"):
         V = u.function_space
         msh = V.mesh
         dim = msh.geometry.dim
@@ -680,7 +760,7 @@ class SegmentToSegment(MirroredContact):
         self.search_pending = True
         self.searched = False
         self.pairing = MortarIntegrals(V, surface_facets(V, facet_tags, slave),
-                                       surface_facets(V, facet_tags, master))
+                                       surface_facets(V, facet_tags, master), exchange)
         self.mirrors: dict[fem.Function, fem.Function] = {
             f: fem.Function(V, name=f"mortar_{f.name}")
             for f in (u, *fields, *([] if step_from is None else [step_from]))}
@@ -763,8 +843,8 @@ class SegmentToSegment(MirroredContact):
         bound = scaled.norm(PETSc.NormType.NORM_1) * scaled.norm(PETSc.NormType.NORM_INFINITY)
         scaled.destroy()
         masses = lumped_mass.array_r.reshape(-1, self.dim)
-        surfaces = np.unique(np.concatenate([self.pairing.slave.local.ravel(),
-                                             self.pairing.master.local.ravel()]))
+        surfaces = np.unique(np.concatenate([self.pairing.slave_local.ravel(),
+                                             self.pairing.master_local.ravel()]))
         surfaces = surfaces[surfaces < len(masses)]
         lightest = self.V.mesh.comm.allreduce(float(masses[surfaces].min(initial=np.inf)),
                                               op=MPI.MIN)

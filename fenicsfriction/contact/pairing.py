@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
+import typing
 
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -43,7 +44,8 @@ from scipy.spatial import cKDTree
 
 from fenicsfriction import _compat, laws
 
-__all__ = ["EXCHANGES", "Pairing", "facet_nodes", "point_facet_distance", "surface_coordinates"]
+__all__ = ["EXCHANGES", "FacetExchange", "Pairing", "facet_nodes", "point_facet_distance",
+           "surface_coordinates"]
 
 #: how many master facets (by centroid distance) are checked exactly for each slave node
 CANDIDATES = 12
@@ -225,6 +227,105 @@ def _boxes_meet(a: np.ndarray, boxes: np.ndarray) -> bool:
     return bool(np.any(np.linalg.norm(gap, axis=1) <= boxes[:, 2, 0]))
 
 
+class FacetExchange:
+    """How a rank obtains the facets of a surface near its own points from the other ranks,
+    without a global gather (the pairing's and the mortar search's exchange).
+
+    The points are split once into at most :data:`BOXES` groups (coordinate bisection of
+    ``points``, their reference positions). At each :meth:`hold` every rank all-gathers its
+    groups' bounding boxes with each group's radius and the bounding box of its own facets'
+    centroids (O(ranks) numbers); two ranks whose boxes come within a radius are neighbours
+    and send each other, point to point, the facets whose centroids lie within a radius of one
+    of the other's boxes. The caller states for each point the distance its search needs; where
+    a group's radius falls short, its radius is set to 1.1 times the need and the exchange
+    repeats (the radii are kept for the next call).
+
+    Attributes:
+        radius: each group's radius (set the first one before the first :meth:`hold`).
+        rounds: how many exchanges the last :meth:`hold` needed.
+        seconds: the time spent exchanging (boxes, sends, receives), summed over calls.
+    """
+
+    def __init__(self, comm: MPI.Comm, points: np.ndarray, nodes_per_facet: int):
+        self.comm = comm
+        self.dim = points.shape[1]
+        self.nodes_per_facet = nodes_per_facet
+        self.group = _groups(points, BOXES)
+        self.radius = np.zeros(int(self.group.max(initial=-1)) + 1)
+        self.rounds = 0
+        self.seconds = 0.0
+
+    def hold(self, local: _Facets, x: np.ndarray,
+             need: typing.Callable[[_Facets], tuple[np.ndarray, typing.Any]]
+             ) -> tuple[_Facets, typing.Any]:
+        """The facets near the points ``x`` (the current positions of ``points``), from all
+        ranks' ``local`` facets: repeated until every point's need (the first item of
+        ``need(held)``: a distance, inf where the facets held cannot tell) is within its
+        group's radius, or the whole surface is held. Returns the facets held and the second
+        item of ``need(held)``."""
+        self.rounds = 0
+        while True:
+            self.rounds += 1
+            t0 = time.perf_counter()
+            held, complete = self._neighbour_facets(local, x)
+            self.seconds += time.perf_counter() - t0
+            reach, result = need(held)
+            ok = complete or bool(np.all(reach * (1 + 1e-9) < self.radius[self.group]))
+            if self.comm.allreduce(ok, op=MPI.LAND):
+                return held, result
+            # each group's radius: beyond its farthest need among the facets held now (that
+            # among all facets is no farther), or four times larger if too few were held
+            for g in range(len(self.radius)):
+                far = reach[self.group == g].max(initial=0.0)
+                self.radius[g] = 4 * self.radius[g] if not np.isfinite(far) else max(
+                    self.radius[g], 1.1 * far)
+
+    def _boxes(self, x: np.ndarray) -> np.ndarray:
+        """The groups' bounding boxes at ``x`` with their radii (g, 3, dim): lower and upper
+        corners, the radius repeated (empty groups: none)."""
+        boxes = []
+        for g, radius in enumerate(self.radius):
+            y = x[self.group == g]
+            if len(y):
+                boxes.append([y.min(axis=0), y.max(axis=0), np.full(self.dim, radius)])
+        return np.array(boxes, dtype=float).reshape(-1, 3, self.dim)
+
+    def _neighbour_facets(self, local: _Facets, x: np.ndarray) -> tuple[_Facets, bool]:
+        """The master facets of every rank whose centroids lie within the radius of one of
+        this rank's boxes, and whether those hold the whole master surface (the candidates are
+        then complete whatever the radii)."""
+        centroid = local.current.mean(axis=1)
+        mine = np.array([centroid.min(axis=0), centroid.max(axis=0)]) if len(centroid) else \
+            np.full((2, self.dim), np.nan)
+        boxes = self._boxes(x)
+        everyone = self.comm.allgather((mine, boxes))
+        masters = np.array([m for m, _ in everyone])
+        present = np.all(np.isfinite(masters[:, 0]), axis=1)
+        whole = (np.array([np.nanmin(masters[present, 0], axis=0),
+                           np.nanmax(masters[present, 1], axis=0)])
+                 if present.any() else np.zeros((2, self.dim)))
+        # the farthest corner of the whole surface's box within some box's radius
+        corners = np.array([[whole[i, k] for k, i in enumerate(bits)]
+                            for bits in np.ndindex(*(2,) * self.dim)])
+        complete = bool(any(np.all(_box_distance(corners, b[0], b[1]) <= b[2, 0])
+                            for b in boxes))
+        rank = self.comm.rank
+        tree = cKDTree(centroid) if len(centroid) else None
+        requests = []
+        for q, (_, their_boxes) in enumerate(everyone):
+            if q != rank and present[rank] and _boxes_meet(mine, their_boxes):
+                rows = np.flatnonzero(_near_boxes(tree, centroid, their_boxes))
+                requests.append(self.comm.isend(local.take(rows), dest=q, tag=7026))
+        pieces: list[_Facets] = []
+        for q, (theirs, _) in enumerate(everyone):
+            if q == rank:
+                pieces.append(local.take(np.flatnonzero(_near_boxes(tree, centroid, boxes))))
+            elif present[q] and _boxes_meet(theirs, boxes):
+                pieces.append(self.comm.recv(source=q, tag=7026))
+        MPI.Request.waitall(requests)
+        return _Facets.join(pieces, self.nodes_per_facet, self.dim), complete
+
+
 class Pairing:
     """Slave nodes of one surface paired with the facets of another, and the operator Q.
 
@@ -280,8 +381,8 @@ class Pairing:
         self.searches = 0
         self.changes = 0
         self.time_s = {"search": 0.0, "build": 0.0, "exchange": 0.0}
-        self._group = _groups(self.x_nodes[self.slave_nodes], BOXES)
-        self._radius = np.zeros(int(self._group.max(initial=-1)) + 1)
+        self._exchange = FacetExchange(self.comm, self.x_nodes[self.slave_nodes],
+                                       self.nodes_per_facet)
 
     # --- the master facets a rank holds ----------------------------------------------------
 
@@ -294,51 +395,6 @@ class Pairing:
         """The whole master surface at displacement ``u``, on every rank (an all-gather)."""
         pieces = self.comm.allgather(self._local_facets(u))
         return _Facets.join(pieces, self.nodes_per_facet, self.dim)
-
-    def _boxes(self, x_slave: np.ndarray) -> np.ndarray:
-        """The groups' bounding boxes at ``x_slave`` with their radii (g, 3, dim): lower and
-        upper corners, the radius repeated (empty groups: none)."""
-        boxes = []
-        for g, radius in enumerate(self._radius):
-            x = x_slave[self._group == g]
-            if len(x):
-                boxes.append([x.min(axis=0), x.max(axis=0), np.full(self.dim, radius)])
-        return np.array(boxes, dtype=float).reshape(-1, 3, self.dim)
-
-    def _neighbour_facets(self, local: _Facets, x_slave: np.ndarray) -> tuple[_Facets, bool]:
-        """The master facets of every rank whose centroids lie within the radius of one of
-        this rank's boxes, and whether those hold the whole master surface (the candidates are
-        then complete whatever the radii)."""
-        centroid = local.current.mean(axis=1)
-        mine = np.array([centroid.min(axis=0), centroid.max(axis=0)]) if len(centroid) else \
-            np.full((2, self.dim), np.nan)
-        boxes = self._boxes(x_slave)
-        everyone = self.comm.allgather((mine, boxes))
-        masters = np.array([m for m, _ in everyone])
-        present = np.all(np.isfinite(masters[:, 0]), axis=1)
-        whole = (np.array([np.nanmin(masters[present, 0], axis=0),
-                           np.nanmax(masters[present, 1], axis=0)])
-                 if present.any() else np.zeros((2, self.dim)))
-        # the farthest corner of the whole surface's box within some box's radius
-        corners = np.array([[whole[i, k] for k, i in enumerate(bits)]
-                            for bits in np.ndindex(*(2,) * self.dim)])
-        complete = bool(any(np.all(_box_distance(corners, b[0], b[1]) <= b[2, 0])
-                            for b in boxes))
-        rank = self.comm.rank
-        tree = cKDTree(centroid) if len(centroid) else None
-        requests = []
-        for q, (_, their_boxes) in enumerate(everyone):
-            if q != rank and present[rank] and _boxes_meet(mine, their_boxes):
-                rows = np.flatnonzero(_near_boxes(tree, centroid, their_boxes))
-                requests.append(self.comm.isend(local.take(rows), dest=q, tag=7026))
-        pieces: list[_Facets] = []
-        for q, (theirs, _) in enumerate(everyone):
-            if q == rank:
-                pieces.append(local.take(np.flatnonzero(_near_boxes(tree, centroid, boxes))))
-            elif present[q] and _boxes_meet(theirs, boxes):
-                pieces.append(self.comm.recv(source=q, tag=7026))
-        MPI.Request.waitall(requests)
-        return _Facets.join(pieces, self.nodes_per_facet, self.dim), complete
 
     # --- the search ------------------------------------------------------------------------
 
@@ -356,26 +412,19 @@ class Pairing:
         if count == 0:
             raise RuntimeError("contact search: the master surface has no facets on any rank")
         if self.searches == 1:
-            self._radius[:] = self._first_radius()
-        self.rounds = 0
-        while True:
-            self.rounds += 1
+            self._exchange.radius[:] = self._first_radius()
+        if self.exchange == "all":
             te = time.perf_counter()
-            if self.exchange == "all":
-                held, complete = self.gather(u), True
-            else:
-                held, complete = self._neighbour_facets(local, x_slave)
+            held = self.gather(u)
             self.time_s["exchange"] += time.perf_counter() - te
-            candidates, reach = _candidates(held, x_slave)
-            ok = complete or bool(np.all(reach * (1 + 1e-9) < self._radius[self._group]))
-            if self.comm.allreduce(ok, op=MPI.LAND):
-                break
-            # each group's radius: beyond its farthest candidate among the facets held now
-            # (those of all facets are no farther), or four times larger if too few were held
-            for g in range(len(self._radius)):
-                need = reach[self._group == g].max(initial=0.0)
-                self._radius[g] = 4 * self._radius[g] if not np.isfinite(need) else max(
-                    self._radius[g], 1.1 * need)
+            candidates = _candidates(held, x_slave)[0]
+            self.rounds = 1
+        else:
+            spent = self._exchange.seconds
+            held, candidates = self._exchange.hold(
+                local, x_slave, lambda held: _candidates(held, x_slave)[::-1])
+            self.time_s["exchange"] += self._exchange.seconds - spent
+            self.rounds = self._exchange.rounds
         self.held = len(held.global_nodes)
         nodes, reference = self._closest(held, x_slave, candidates)
         if self.Q is not None:

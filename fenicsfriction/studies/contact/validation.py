@@ -56,6 +56,9 @@ class _Bodies:
             master segments, nodal rule; Pop) or ``"mortar"`` (the law on mortar-weighted
             gaps, segment-to-segment integration); :func:`fenicsfriction.contact.make_contact`.
         degree: the Lagrange degree of the displacement, 1 or 2 (2: mortar only).
+        partition: how :meth:`build` partitions the mesh over the ranks: ``"graph"``
+            (dolfinx's graph partitioner) or ``"contact"`` (both bodies cut across the contact
+            plane; :mod:`fenicsfriction.studies.contact.geometry`).
     """
 
     E1: float = 1.0
@@ -67,8 +70,11 @@ class _Bodies:
     passes: int = 1
     formulation: str = "node-to-segment"
     degree: int = 1
+    partition: str = "graph"
 
     def __post_init__(self) -> None:
+        check("partition", self.partition, self.partition in geometry.PARTITIONS,
+              f"one of {', '.join(geometry.PARTITIONS)}")
         self.E_star  # noqa: B018  (validates E1, nu1, E2, nu2, naming each)
         check("law", self.law, isinstance(self.law, laws.InterfaceLaw),
               "must be a fenicsfriction.laws.InterfaceLaw (it validates its own parameters)")
@@ -83,8 +89,10 @@ class _Bodies:
 
     @property
     def discretisation(self) -> dict[str, typing.Any]:
-        """The contact formulation and the degree, as the summaries record them."""
-        return {"formulation": self.formulation, "degree": self.degree}
+        """The contact formulation, the degree and the partition, as the summaries record
+        them."""
+        return {"formulation": self.formulation, "degree": self.degree,
+                "partition": self.partition}
 
     def with_law(self, **changes: typing.Any) -> typing.Self:
         """The scene with its law changed, e.g. ``scene.with_law(c_n=1e5)``."""
@@ -139,7 +147,8 @@ class Hertz(_Bodies):
 
     def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
         mesh = (geometry.hertz_2d if self.dim == 2 else geometry.hertz_3d)(
-            comm, R=self.radius, refine=self.refine, h_contact=self.h_contact)
+            comm, R=self.radius, refine=self.refine, h_contact=self.h_contact,
+            partition=self.partition)
         # the 2D cylinder's sliding is stopped at its loaded face; the quarter sphere's by the
         # symmetry planes
         return self.model(mesh, fix_load_face=self.dim == 2)
@@ -219,7 +228,7 @@ class Patch(_Bodies):
 
     def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
         mesh = (geometry.patch_2d if self.dim == 2 else geometry.patch_3d)(
-            comm, n_upper=self.n_upper, n_lower=self.n_lower)
+            comm, n_upper=self.n_upper, n_lower=self.n_lower, partition=self.partition)
         model = self.model(mesh, clamp=False)
         model.rollers(range(self.dim - 1))
         return model
@@ -288,7 +297,7 @@ class Cattaneo(Hertz):
 
     def build(self, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyModel:
         mesh = geometry.hertz_2d(comm, R=self.radius, refine=self.refine,
-                                 h_contact=self.h_contact)
+                                 h_contact=self.h_contact, partition=self.partition)
         return self.model(mesh, enforcement=self.enforcement, penalty_T=self.penalty_T)
 
     def stick_zone(self, values: SurfaceValues, tol: float = 1e-3) -> tuple[float, float]:
