@@ -24,9 +24,7 @@ LOAD_AT_START = os.getloadavg()
 #: solves really ran (an event that never ran is left out)
 PATH_EVENTS = ("SNESSolve", "TSStep", "KSPSolve", "KSPGMRESOrthog", "PCSetUp", "PCApply",
                "MatLUFactorSym", "MatLUFactorNum", "MatCholFctrSym", "MatCholFctrNum",
-               "MatSolve", "PCGAMGGraph_AGG", "PCGAMGCoarse_AGG", "PCGAMGProl_AGG",
-               "PCGAMGOptProl_AGG", "GAMG: createProl", "GAMG: partLevel", "EPSSolve",
-               "PEPSolve")
+               "MatSolve", "PCSetUp_GAMG+", "  GAMG PtAP", "EPSSolve", "PEPSolve")
 
 if "petsc4py.PETSc" in sys.modules:  # start PETSc's event log before the run creates objects
     sys.modules["petsc4py.PETSc"].Log.begin()

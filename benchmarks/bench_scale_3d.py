@@ -1,0 +1,352 @@
+"""The 3D block at growing size and on 1 and 2 ranks: time and memory per rank of the steady
+continuation to μ = 0.5 and of a dynamics run, direct (MUMPS) against Krylov + AMG.
+
+One run is one mesh, one path and one rank count, in a process of its own (peak memory is the
+process's): it writes ``bench_scale_3d_<path>_r<refine>_p<ranks>[_<tag>].json`` with
+
+* the unknowns n (the 3D block of ``fenicsfriction block steady --dim 3``: 4r × 3r × 2r
+  hexahedra of degree 2, n = 3 (8r+1)(6r+1)(4r+1));
+* the steady continuation μ = 0 → 0.5 (``--mu-steps`` equal increments, secant predictor):
+  wall time, Newton iterations per step, Krylov iterations;
+* ``--steps`` fixed steps of generalized-α dynamics (dt = ``--dt``) from the steady state at
+  μ = 0.5 with the belt's velocity perturbed: wall time per step, Newton iterations;
+* each phase's time split by PETSc's event log, inside a log stage per phase (the maximum
+  over the ranks): assembly (SNES function and Jacobian evaluations, inclusive), linear
+  set-up (PCSetUp: MUMPS's factorisation or the AMG hierarchy), Krylov (KSPSolve without the
+  set-up it contains), contact search (none in this scene: the belt is a compliance law on
+  a plane, searched nowhere) and observers (their own log stage), and the rest;
+* the peak resident memory of every rank after each phase, and :func:`_common.environment`.
+
+``--collect`` reads every such JSON in ``--out`` and writes ``bench_scale_3d.json`` (the
+least-squares exponents of time ~ n^a and memory ~ n^b on log-log axes, per path; the
+strong-scaling speed-ups 1 → 2 ranks at equal n, the weak-scaling efficiencies 1 rank at n
+against 2 ranks at about 2n, and the extrapolation to 8, 64 and 512 ranks described in
+docs/scaling.md) and ``bench_scale_3d.png``, and prints the tables as markdown.
+"""
+
+from __future__ import annotations
+
+import inspect
+import json
+import logging
+import math
+import pathlib
+import resource
+import time
+import typing
+
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import numpy as np
+from _common import note_solver, save, write_summary
+from _common import parser as benchmark_parser
+
+#: the dynamics scene of bench_dynamics.py (the law's ε and b_n; the belt speed)
+MU, BELT_SPEED, B_N, EPS = 0.5, 0.08, 0.381e10, 1e-2
+PERTURBATION = -0.01  # [cm/s], added to the tangential velocity before the dynamics run
+
+#: the linear set-up's PETSc events, none nested in another: MUMPS's factorisations and
+#: GAMG's hierarchy (hypre's has no event of its own: its PCSetUp is counted when no other ran)
+SETUP_EVENTS = ("MatLUFactorSym", "MatLUFactorNum", "MatCholFctrSym", "MatCholFctrNum",
+                "PCSetUp_GAMG+")
+PATHS = ("direct", "amg")
+
+
+def dofs_of(refine: int) -> int:
+    """Unknowns of the 3D block at ``refine`` (degree 2, nz = 2)."""
+    return 3 * (8 * refine + 1) * (6 * refine + 1) * (4 * refine + 1)
+
+
+def _peak_mib(comm: MPI.Comm) -> list[float]:
+    return comm.allgather(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0)
+
+
+def _stage_times(stage: PETSc.Log.Stage, comm: MPI.Comm) -> dict[str, float]:
+    """A phase's time by PETSc's events in its log stage, the maximum over the ranks:
+    assembly (the SNES function and Jacobian evaluations), the linear set-up
+    (:data:`SETUP_EVENTS`), the Krylov iterations with their preconditioner applications and
+    the line search (the rest of the SNES solves), contact search (none in this scene)."""
+    def event(name: str) -> float:
+        return float(PETSc.Log.Event(name).getPerfInfo(stage)["time"])
+
+    assembly = event("SNESFunctionEval") + event("SNESJacobianEval")
+    setup = sum(map(event, SETUP_EVENTS)) or event("PCSetUp")
+    times = {"assembly": assembly, "linear set-up": setup,
+             "Krylov": event("SNESSolve") - assembly - setup, "contact search": 0.0}
+    return {name: comm.allreduce(t, op=MPI.MAX) for name, t in times.items()}
+
+
+def _solver_args(cls: type, path: str) -> dict[str, typing.Any]:
+    """How ``cls`` (SteadySolver or DynamicsSolver) is asked for ``path``: its own
+    ``linear_solver="amg"`` where it has one; else GAMG through the PETSc options (GMRES,
+    without the rigid-body near-nullspace), which the JSON's solver path then shows."""
+    if path == "direct":
+        return {}
+    choices = getattr(inspect.getmodule(cls), "LINEAR_SOLVERS", ())
+    if "linear_solver" in inspect.signature(cls).parameters and "amg" in choices:
+        return {"linear_solver": "amg"}
+    return {"options": {"ksp_type": "gmres", "pc_type": "gamg", "ksp_rtol": 1e-8}}
+
+
+class _Observers:
+    """The observers' time in a log stage of their own: the spring force at every step."""
+
+    def __init__(self, model: typing.Any):
+        self.model, self.stage = model, PETSc.Log.Stage("observers")
+        self.seconds = 0.0
+
+    def __call__(self, *_: typing.Any) -> dict[str, float]:
+        self.stage.push()
+        t0 = time.perf_counter()
+        q = self.model.quantities()
+        self.seconds += time.perf_counter() - t0
+        self.stage.pop()
+        return {"spring_force": float(q.spring_force)}
+
+
+def run(refine: int, path: str, mu_steps: int, steps: int, dt: float, comm: MPI.Comm) -> dict:
+    """Steady continuation and ``steps`` dynamics steps of the 3D block at ``refine``."""
+    import fenicsfriction as ff
+    from fenicsfriction.dynamics import DynamicsError, DynamicsSolver
+
+    say = ff.results.get_logger(comm).info
+    t0 = time.perf_counter()
+    law = ff.InterfaceLaw(mu=0.0, b_n=B_N, eps=EPS)
+    model = ff.BlockOnBelt(refine=refine, dim=3, belt_speed=BELT_SPEED, law=law).build(
+        comm, with_friction=True)
+    n = model.V.dofmap.index_map.size_global * model.V.dofmap.index_map_bs
+    observe = _Observers(model)
+    build_s = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
+    say(f"{n} unknowns, {comm.size} rank(s), {path}: model built in {build_s:.1f} s")
+    out: dict[str, typing.Any] = {"refine": refine, "dofs": n, "ranks": comm.size,
+                                  "path": path, "build_s": build_s,
+                                  "peak_mib_build": _peak_mib(comm)}
+
+    stage = PETSc.Log.Stage("steady continuation")
+    stage.push()
+    comm.Barrier()
+    t0 = time.perf_counter()
+    solver = ff.SteadySolver(model.residual, prefix="scale_s_",
+                             **_merge(_solver_args(ff.SteadySolver, path),
+                                      model.solver_options()))
+    model.initial_guess()
+    records = ff.continuation(solver, model.mu, np.linspace(0.0, MU, mu_steps + 1),
+                              observe=observe)
+    steady_s = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
+    stage.pop()
+    note_solver(solver)
+    krylov = solver.snes.getLinearSolveIterations()
+    out["steady"] = {"wall_time_s": steady_s, "linear_solver": solver.linear_solver,
+                     "jit_s": comm.allreduce(solver.jit_time_s, op=MPI.MAX),
+                     "newton_iterations": [r["newton_iterations"] for r in records],
+                     "krylov_iterations_last_step": krylov,
+                     "stages_s": _stage_times(stage, comm),
+                     "observers_s": comm.allreduce(observe.seconds, op=MPI.MAX),
+                     "spring_force": records[-1]["spring_force"]}
+    out["peak_mib_steady"] = _peak_mib(comm)
+    say(f"  steady continuation to μ = {MU}: {steady_s:.1f} s, Newton "
+        f"{out['steady']['newton_iterations']}, {out['peak_mib_steady']} MiB")
+    for obj in (solver.snes, solver.A, solver.b, solver.x):  # the SNES and its callbacks form
+        obj.destroy()                                        # a cycle gc leaves
+    if steps == 0:
+        return out
+
+    r = model.residual
+    r.u_dot.x.array[0::3] += PERTURBATION  # the tangential velocity, along the belt
+    observe.seconds = 0.0
+    stage = PETSc.Log.Stage("dynamics")
+    stage.push()
+    comm.Barrier()
+    t0 = time.perf_counter()
+    dynamics = DynamicsSolver(r, prefix="scale_d_", atol=1e-10 * model.force_scale,
+                              **_solver_args(DynamicsSolver, path))
+    setup_s = time.perf_counter() - t0
+    failure = None
+    try:
+        records = dynamics.run(steps * dt, dt, observe=observe)
+    except DynamicsError as err:
+        records, failure = err.records, str(err)
+    dynamics_s = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
+    stage.pop()
+    note_solver(dynamics)
+    done = len(records) - 1
+    out["dynamics"] = {"wall_time_s": dynamics_s, "setup_s": comm.allreduce(setup_s, op=MPI.MAX),
+                       "dt": dt, "steps": done, "failure": failure,
+                       "time_per_step_s": (dynamics_s - setup_s) / max(done, 1),
+                       "newton_iterations": int(sum(x["newton_iterations"] for x in records)),
+                       "rejected_steps": int(sum(x["rejected_steps"] for x in records)),
+                       "stages_s": _stage_times(stage, comm),
+                       "observers_s": comm.allreduce(observe.seconds, op=MPI.MAX)}
+    out["peak_mib_dynamics"] = _peak_mib(comm)
+    say(f"  {done} dynamics steps: {dynamics_s:.1f} s "
+        f"({out['dynamics']['time_per_step_s']:.2f} s/step), "
+        f"{out['peak_mib_dynamics']} MiB")
+    dynamics.ts.destroy()
+    return out
+
+
+def _merge(args: dict, options: dict) -> dict:
+    """``args`` with the model's SNES tolerances added to its ``options``."""
+    return {**args, "options": {**args.get("options", {}), **options}}
+
+
+# --- collecting the runs -----------------------------------------------------------------------
+def fit_exponent(n: list[float], y: list[float]) -> float | None:
+    """The least-squares slope of log y against log n (None below two points)."""
+    if len(n) < 2:
+        return None
+    return float(np.polyfit(np.log(n), np.log(y), 1)[0])
+
+
+def collect(folder: pathlib.Path) -> dict:
+    runs = [json.loads(p.read_text()) for p in sorted(folder.glob("bench_scale_3d_*_r*_p*.json"))]
+    summary: dict[str, typing.Any] = {"runs": runs, "fits": {}, "strong": [], "weak": []}
+    for path in PATHS:
+        serial = sorted((r for r in runs if r["path"] == path and r["ranks"] == 1),
+                        key=lambda r: r["dofs"])
+        best = {}
+        for r in serial:  # the fastest of repeated runs at one size
+            if r["dofs"] not in best or (r["steady"]["wall_time_s"]
+                                         < best[r["dofs"]]["steady"]["wall_time_s"]):
+                best[r["dofs"]] = r
+        serial = list(best.values())
+        n = [r["dofs"] for r in serial]
+        fits = {"dofs": n,
+                "steady_time_exponent": fit_exponent(
+                    n, [r["steady"]["wall_time_s"] for r in serial]),
+                "memory_exponent": fit_exponent(
+                    n, [max(r["peak_mib_steady"]) for r in serial])}
+        dyn = [r for r in serial if "dynamics" in r]
+        fits["step_time_exponent"] = fit_exponent(
+            [r["dofs"] for r in dyn], [r["dynamics"]["time_per_step_s"] for r in dyn])
+        summary["fits"][path] = fits
+        for one in serial:
+            for two in (r for r in runs if r["path"] == path and r["ranks"] == 2):
+                if two["dofs"] == one["dofs"]:
+                    summary["strong"].append(_strong(one, two))
+                elif 1.6 <= two["dofs"] / one["dofs"] <= 2.4:
+                    summary["weak"].append(_weak(one, two))
+    return summary
+
+
+def _strong(one: dict, two: dict) -> dict:
+    row = {"path": one["path"], "dofs": one["dofs"], "tags": [one.get("tag"), two.get("tag")],
+           "load": [one["environment"]["load_average"], two["environment"]["load_average"]]}
+    for phase in ("steady", "dynamics"):
+        if phase in one and phase in two:
+            key = "wall_time_s" if phase == "steady" else "time_per_step_s"
+            row[phase] = {"1": one[phase][key], "2": two[phase][key],
+                          "speedup": one[phase][key] / two[phase][key],
+                          "stages_1": one[phase]["stages_s"], "stages_2": two[phase]["stages_s"],
+                          "observers": [one[phase]["observers_s"], two[phase]["observers_s"]]}
+    return row
+
+
+def _weak(one: dict, two: dict) -> dict:
+    """Weak scaling efficiency: (time per unknown on 1 rank) / (time per unknown per rank on
+    2), i.e. t1 / t2 × (n2 / 2 n1) so that a slightly uneven size ratio is corrected to first
+    order (the cost is not linear in n; the exponents fitted above say how far off that is)."""
+    row = {"path": one["path"], "dofs": [one["dofs"], two["dofs"]]}
+    for phase in ("steady", "dynamics"):
+        if phase in one and phase in two:
+            key = "wall_time_s" if phase == "steady" else "time_per_step_s"
+            row[phase] = (one[phase][key] / two[phase][key]) * two["dofs"] / (2 * one["dofs"])
+    return row
+
+
+def plot(summary: dict, path: pathlib.Path) -> None:
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 3, figsize=(13, 4))
+    for name, marker in zip(PATHS, "os", strict=True):
+        serial = [r for r in summary["runs"] if r["path"] == name and r["ranks"] == 1]
+        if not serial:
+            continue
+        serial.sort(key=lambda r: r["dofs"])
+        n = [r["dofs"] for r in serial]
+        axes[0].loglog(n, [r["steady"]["wall_time_s"] for r in serial], marker, ls="-",
+                       label=name)
+        dyn = [r for r in serial if "dynamics" in r]
+        axes[1].loglog([r["dofs"] for r in dyn], [r["dynamics"]["time_per_step_s"] for r in dyn],
+                       marker, ls="-", label=name)
+        axes[2].loglog(n, [max(r["peak_mib_steady"]) for r in serial], marker, ls="-",
+                       label=name)
+    for ax, title in zip(axes, ("steady continuation to μ = 0.5 [s]",
+                                "dynamics, time per step [s]", "peak memory per rank [MiB]"),
+                         strict=True):
+        ax.set_xlabel("unknowns n")
+        ax.set_title(title)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend()
+    save(fig, path, 120)
+
+
+def markdown(summary: dict) -> str:
+    lines = ["| path | n | ranks | steady [s] | Newton | dyn. s/step | steps | peak MiB/rank |",
+             "|---|---|---|---|---|---|---|---|"]
+    for r in sorted(summary["runs"], key=lambda r: (r["path"], r["dofs"], r["ranks"])):
+        d = r.get("dynamics", {})
+        lines.append(f"| {r['path']} | {r['dofs']:,} | {r['ranks']} | "
+                     f"{r['steady']['wall_time_s']:.1f} | {sum(r['steady']['newton_iterations'])}"
+                     f" | {d.get('time_per_step_s', math.nan):.2f} | {d.get('steps', 0)} | "
+                     f"{max(r.get('peak_mib_dynamics', r['peak_mib_steady'])):.0f} |")
+    lines += ["", "| path | time exponent (steady) | time exponent (dyn. step) | memory exponent |",
+              "|---|---|---|---|"]
+    for name, f in summary["fits"].items():
+        cells = [f"{v:.2f}" if v is not None else "-" for v in
+                 (f["steady_time_exponent"], f["step_time_exponent"], f["memory_exponent"])]
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    for row in summary["strong"]:
+        lines += ["", f"Strong scaling, {row['path']}, n = {row['dofs']:,}:"]
+        for phase in ("steady", "dynamics"):
+            if phase in row:
+                p = row[phase]
+                lines.append(f"- {phase}: 1 rank {p['1']:.2f} s, 2 ranks {p['2']:.2f} s, "
+                             f"speed-up {p['speedup']:.2f}")
+    for row in summary["weak"]:
+        lines.append(f"- weak scaling {row['path']} {row['dofs']}: " + ", ".join(
+            f"{k} {v:.0%}" for k, v in row.items() if k in ("steady", "dynamics")))
+    return "\n".join(lines)
+
+
+def main() -> None:
+    parser = benchmark_parser(__doc__)
+    parser.add_argument("--refine", type=int, default=3,
+                        help="mesh refinement r (4r × 3r × 2r Q2 hexahedra; default 3: 18,525 "
+                             "unknowns; 5, 7, 9, 12: 80,073, 213,585, 446,589, 1,040,697)")
+    parser.add_argument("--path", choices=PATHS, default="direct",
+                        help="direct: MUMPS (the solvers' default path); amg: Krylov + AMG")
+    parser.add_argument("--mu-steps", type=int, default=10,
+                        help="continuation increments to μ = 0.5 (default 10)")
+    parser.add_argument("--steps", type=int, default=10,
+                        help="dynamics steps (default 10; 0: none)")
+    parser.add_argument("--dt", type=float, default=1e-5, help="time step [s] (default 1e-5)")
+    parser.add_argument("--tag", default="", help="suffix of the JSON's name (repeated runs)")
+    parser.add_argument("--collect", action="store_true",
+                        help="no run: fit, plot and tabulate the JSONs in --out")
+    args = parser.parse_args()
+    if args.collect:
+        summary = collect(args.out)
+        write_summary(args.out / "bench_scale_3d.json", summary, MPI.COMM_SELF)
+        plot(summary, args.out / "bench_scale_3d.png")
+        print(markdown(summary))
+        return
+    for flag, value, ok in (("--refine", args.refine, args.refine >= 1),
+                            ("--mu-steps", args.mu_steps, args.mu_steps >= 1),
+                            ("--steps", args.steps, args.steps >= 0),
+                            ("--dt", args.dt, args.dt > 0)):
+        if not ok:
+            parser.error(f"{flag}={value} is invalid: must be positive")
+    logging.getLogger("ffcx").setLevel(logging.WARNING)
+    logging.getLogger().addFilter(lambda record: record.levelno >= logging.WARNING)
+    PETSc.Log.begin()
+    comm = MPI.COMM_WORLD
+    result = run(args.refine, args.path, args.mu_steps, args.steps, args.dt, comm)
+    result["tag"] = args.tag
+    name = f"bench_scale_3d_{args.path}_r{args.refine}_p{comm.size}"
+    write_summary(args.out / f"{name}{'_' + args.tag if args.tag else ''}.json", result, comm)
+
+
+if __name__ == "__main__":
+    main()
