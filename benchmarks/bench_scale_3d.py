@@ -78,13 +78,17 @@ def _stage_times(stage: PETSc.Log.Stage, comm: MPI.Comm) -> dict[str, float]:
 
 
 def _solver_args(cls: type, path: str) -> dict[str, typing.Any]:
-    """How ``cls`` (SteadySolver or DynamicsSolver) is asked for ``path``: its own
-    ``linear_solver="amg"`` where it has one; else GAMG through the PETSc options (GMRES,
-    without the rigid-body near-nullspace), which the JSON's solver path then shows."""
+    """How ``cls`` (SteadySolver or DynamicsSolver) is asked for ``path``, explicitly (its
+    ``"auto"`` may pick either). Direct: the steady solver's reused MUMPS LU under FGMRES (its
+    3D path before AMG; the condensation, faster below ≈ 4e4 unknowns, fills a dense
+    complement that grows like n^(4/3)), the dynamics' MUMPS LU at every Newton iteration.
+    AMG: ``linear_solver="amg"`` where the solver has it; else GAMG through the PETSc options
+    (GMRES, without the rigid-body near-nullspace), which the JSON's solver path then shows."""
+    has_choice = "linear_solver" in inspect.signature(cls).parameters
     if path == "direct":
-        return {}
-    choices = getattr(inspect.getmodule(cls), "LINEAR_SOLVERS", ())
-    if "linear_solver" in inspect.signature(cls).parameters and "amg" in choices:
+        return {"linear_solver": "reused-lu" if cls.__name__ == "SteadySolver" else "lu"
+                } if has_choice else {}
+    if has_choice and "amg" in getattr(inspect.getmodule(cls), "LINEAR_SOLVERS", ()):
         return {"linear_solver": "amg"}
     return {"options": {"ksp_type": "gmres", "pc_type": "gamg", "ksp_rtol": 1e-8}}
 
@@ -141,8 +145,8 @@ def run(refine: int, path: str, mu_steps: int, steps: int, dt: float, comm: MPI.
                      "jit_s": comm.allreduce(solver.jit_time_s, op=MPI.MAX),
                      "newton_iterations": [r["newton_iterations"] for r in records],
                      "krylov_iterations_last_step": krylov,
-                     "stages_s": _stage_times(stage, comm),
-                     "observers_s": comm.allreduce(observe.seconds, op=MPI.MAX),
+                     "stages_s": {**_stage_times(stage, comm),
+                                  "observers": comm.allreduce(observe.seconds, op=MPI.MAX)},
                      "spring_force": records[-1]["spring_force"]}
     out["peak_mib_steady"] = _peak_mib(comm)
     say(f"  steady continuation to μ = {MU}: {steady_s:.1f} s, Newton "
@@ -176,8 +180,8 @@ def run(refine: int, path: str, mu_steps: int, steps: int, dt: float, comm: MPI.
                        "time_per_step_s": (dynamics_s - setup_s) / max(done, 1),
                        "newton_iterations": int(sum(x["newton_iterations"] for x in records)),
                        "rejected_steps": int(sum(x["rejected_steps"] for x in records)),
-                       "stages_s": _stage_times(stage, comm),
-                       "observers_s": comm.allreduce(observe.seconds, op=MPI.MAX)}
+                       "stages_s": {**_stage_times(stage, comm),
+                                    "observers": comm.allreduce(observe.seconds, op=MPI.MAX)}}
     out["peak_mib_dynamics"] = _peak_mib(comm)
     say(f"  {done} dynamics steps: {dynamics_s:.1f} s "
         f"({out['dynamics']['time_per_step_s']:.2f} s/step), "
@@ -220,6 +224,8 @@ def collect(folder: pathlib.Path) -> dict:
         dyn = [r for r in serial if "dynamics" in r]
         fits["step_time_exponent"] = fit_exponent(
             [r["dofs"] for r in dyn], [r["dynamics"]["time_per_step_s"] for r in dyn])
+        fits["memory_exponent_dynamics"] = fit_exponent(
+            [r["dofs"] for r in dyn], [max(r["peak_mib_dynamics"]) for r in dyn])
         summary["fits"][path] = fits
         for one in serial:
             for two in (r for r in runs if r["path"] == path and r["ranks"] == 2):
@@ -238,9 +244,45 @@ def _strong(one: dict, two: dict) -> dict:
             key = "wall_time_s" if phase == "steady" else "time_per_step_s"
             row[phase] = {"1": one[phase][key], "2": two[phase][key],
                           "speedup": one[phase][key] / two[phase][key],
-                          "stages_1": one[phase]["stages_s"], "stages_2": two[phase]["stages_s"],
-                          "observers": [one[phase]["observers_s"], two[phase]["observers_s"]]}
+                          "total_1": one[phase]["wall_time_s"],
+                          "total_2": two[phase]["wall_time_s"],
+                          "stages_1": one[phase]["stages_s"], "stages_2": two[phase]["stages_s"]}
+            row[phase]["model"] = model(row, phase)
     return row
+
+
+def predicted_time(t1: float, t2: float, p: int, log_growth: bool) -> float:
+    """A stage's time on ``p`` ranks from its times on 1 and 2.
+
+    Amdahl (``log_growth`` False): a part f that does not divide, t(p) = t1 ((1 - f)/p + f),
+    f = 2 t2/t1 - 1 from the two measurements. AMG's set-up and Krylov iterations
+    (``log_growth`` True): everything divides but the levels' communication and the coarse
+    grids grow like log p, t(p) = t1 (1 + γ log2 p) / p with γ = 2 t2/t1 - 1. Both reproduce
+    t2; they differ only in how they extrapolate, and both rest on two points."""
+    if t1 <= 0.0:
+        return 0.0
+    excess = min(max(2.0 * t2 / t1 - 1.0, 0.0), 1.0 if not log_growth else math.inf)
+    if log_growth:
+        return t1 * (1.0 + excess * math.log2(p)) / p
+    return t1 * ((1.0 - excess) / p + excess)
+
+
+def model(row: dict, phase: str, ranks: tuple[int, ...] = (8, 64, 512)) -> dict[int, float]:
+    """Predicted speed-ups on ``ranks`` at the same n (strong scaling) from a strong-scaling
+    row's stage times: every stage, and the rest of the wall time, by
+    :func:`predicted_time`; AMG's set-up and Krylov with log p growth, MUMPS's with Amdahl."""
+    p1, p2 = row[phase]["stages_1"], row[phase]["stages_2"]
+    total1, total2 = row[phase]["total_1"], row[phase]["total_2"]  # the phase's whole run
+    rest1 = max(total1 - sum(p1.values()), 0.0)
+    rest2 = max(total2 - sum(p2.values()), 0.0)
+    amg = row["path"] == "amg"
+    out = {}
+    for p in ranks:
+        t = predicted_time(rest1, rest2, p, False)
+        for stage, t1 in p1.items():
+            t += predicted_time(t1, p2[stage], p, amg and stage in ("linear set-up", "Krylov"))
+        out[p] = total1 / t if t > 0 else math.nan
+    return out
 
 
 def _weak(one: dict, two: dict) -> dict:
@@ -291,11 +333,12 @@ def markdown(summary: dict) -> str:
                      f"{r['steady']['wall_time_s']:.1f} | {sum(r['steady']['newton_iterations'])}"
                      f" | {d.get('time_per_step_s', math.nan):.2f} | {d.get('steps', 0)} | "
                      f"{max(r.get('peak_mib_dynamics', r['peak_mib_steady'])):.0f} |")
-    lines += ["", "| path | time exponent (steady) | time exponent (dyn. step) | memory exponent |",
-              "|---|---|---|---|"]
+    lines += ["", "| path | time exponent: steady | dynamics step | memory exponent: steady "
+              "| with dynamics |", "|---|---|---|---|---|"]
     for name, f in summary["fits"].items():
         cells = [f"{v:.2f}" if v is not None else "-" for v in
-                 (f["steady_time_exponent"], f["step_time_exponent"], f["memory_exponent"])]
+                 (f["steady_time_exponent"], f["step_time_exponent"], f["memory_exponent"],
+                  f["memory_exponent_dynamics"])]
         lines.append(f"| {name} | " + " | ".join(cells) + " |")
     for row in summary["strong"]:
         lines += ["", f"Strong scaling, {row['path']}, n = {row['dofs']:,}:"]
@@ -314,7 +357,7 @@ def main() -> None:
     parser = benchmark_parser(__doc__)
     parser.add_argument("--refine", type=int, default=3,
                         help="mesh refinement r (4r × 3r × 2r Q2 hexahedra; default 3: 18,525 "
-                             "unknowns; 5, 7, 9, 12: 80,073, 213,585, 446,589, 1,040,697)")
+                             "unknowns; 5, 7, 9, 12: 80,073, 213,237, 445,665, 1,040,907)")
     parser.add_argument("--path", choices=PATHS, default="direct",
                         help="direct: MUMPS (the solvers' default path); amg: Krylov + AMG")
     parser.add_argument("--mu-steps", type=int, default=10,
