@@ -30,6 +30,7 @@ if "petsc4py.PETSc" in sys.modules:  # start PETSc's event log before the run cr
     sys.modules["petsc4py.PETSc"].Log.begin()
 
 _noted: list[dict[str, typing.Any]] = []
+_stages: list[str] = ["Main Stage"]
 
 
 def parser(doc: str | None) -> argparse.ArgumentParser:
@@ -99,6 +100,14 @@ def solver_path(solver: typing.Any) -> dict[str, typing.Any]:
     return {"solver": type(solver).__qualname__, "unknown": True}
 
 
+def log_stage(name: str) -> typing.Any:
+    """The PETSc log stage ``name``; the events of every stage made here are counted in the
+    record (:func:`environment`), not only those of the main stage."""
+    if name not in _stages:
+        _stages.append(name)
+    return sys.modules["petsc4py.PETSc"].Log.Stage(name)
+
+
 def note_solver(solver: typing.Any) -> None:
     """Read ``solver``'s path now (it may be gone when the JSON is written); each distinct
     path is recorded once."""
@@ -137,12 +146,17 @@ def _live_solver_paths(known: list[dict[str, typing.Any]]) -> list[dict[str, typ
 
 
 def _event_counts() -> dict[str, dict[str, float]]:
+    """Rank 0's count and time of each of :data:`PATH_EVENTS`, summed over the log stages."""
     if "petsc4py.PETSc" not in sys.modules:
         return {}
     log = sys.modules["petsc4py.PETSc"].Log
-    info = {name: log.Event(name).getPerfInfo() for name in PATH_EVENTS}
-    return {name: {"count": int(i["count"]), "time_s": float(i["time"])}
-            for name, i in info.items() if i["count"] > 0}
+    counts = {}
+    for name in PATH_EVENTS:
+        info = [log.Event(name).getPerfInfo(log.Stage(stage)) for stage in _stages]
+        count = sum(int(i["count"]) for i in info)
+        if count > 0:
+            counts[name] = {"count": count, "time_s": sum(float(i["time"]) for i in info)}
+    return counts
 
 
 def environment(comm: MPI.Comm = MPI.COMM_WORLD, solvers: typing.Iterable = ()
