@@ -41,6 +41,7 @@ _EXPORTS: dict[str, str] = {
     "PanagiotopoulosSolver": "panagiotopoulos", "ProcessError": "panagiotopoulos",
     "ProcessReport": "panagiotopoulos", "SurfaceMollifier": "mollification",
     "integrate_hybrid": "events", "HybridError": "events", "HybridResult": "events",
+    "rigid_body_modes": "amg", "choose_linear_solver": "amg",
     # two-body contact elements
     "NodeToSegment": "contact", "solve_with_search": "contact",
     # post-processing and output
@@ -77,9 +78,9 @@ _EXPORTS: dict[str, str] = {
     "InteractingEQModel": "studies.multicontact", "FKChain": "studies.multicontact",
 }
 
-_SUBMODULES = ("contact", "dynamics", "events", "forms", "io", "laws", "meshing", "mollification",
-               "numerics", "panagiotopoulos", "plotting", "results", "rotation", "signals",
-               "stability", "statistics", "steady", "studies", "timestepping")
+_SUBMODULES = ("amg", "contact", "dynamics", "events", "forms", "io", "laws", "meshing",
+               "mollification", "numerics", "panagiotopoulos", "plotting", "results", "rotation",
+               "signals", "stability", "statistics", "steady", "studies", "timestepping")
 
 __getattr__, __dir__, __all__ = attach(__name__, _EXPORTS, _SUBMODULES)
 __all__.append("__version__")  # the same list __dir__ returns

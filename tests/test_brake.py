@@ -106,12 +106,15 @@ def test_a_pair_couples_and_grows_above_mu_crit(brake):
 
 def test_projection_on_frictionless_modes_reproduces_the_band(brake):
     """The projected problem on the 40 lowest real modes of the frictionless (K_s, M) (up to
-    about 13 kHz, 4x the band) gives every eigenvalue of the band: exactly at μ = 0, where the
-    band's modes are in the basis (round-off), and to 1e-3 at μ = 0.2: twice the floor of a
+    about 13 kHz, 4x the band) gives every eigenvalue of the band: at μ = 0, where the band's
+    modes are in the basis, to the eigensolvers' tolerance (the basis stops at a relative
+    residual of 1e-10 of its shift-and-invert operator: the band then agrees to 1.5e-9 on one
+    rank and 1.3e-8 on two, whose partition changes the Krylov spaces; 1e-7 asked), and to 1e-3
+    at μ = 0.2: twice the floor of a
     basis that holds no static correction for the friction's interface terms, 4.7e-4 on the
     1.83 kHz mode, which does not shrink with more modes (40, 80 and 160 modes gave the same
     floor at 10⁵ unknowns, benchmarks/bench_brake.py)."""
-    for mu, tol in ((0.0, 1e-8), (0.2, 1e-3)):
+    for mu, tol in ((0.0, 1e-7), (0.2, 1e-3)):
         full = brake.modes(mu)
         projected = brake.basis.solve(*brake.model.pencil(), BAND)
         assert len(projected) == len(full)

@@ -1,0 +1,230 @@
+r"""Newton's linear systems by a Krylov method preconditioned with algebraic multigrid (AMG): the
+rigid-body near-nullspace, the PETSc options of the AMG path, and the automatic choice of a
+solver's linear-solver path.
+
+An elastic body's stiffness K annihilates its rigid motions (3 in 2D, 6 in 3D); aggregation
+AMG (PETSc GAMG, Adams et al. 2004; Vaněk, Mandel & Brezina 1996) builds its coarse spaces from
+these *near-nullspace* vectors, restricted to each aggregate, and with them converges in a
+number of iterations independent of the mesh size. A mesh that holds several bodies (two-body
+contact, a block on a slab) has the rigid motions of each body: :func:`rigid_body_modes` returns
+one set per body (connected component of the mesh), each supported on its own body, which
+spans the global set and more; the supports couple only through the contact terms.
+
+The Jacobian is not symmetric wherever friction slips (the friction force follows the normal
+pressure), so the Krylov method is GMRES with right preconditioning (its test is on the true
+residual); CG is kept for a symmetric problem. The Krylov tolerance is tied to Newton's: a
+relative 1e-8 per linear solve keeps Newton's quadratic phase down to its own tolerance, so
+the converged state equals the direct path's to Newton's tolerance.
+
+Everything here is a default under the solver's options prefix: ``-<prefix>pc_type lu`` gives
+the direct path back, ``-<prefix>pc_type hypre`` BoomerAMG, any ``-<prefix>pc_gamg_*`` or
+``-<prefix>mg_levels_*`` option tunes GAMG (docs/solvers.md has the measurements behind the
+defaults and the crossovers of :func:`choose_linear_solver`).
+"""
+
+from __future__ import annotations
+
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import dolfinx.la
+import numpy as np
+import scipy.sparse
+import scipy.sparse.csgraph
+from dolfinx import fem
+
+from fenicsfriction.laws import check
+
+__all__ = ["AMG_TYPES", "LINEAR_SOLVER_PATHS", "amg_options", "attach_near_nullspace",
+           "bodies", "choose_linear_solver", "rigid_body_modes", "uses_amg"]
+
+#: the AMG preconditioners :func:`amg_options` configures (PETSc ``pc_type``)
+AMG_TYPES = ("gamg", "hypre")
+
+#: the paths :func:`choose_linear_solver` chooses from
+LINEAR_SOLVER_PATHS = ("lu", "condensed", "reused-lu", "amg")
+
+#: ``"auto"`` solves by AMG from this many unknowns per rank on in 3D (below: a reused LU or
+#: the condensation): measured on the 3D block's steady continuation (docs/solvers.md)
+AMG_MIN_UNKNOWNS_3D = 20_000
+
+#: and from this many in 2D, where the sparse factorisation fills like n log n and MUMPS
+#: stays faster far longer
+AMG_MIN_UNKNOWNS_2D = 400_000
+
+
+def bodies(V: fem.FunctionSpace) -> tuple[np.ndarray, int]:
+    """The body (connected component of the mesh) of each node of ``V`` on this rank, owned and
+    ghost, numbered 0, 1, ... the same on every rank; and the number of bodies.
+
+    Each rank labels the components of its own part of the mesh; a ghost node joins its
+    component to the owner's component of that node, and the (few) joins are gathered on every
+    rank and merged there, so no rank holds more than the list of components.
+    """
+    comm = V.mesh.comm
+    index_map = V.dofmap.index_map
+    n_local = index_map.size_local + index_map.num_ghosts
+    cells = V.dofmap.list  # an adjacency list up to 0.7, an array of rows from 0.8
+    cells = np.asarray(getattr(cells, "array", cells)).reshape(-1, V.dofmap.dof_layout.num_dofs)
+    # a chain through each cell's nodes connects them
+    rows, cols = cells[:, :-1].ravel(), cells[:, 1:].ravel()
+    graph = scipy.sparse.coo_matrix((np.ones(rows.size), (rows, cols)), shape=(n_local, n_local))
+    count, local = scipy.sparse.csgraph.connected_components(graph, directed=False)
+    offset = comm.scan(count) - count
+    label = local + offset  # a global number for each rank's component
+    # the owner's label of each ghost node
+    owner = dolfinx.la.vector(index_map)
+    owner.array[:] = label
+    owner.scatter_forward()
+    ghost_labels = owner.array[index_map.size_local:].astype(np.int64)
+    joins = np.unique(np.column_stack([label[index_map.size_local:], ghost_labels]), axis=0)
+    joins = np.concatenate(comm.allgather(joins.reshape(-1, 2)))
+    total = comm.allreduce(count, op=MPI.SUM)
+    merged = scipy.sparse.coo_matrix((np.ones(len(joins)), (joins[:, 0], joins[:, 1])),
+                                     shape=(total, total))
+    n_bodies, body_of_component = scipy.sparse.csgraph.connected_components(merged,
+                                                                            directed=False)
+    return body_of_component[label], int(n_bodies)
+
+
+def _modes(x: np.ndarray, gdim: int) -> list[np.ndarray]:
+    """The rigid motions at the points ``x`` (rows, centred): translations, then rotations."""
+    n = x.shape[0]
+    modes = []
+    for i in range(gdim):
+        mode = np.zeros((n, gdim))
+        mode[:, i] = 1.0
+        modes.append(mode)
+    # rotation about axis k: (-x_j, x_i) in the (i, j) plane
+    planes = [(0, 1)] if gdim == 2 else [(0, 1), (1, 2), (2, 0)]
+    for i, j in planes:
+        mode = np.zeros((n, gdim))
+        mode[:, i], mode[:, j] = -x[:, j], x[:, i]
+        modes.append(mode)
+    return modes
+
+
+def rigid_body_modes(V: fem.FunctionSpace, per_body: bool = True) -> PETSc.NullSpace:
+    r"""The rigid motions of the bodies of a vector space ``V`` as an orthonormal PETSc
+    near-nullspace: 3 vectors per body in 2D (two translations, one rotation), 6 in 3D.
+
+    Args:
+        V: a vector Lagrange space (the displacement's).
+        per_body: one set per body (connected component of the mesh, :func:`bodies`), each
+            vector zero outside its body; else one set for the whole mesh. The bodies move
+            independently wherever they do not touch, so the global set leaves each body's
+            relative rigid motion out of the coarse spaces: with the contact's penalty the
+            two-body operator is nearly singular in exactly those directions.
+
+    The vectors are orthonormalised (modified Gram–Schmidt, twice: the rotations of a body far
+    from the origin are nearly translations) after centring each body's coordinates on its
+    centroid.
+    """
+    gdim = V.mesh.geometry.dim
+    bs = V.dofmap.index_map_bs
+    check("V", bs, bs == gdim, f"must be a vector space of {gdim} components (block size {bs})")
+    comm = V.mesh.comm
+    n_owned = V.dofmap.index_map.size_local
+    x = V.tabulate_dof_coordinates()[:n_owned, :gdim]
+    if per_body:
+        body, n_bodies = bodies(V)
+        body = body[:n_owned]
+    else:
+        body, n_bodies = np.zeros(n_owned, dtype=np.int64), 1
+    sums = comm.allreduce(np.column_stack([
+        np.bincount(body, weights=x[:, k], minlength=n_bodies) for k in range(gdim)]
+        + [np.bincount(body, minlength=n_bodies)]), op=MPI.SUM)
+    centroids = sums[:, :gdim] / np.maximum(sums[:, gdim:], 1)
+    vectors = []
+    for b in range(n_bodies):
+        inside = body == b
+        for mode in _modes(x - centroids[b], gdim):
+            mode[~inside] = 0.0
+            vec = PETSc.Vec().createMPI((n_owned * bs, PETSc.DETERMINE), bsize=bs, comm=comm)
+            vec.setArray(mode.ravel())
+            vectors.append(vec)
+    for _ in range(2):
+        for i, vec in enumerate(vectors):
+            for previous in vectors[:i]:
+                vec.axpy(-vec.dot(previous), previous)
+            vec.scale(1.0 / vec.norm())
+    return PETSc.NullSpace().create(vectors=vectors, comm=comm)
+
+
+def attach_near_nullspace(A: PETSc.Mat, V: fem.FunctionSpace,
+                          per_body: bool = True) -> PETSc.NullSpace:
+    """Give ``A`` (a Jacobian on ``V``) its rigid-body near-nullspace, which GAMG builds its
+    coarse spaces from and BoomerAMG interpolates (``vec_interp_variant``); the block size is
+    dolfinx's (one block per node). Returned: the near-nullspace (set it again on a matrix
+    whose storage was replaced)."""
+    nullspace = rigid_body_modes(V, per_body)
+    A.setNearNullSpace(nullspace)
+    return nullspace
+
+
+def amg_options(dim: int, preconditioner: str = "gamg", symmetric: bool = False) -> dict:
+    """PETSc options of the Krylov + AMG path (to put under the solver's prefix).
+
+    Args:
+        dim: the geometric dimension (BoomerAMG's strong threshold: 0.25 in 2D, 0.5 in 3D).
+        preconditioner: ``"gamg"`` (smoothed aggregation with the near-nullspace, the default:
+            faster on the block, docs/solvers.md) or ``"hypre"`` (BoomerAMG, systems options:
+            nodal coarsening and interpolation of the rigid modes).
+        symmetric: the Jacobian is symmetric (no slipping friction): CG, else GMRES.
+
+    GAMG: one smoothing of the tentative prolongator (``agg_nsmooths 1``), a drop threshold
+    0.01, Chebyshev smoothing with Jacobi on the levels, the interpolation kept across Newton
+    iterations (``reuse_interpolation``: the Galerkin products are redone on the new Jacobian,
+    the aggregates and prolongators kept; the interface is a small part of the operator).
+    """
+    check("preconditioner", preconditioner, preconditioner in AMG_TYPES,
+          f"use one of {', '.join(AMG_TYPES)}")
+    krylov = {"ksp_type": "cg" if symmetric else "gmres", "ksp_rtol": 1e-8,
+              "ksp_atol": 1e-50, "ksp_max_it": 500, "ksp_norm_type": "unpreconditioned"}
+    if not symmetric:
+        krylov.update({"ksp_pc_side": "right", "ksp_gmres_restart": 100,
+                       "ksp_gmres_modifiedgramschmidt": True})
+    if preconditioner == "gamg":
+        return {**krylov, "pc_type": "gamg", "pc_gamg_type": "agg",
+                "pc_gamg_agg_nsmooths": 1, "pc_gamg_threshold": 0.01,
+                "pc_gamg_reuse_interpolation": True, "pc_gamg_coarse_eq_limit": 1000,
+                "mg_levels_ksp_type": "chebyshev", "mg_levels_pc_type": "jacobi",
+                "mg_levels_ksp_max_it": 2}
+    return {**krylov, "pc_type": "hypre", "pc_hypre_type": "boomeramg",
+            "pc_hypre_boomeramg_strong_threshold": 0.5 if dim == 3 else 0.25,
+            "pc_hypre_boomeramg_nodal_coarsen": 6,
+            "pc_hypre_boomeramg_vec_interp_variant": 3,
+            "pc_hypre_boomeramg_coarsen_type": "HMIS",
+            "pc_hypre_boomeramg_interp_type": "ext+i",
+            "pc_hypre_boomeramg_agg_nl": 1}
+
+
+def uses_amg(ksp: PETSc.KSP) -> bool:
+    """Whether the options put an AMG preconditioner on ``ksp`` (else a factorisation)."""
+    return ksp.getPC().getType() in AMG_TYPES
+
+
+def choose_linear_solver(dim: int, size: int, ranks: int, splits: bool,
+                         condensable: bool = False) -> str:
+    """The linear-solver path ``"auto"`` takes (one of :data:`LINEAR_SOLVER_PATHS`).
+
+    Args:
+        dim: the geometric dimension.
+        size: the global number of unknowns.
+        ranks: the number of MPI ranks.
+        splits: the Jacobian splits into a constant bulk and an interface (steady problems
+            without contact couplings), which the condensation and the reused LU need.
+        condensable: the interface is small enough to condense onto
+            (``steady.AUTO_CONDENSE_MAX_FILL``).
+
+    AMG from :data:`AMG_MIN_UNKNOWNS_3D` unknowns per rank in 3D and
+    :data:`AMG_MIN_UNKNOWNS_2D` in 2D; below, the factorisations as before: condensed,
+    reused LU where the Jacobian splits, else an LU per iteration.
+    """
+    check("dim", dim, dim in (2, 3), "use 2 or 3")
+    threshold = AMG_MIN_UNKNOWNS_3D if dim == 3 else AMG_MIN_UNKNOWNS_2D
+    if size >= threshold * ranks:
+        return "amg"
+    if splits:
+        return "condensed" if condensable else "reused-lu"
+    return "lu"
