@@ -82,43 +82,29 @@ def _solver_args(cls: type, path: str) -> dict[str, typing.Any]:
     ``"auto"`` may pick either). Direct: the steady solver's reused MUMPS LU under FGMRES (its
     3D path before AMG; the condensation, faster below ≈ 4e4 unknowns, fills a dense
     complement that grows like n^(4/3)), the dynamics' MUMPS LU at every Newton iteration.
-    AMG: ``linear_solver="amg"`` where the solver has it; else GAMG through the PETSc options
-    (GMRES) with the rigid-body near-nullspace :func:`_stand_in_nullspace` attaches, which the
-    JSON's solver path and ``amg_stand_in`` then show."""
+    AMG: ``linear_solver="amg"`` where the solver has it; else the options of
+    :func:`fenicsfriction.amg.amg_options` (GMRES + GAMG) with the near-nullspace
+    :func:`_attach_nullspace` gives the matrix, which ``amg_by_options`` records."""
+    from fenicsfriction import amg
+
     has_choice = "linear_solver" in inspect.signature(cls).parameters
     if path == "direct":
         return {"linear_solver": "reused-lu" if cls.__name__ == "SteadySolver" else "lu"
                 } if has_choice else {}
     if has_choice and "amg" in getattr(inspect.getmodule(cls), "LINEAR_SOLVERS", ()):
         return {"linear_solver": "amg"}
-    return {"options": {"ksp_type": "gmres", "ksp_rtol": 1e-8, "ksp_gmres_restart": 100,
-                        "pc_type": "gamg", "pc_gamg_threshold": 0.01}}
+    return {"options": amg.amg_options(3)}
 
 
-def _stand_in_nullspace(solver: typing.Any, V: typing.Any) -> bool:
-    """Until the solvers have an AMG path of their own: the six rigid motions of the block
-    (orthonormalised) as the near-nullspace of ``solver``'s matrix, which GAMG's aggregates
-    interpolate. False (nothing done) when the solver chose its own path."""
-    pc = getattr(solver, "snes", None) or solver.ts.getSNES()
-    if pc.getKSP().getPC().getType() != "gamg" or getattr(solver, "linear_solver", "") == "amg":
+def _attach_nullspace(solver: typing.Any, V: typing.Any) -> bool:
+    """Where the AMG path came from the options (the solver has none of its own): the block's
+    rigid-body near-nullspace on ``solver``'s matrix. False where the solver set it up."""
+    from fenicsfriction import amg
+
+    snes = getattr(solver, "snes", None) or solver.ts.getSNES()
+    if getattr(solver, "linear_solver", "") == "amg" or not amg.uses_amg(snes.getKSP()):
         return False
-    owned = V.dofmap.index_map.size_local
-    x = V.tabulate_dof_coordinates()[:owned]
-    modes = []
-    for k in range(6):
-        vec = solver.A.createVecLeft()
-        a = vec.getArray().reshape(owned, 3)
-        if k < 3:
-            a[:, k] = 1.0
-        else:  # rotation about axis k - 3: e_k × x
-            i, j = [(1, 2), (2, 0), (0, 1)][k - 3]
-            a[:, i], a[:, j] = -x[:, j], x[:, i]
-        modes.append(vec)
-    for k, vec in enumerate(modes):  # Gram-Schmidt
-        for prev in modes[:k]:
-            vec.axpy(-vec.dot(prev), prev)
-        vec.scale(1.0 / vec.norm())
-    solver.A.setNearNullSpace(PETSc.NullSpace().create(vectors=modes, comm=V.mesh.comm))
+    amg.attach_near_nullspace(solver.A, V)
     return True
 
 
@@ -163,7 +149,7 @@ def run(refine: int, path: str, mu_steps: int, steps: int, dt: float, comm: MPI.
     solver = ff.SteadySolver(model.residual, prefix="scale_s_",
                              **_merge(_solver_args(ff.SteadySolver, path),
                                       model.solver_options()))
-    out["amg_stand_in"] = path == "amg" and _stand_in_nullspace(solver, model.V)
+    out["amg_by_options"] = path == "amg" and _attach_nullspace(solver, model.V)
     model.initial_guess()
     records = ff.continuation(solver, model.mu, np.linspace(0.0, MU, mu_steps + 1),
                               observe=observe)
@@ -196,7 +182,7 @@ def run(refine: int, path: str, mu_steps: int, steps: int, dt: float, comm: MPI.
     dynamics = DynamicsSolver(r, prefix="scale_d_", atol=1e-10 * model.force_scale,
                               **_solver_args(DynamicsSolver, path))
     if path == "amg":
-        _stand_in_nullspace(dynamics, model.V)
+        out["amg_by_options_dynamics"] = _attach_nullspace(dynamics, model.V)
     setup_s = time.perf_counter() - t0
     failure = None
     try:
