@@ -234,7 +234,11 @@ def collect(folder: pathlib.Path) -> dict:
                 best[r["dofs"]] = r
         serial = list(best.values())
         n = [r["dofs"] for r in serial]
-        fits = {"dofs": n,
+        fits = {"dofs": n, "steady_s": [r["steady"]["wall_time_s"] for r in serial],
+                "peak_mib": [max(r.get("peak_mib_dynamics", r["peak_mib_steady"]))
+                             for r in serial],
+                "step_s": [r["dynamics"]["time_per_step_s"] if "dynamics" in r else None
+                           for r in serial],
                 "steady_time_exponent": fit_exponent(
                     n, [r["steady"]["wall_time_s"] for r in serial]),
                 "memory_exponent": fit_exponent(
@@ -245,11 +249,14 @@ def collect(folder: pathlib.Path) -> dict:
         fits["memory_exponent_dynamics"] = fit_exponent(
             [r["dofs"] for r in dyn], [max(r["peak_mib_dynamics"]) for r in dyn])
         summary["fits"][path] = fits
-        for one in serial:
-            for two in (r for r in runs if r["path"] == path and r["ranks"] == 2):
-                if two["dofs"] == one["dofs"]:
-                    summary["strong"].append(_strong(one, two))
-                elif 1.6 <= two["dofs"] / one["dofs"] <= 2.4:
+        for two in (r for r in runs if r["path"] == path and r["ranks"] == 2):
+            # the serial run of the same tag (measured moments before), else the fastest
+            same = [r for r in runs if r["path"] == path and r["ranks"] == 1
+                    and r["dofs"] == two["dofs"] and r.get("tag") == two.get("tag")]
+            for one in same or [r for r in serial if r["dofs"] == two["dofs"]]:
+                summary["strong"].append(_strong(one, two))
+            for one in serial:
+                if 1.6 <= two["dofs"] / one["dofs"] <= 2.4:
                     summary["weak"].append(_weak(one, two))
     return summary
 
@@ -320,18 +327,13 @@ def plot(summary: dict, path: pathlib.Path) -> None:
 
     fig, axes = plt.subplots(1, 3, figsize=(13, 4))
     for name, marker in zip(PATHS, "os", strict=True):
-        serial = [r for r in summary["runs"] if r["path"] == name and r["ranks"] == 1]
-        if not serial:
+        f = summary["fits"].get(name)
+        if not f or not f["dofs"]:
             continue
-        serial.sort(key=lambda r: r["dofs"])
-        n = [r["dofs"] for r in serial]
-        axes[0].loglog(n, [r["steady"]["wall_time_s"] for r in serial], marker, ls="-",
-                       label=name)
-        dyn = [r for r in serial if "dynamics" in r]
-        axes[1].loglog([r["dofs"] for r in dyn], [r["dynamics"]["time_per_step_s"] for r in dyn],
-                       marker, ls="-", label=name)
-        axes[2].loglog(n, [max(r["peak_mib_steady"]) for r in serial], marker, ls="-",
-                       label=name)
+        axes[0].loglog(f["dofs"], f["steady_s"], marker, ls="-", label=name)
+        steps = [(n, t) for n, t in zip(f["dofs"], f["step_s"], strict=True) if t is not None]
+        axes[1].loglog(*zip(*steps, strict=True), marker, ls="-", label=name)
+        axes[2].loglog(f["dofs"], f["peak_mib"], marker, ls="-", label=name)
     for ax, title in zip(axes, ("steady continuation to μ = 0.5 [s]",
                                 "dynamics, time per step [s]", "peak memory per rank [MiB]"),
                          strict=True):
@@ -359,12 +361,24 @@ def markdown(summary: dict) -> str:
                   f["memory_exponent_dynamics"])]
         lines.append(f"| {name} | " + " | ".join(cells) + " |")
     for row in summary["strong"]:
-        lines += ["", f"Strong scaling, {row['path']}, n = {row['dofs']:,}:"]
+        load = [f"{x['start'][0]:.1f}-{x['end'][0]:.1f}" for x in row["load"]]
+        lines += ["", f"Strong scaling, {row['path']}, n = {row['dofs']:,}, runs {row['tags']} "
+                  f"(load average 1 rank: {load[0]}, 2 ranks: {load[1]}):", "",
+                  "| phase | stage | 1 rank [s] | 2 ranks [s] | speed-up | share on 2 ranks |",
+                  "|---|---|---|---|---|---|"]
         for phase in ("steady", "dynamics"):
-            if phase in row:
-                p = row[phase]
-                lines.append(f"- {phase}: 1 rank {p['1']:.2f} s, 2 ranks {p['2']:.2f} s, "
-                             f"speed-up {p['speedup']:.2f}")
+            if phase not in row:
+                continue
+            p = row[phase]
+            unit = "" if phase == "steady" else " per step"
+            lines.append(f"| **{phase}{unit}** | | **{p['1']:.2f}** | **{p['2']:.2f}** | "
+                         f"**{p['speedup']:.2f}** | |")
+            for stage, t1 in p["stages_1"].items():
+                t2 = p["stages_2"][stage]
+                lines.append(f"| | {stage} | {t1:.2f} | {t2:.2f} | "
+                             f"{t1 / t2 if t2 > 0 else math.nan:.2f} | {t2 / p['total_2']:.0%} |")
+            lines.append("| | model: speed-up on 8 / 64 / 512 ranks | | | " + " / ".join(
+                f"{v:.1f}" for v in p["model"].values()) + " | |")
     for row in summary["weak"]:
         lines.append(f"- weak scaling {row['path']} {row['dofs']}: " + ", ".join(
             f"{k} {v:.0%}" for k, v in row.items() if k in ("steady", "dynamics")))
