@@ -147,7 +147,7 @@ def run(refine: int, path: str, mu_steps: int, steps: int, dt: float, comm: MPI.
     stage = log_stage("steady continuation")
     stage.push()
     comm.Barrier()
-    t0 = time.perf_counter()
+    t0, cpu0 = time.perf_counter(), time.process_time()
     solver = ff.SteadySolver(model.residual, prefix="scale_s_",
                              **_merge(_solver_args(ff.SteadySolver, path),
                                       model.solver_options()))
@@ -156,10 +156,12 @@ def run(refine: int, path: str, mu_steps: int, steps: int, dt: float, comm: MPI.
     records = ff.continuation(solver, model.mu, np.linspace(0.0, MU, mu_steps + 1),
                               observe=observe)
     steady_s = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
+    steady_cpu = comm.allgather(time.process_time() - cpu0)
     stage.pop()
     note_solver(solver)
     krylov = solver.snes.getLinearSolveIterations()
-    out["steady"] = {"wall_time_s": steady_s, "linear_solver": solver.linear_solver,
+    out["steady"] = {"wall_time_s": steady_s, "cpu_time_s_per_rank": steady_cpu,
+                     "linear_solver": solver.linear_solver,
                      "jit_s": comm.allreduce(solver.jit_time_s, op=MPI.MAX),
                      "newton_iterations": [r["newton_iterations"] for r in records],
                      "krylov_iterations_last_step": krylov,
@@ -183,24 +185,26 @@ def run(refine: int, path: str, mu_steps: int, steps: int, dt: float, comm: MPI.
     stage = log_stage("dynamics")
     stage.push()
     comm.Barrier()
-    t0 = time.perf_counter()
+    t0, cpu0 = time.perf_counter(), time.process_time()
     dynamics = DynamicsSolver(r, prefix="scale_d_", atol=1e-10 * model.force_scale,
                               **_solver_args(DynamicsSolver, path))
     if path == "amg":
         out["amg_by_options_dynamics"] = _attach_nullspace(dynamics, model.V)
-    setup_s = time.perf_counter() - t0
+    setup_s, setup_cpu = time.perf_counter() - t0, time.process_time() - cpu0
     failure = None
     try:
         records = dynamics.run(steps * dt, dt, observe=observe)
     except DynamicsError as err:
         records, failure = err.records, str(err)
     dynamics_s = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
+    step_cpu = comm.allgather((time.process_time() - cpu0 - setup_cpu) / max(len(records) - 1, 1))
     stage.pop()
     note_solver(dynamics)
     done = len(records) - 1
     out["dynamics"] = {"wall_time_s": dynamics_s, "setup_s": comm.allreduce(setup_s, op=MPI.MAX),
                        "dt": dt, "steps": done, "failure": failure,
                        "time_per_step_s": (dynamics_s - setup_s) / max(done, 1),
+                       "cpu_time_per_step_s_per_rank": step_cpu,
                        "newton_iterations": int(sum(x["newton_iterations"] for x in records)),
                        "rejected_steps": int(sum(x["rejected_steps"] for x in records)),
                        "stages_s": {**_stage_times(stage, comm),
@@ -251,6 +255,13 @@ def collect(folder: pathlib.Path) -> dict:
         dyn = [r for r in serial if "dynamics" in r]
         fits["step_time_exponent"] = fit_exponent(
             [r["dofs"] for r in dyn], [r["dynamics"]["time_per_step_s"] for r in dyn])
+        cpu = [r for r in serial if "cpu_time_s_per_rank" in r["steady"]]
+        fits["steady_cpu_exponent"] = fit_exponent(
+            [r["dofs"] for r in cpu], [r["steady"]["cpu_time_s_per_rank"][0] for r in cpu])
+        cpu = [r for r in dyn if "cpu_time_per_step_s_per_rank" in r["dynamics"]]
+        fits["step_cpu_exponent"] = fit_exponent(
+            [r["dofs"] for r in cpu],
+            [r["dynamics"]["cpu_time_per_step_s_per_rank"][0] for r in cpu])
         fits["memory_exponent_dynamics"] = fit_exponent(
             [r["dofs"] for r in dyn], [max(r["peak_mib_dynamics"]) for r in dyn])
         summary["fits"][path] = fits
@@ -350,20 +361,27 @@ def plot(summary: dict, path: pathlib.Path) -> None:
 
 
 def markdown(summary: dict) -> str:
-    lines = ["| path | n | ranks | steady [s] | Newton | dyn. s/step | steps | peak MiB/rank |",
-             "|---|---|---|---|---|---|---|---|"]
+    lines = ["| path | n | ranks | run | load | steady [s] (CPU) | Newton | dyn. s/step (CPU) "
+             "| steps | peak MiB/rank |", "|---|---|---|---|---|---|---|---|---|---|"]
     for r in sorted(summary["runs"], key=lambda r: (r["path"], r["dofs"], r["ranks"])):
-        d = r.get("dynamics", {})
-        lines.append(f"| {r['path']} | {r['dofs']:,} | {r['ranks']} | "
-                     f"{r['steady']['wall_time_s']:.1f} | {sum(r['steady']['newton_iterations'])}"
-                     f" | {d.get('time_per_step_s', math.nan):.2f} | {d.get('steps', 0)} | "
+        d, st = r.get("dynamics", {}), r["steady"]
+        load = r["environment"]["load_average"]
+        cpu = st.get("cpu_time_s_per_rank", [math.nan])[0]
+        step_cpu = d.get("cpu_time_per_step_s_per_rank", [math.nan])[0]
+        lines.append(f"| {r['path']} | {r['dofs']:,} | {r['ranks']} | {r.get('tag') or '-'} | "
+                     f"{load['start'][0]:.1f}-{load['end'][0]:.1f} | "
+                     f"{st['wall_time_s']:.1f} ({cpu:.1f}) | {sum(st['newton_iterations'])} | "
+                     f"{d.get('time_per_step_s', math.nan):.2f} ({step_cpu:.2f}) | "
+                     f"{d.get('steps', 0)} | "
                      f"{max(r.get('peak_mib_dynamics', r['peak_mib_steady'])):.0f} |")
-    lines += ["", "| path | time exponent: steady | dynamics step | memory exponent: steady "
-              "| with dynamics |", "|---|---|---|---|---|"]
+    lines += ["", "| path | sizes | time exponent: steady (CPU) | dynamics step (CPU) "
+              "| memory exponent: steady | with dynamics |", "|---|---|---|---|---|---|"]
     for name, f in summary["fits"].items():
         cells = [f"{v:.2f}" if v is not None else "-" for v in
-                 (f["steady_time_exponent"], f["step_time_exponent"], f["memory_exponent"],
-                  f["memory_exponent_dynamics"])]
+                 (f["steady_time_exponent"], f["steady_cpu_exponent"], f["step_time_exponent"],
+                  f["step_cpu_exponent"], f["memory_exponent"], f["memory_exponent_dynamics"])]
+        cells = [f"{cells[0]} ({cells[1]})", f"{cells[2]} ({cells[3]})", *cells[4:]]
+        cells.insert(0, ", ".join(f"{n:,}" for n in f["dofs"]))
         lines.append(f"| {name} | " + " | ".join(cells) + " |")
     for row in summary["strong"]:
         load = [f"{x['start'][0]:.1f}-{x['end'][0]:.1f}" for x in row["load"]]
