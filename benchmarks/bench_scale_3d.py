@@ -271,9 +271,11 @@ def collect(folder: pathlib.Path) -> dict:
                     and r["dofs"] == two["dofs"] and r.get("tag") == two.get("tag")]
             for one in same or [r for r in serial if r["dofs"] == two["dofs"]]:
                 summary["strong"].append(_strong(one, two))
-            for one in serial:
-                if 1.6 <= two["dofs"] / one["dofs"] <= 2.4:
-                    summary["weak"].append(_weak(one, two))
+            half = [r for r in runs if r["path"] == path and r["ranks"] == 1
+                    and 1.6 <= two["dofs"] / r["dofs"] <= 2.4]
+            for one in [r for r in half if r.get("tag") == two.get("tag")] or [
+                    r for r in serial if r in half]:
+                summary["weak"].append(_weak(one, two))
     return summary
 
 
@@ -330,7 +332,9 @@ def _weak(one: dict, two: dict) -> dict:
     """Weak scaling efficiency: (time per unknown on 1 rank) / (time per unknown per rank on
     2), i.e. t1 / t2 × (n2 / 2 n1) so that a slightly uneven size ratio is corrected to first
     order (the cost is not linear in n; the exponents fitted above say how far off that is)."""
-    row = {"path": one["path"], "dofs": [one["dofs"], two["dofs"]]}
+    row = {"path": one["path"], "dofs": [one["dofs"], two["dofs"]],
+           "tags": [one.get("tag"), two.get("tag")],
+           "load": [one["environment"]["load_average"], two["environment"]["load_average"]]}
     for phase in ("steady", "dynamics"):
         if phase in one and phase in two:
             key = "wall_time_s" if phase == "steady" else "time_per_step_s"
@@ -403,8 +407,10 @@ def markdown(summary: dict) -> str:
             lines.append("| | model: speed-up on 8 / 64 / 512 ranks | | | " + " / ".join(
                 f"{v:.1f}" for v in p["model"].values()) + " | |")
     for row in summary["weak"]:
-        lines.append(f"- weak scaling {row['path']} {row['dofs']}: " + ", ".join(
-            f"{k} {v:.0%}" for k, v in row.items() if k in ("steady", "dynamics")))
+        load = [f"{x['start'][0]:.1f}-{x['end'][0]:.1f}" for x in row["load"]]
+        lines.append(f"- weak scaling, {row['path']}, 1 rank at {row['dofs'][0]:,}, 2 ranks at "
+                     f"{row['dofs'][1]:,} (runs {row['tags']}, load {load}): " + ", ".join(
+                         f"{k} {row[k]:.0%}" for k in ("steady", "dynamics") if k in row))
     return "\n".join(lines)
 
 
