@@ -14,6 +14,7 @@ import time
 import typing
 
 from mpi4py import MPI
+from petsc4py import PETSc
 
 from fenicsfriction import results
 
@@ -26,8 +27,9 @@ PATH_EVENTS = ("SNESSolve", "TSStep", "KSPSolve", "KSPGMRESOrthog", "PCSetUp", "
                "MatLUFactorSym", "MatLUFactorNum", "MatCholFctrSym", "MatCholFctrNum",
                "MatSolve", "PCSetUp_GAMG+", "  GAMG PtAP", "EPSSolve", "PEPSolve")
 
-if "petsc4py.PETSc" in sys.modules:  # start PETSc's event log before the run creates objects
-    sys.modules["petsc4py.PETSc"].Log.begin()
+# PETSc's event log, started before the run creates any object (every benchmark imports this
+# module first), so that the record can say which factorisations and preconditioners ran
+PETSc.Log.begin()
 
 _noted: list[dict[str, typing.Any]] = []
 _stages: list[str] = ["Main Stage"]
@@ -105,7 +107,7 @@ def log_stage(name: str) -> typing.Any:
     record (:func:`environment`), not only those of the main stage."""
     if name not in _stages:
         _stages.append(name)
-    return sys.modules["petsc4py.PETSc"].Log.Stage(name)
+    return PETSc.Log.Stage(name)
 
 
 def note_solver(solver: typing.Any) -> None:
@@ -126,10 +128,7 @@ def _covered(path: dict[str, typing.Any], paths: list[dict[str, typing.Any]]) ->
 
 def _live_solver_paths(known: list[dict[str, typing.Any]]) -> list[dict[str, typing.Any]]:
     """The paths of the PETSc solvers still alive that ``known`` does not already hold."""
-    if "petsc4py.PETSc" not in sys.modules:
-        return []
-    petsc = sys.modules["petsc4py.PETSc"]
-    kinds = tuple(getattr(petsc, name) for name in ("TS", "SNES", "KSP"))
+    kinds: tuple[type, ...] = (PETSc.TS, PETSc.SNES, PETSc.KSP)
     slepc = sys.modules.get("slepc4py.SLEPc")
     if slepc is not None:
         kinds += (slepc.EPS, slepc.PEP)
@@ -147,9 +146,7 @@ def _live_solver_paths(known: list[dict[str, typing.Any]]) -> list[dict[str, typ
 
 def _event_counts() -> dict[str, dict[str, float]]:
     """Rank 0's count and time of each of :data:`PATH_EVENTS`, summed over the log stages."""
-    if "petsc4py.PETSc" not in sys.modules:
-        return {}
-    log = sys.modules["petsc4py.PETSc"].Log
+    log = PETSc.Log
     counts = {}
     for name in PATH_EVENTS:
         info = [log.Event(name).getPerfInfo(log.Stage(stage)) for stage in _stages]
@@ -166,7 +163,7 @@ def environment(comm: MPI.Comm = MPI.COMM_WORLD, solvers: typing.Iterable = ()
     average at the start and now (other processes on the machine slow every timing), and
     the solver path: each of ``solvers``, those noted with :func:`note_solver` and the PETSc
     solvers still alive, as PETSc reports them, with the PETSc events that ran (rank 0's
-    counts; the log starts when this module is imported after petsc4py)."""
+    counts; the log starts when this module is imported)."""
     for solver in solvers:
         note_solver(solver)
     peak_mib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # KiB on Linux
