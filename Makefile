@@ -52,10 +52,10 @@ lint: setup
 	$(PY) -m mypy
 
 test-serial: setup
-	$(PY) -m pytest -q tests
+	$(PY) -m pytest -q --durations=25 tests
 
 test-mpi: setup
-	$(MPIRUN) $(PY) -m mpi4py -m pytest -q --with-mpi tests
+	$(MPIRUN) $(PY) -m mpi4py -m pytest -q --durations=25 --with-mpi tests
 
 # the HTML documentation (Sphinx + MyST, Debian's packages, nothing downloaded), warnings as errors
 docs: setup

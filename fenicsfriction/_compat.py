@@ -8,6 +8,8 @@ arguments (``scale``/``alpha``, ``diagonal``/``diag``) are passed positionally.
 
 from __future__ import annotations
 
+import functools
+import inspect
 import logging
 import math
 import typing
@@ -34,7 +36,9 @@ __all__ = [
     "element_degree",
     "interpolation_points",
     "jit_options",
+    "key_partitioner",
     "lagrange_vector_space",
+    "model_cell_centroids",
     "model_to_mesh",
     "nodal_quadrature",
     "petsc_vec",
@@ -221,21 +225,101 @@ def assemble_matrix_into(A: PETSc.Mat, a: fem.FormMetaClass, bcs: list,
     dolfinx.fem.petsc.assemble_matrix(A, a, bcs, diagonal)
 
 
-def model_to_mesh(model: typing.Any, comm: MPI.Comm, rank: int,
-                  gdim: int) -> tuple[mesh.Mesh, mesh.MeshTagsMetaClass, mesh.MeshTagsMetaClass]:
+def _gmsh_reader() -> typing.Any:
+    import importlib
+    try:
+        return importlib.import_module("dolfinx.io.gmsh")  # dolfinx >= 0.10
+    except ImportError:
+        return importlib.import_module("dolfinx.io.gmshio")
+
+
+def model_cell_centroids(model: typing.Any, gdim: int) -> np.ndarray:
+    """The centroids (cells, 3) of a gmsh model's cells of dimension ``gdim``, in the order
+    :func:`model_to_mesh` hands them to the partitioner (its physical groups' elements, read
+    by the reader's own ``extract_topology_and_markers``). On the rank that holds the model."""
+    reader = _gmsh_reader()
+    x = reader.extract_geometry(model)
+    for kind, data in reader.extract_topology_and_markers(model).items():
+        if model.mesh.getElementProperties(kind)[1] == gdim:
+            return x[np.asarray(data["topology"], dtype=np.int64)].mean(axis=1)
+    return np.zeros((0, 3))
+
+
+def key_partitioner(keys: np.ndarray) -> typing.Callable:
+    """A cell partitioner for dolfinx's mesh creation that sorts the cells by ``keys`` (one
+    number per input cell on this rank, e.g. a coordinate of its centroid) and gives each rank
+    an equal run of them: a coordinate cut, not a graph cut. Ghost cells, where the mesh has
+    them (0.5.2's gmsh reader asks for shared facets), are the facet neighbours owned
+    elsewhere. The input cells must all be on one rank (as :func:`model_to_mesh` reads them).
+
+    dolfinx wraps it with ``create_cell_partitioner``: 0.5.2 takes the graph partitioner alone
+    (the ghost mode comes from ``create_mesh``), 0.6-0.9 also the ghost mode (none, the gmsh
+    reader's default there).
+    """
+    keys = np.asarray(keys, dtype=float)
+
+    def partition(comm: typing.Any, nparts: int, graph: typing.Any, ghosting: bool) -> typing.Any:
+        n = graph.num_nodes
+        if comm.allreduce(int(n > 0)) > 1:
+            raise RuntimeError("key_partitioner: the cells must all be on one rank")
+        if n and len(keys) != n:
+            raise RuntimeError(f"key_partitioner: {len(keys)} keys for {n} cells")
+        owner = np.zeros(n, dtype=np.int32)
+        owner[np.argsort(keys[:n], kind="stable")] = np.arange(n, dtype=np.int64) * nparts // n
+        if not ghosting:
+            return _adjacency_list(owner, np.arange(n + 1, dtype=np.int32))
+        offsets, links = np.asarray(graph.offsets), np.asarray(graph.array)
+        first = comm.exscan(n) or 0
+        rows = np.repeat(np.arange(n), np.diff(offsets))
+        other = owner[links - first]
+        pairs = np.unique(np.stack([rows, other])[:, other != owner[rows]], axis=1)
+        counts = np.bincount(pairs[0], minlength=n) + 1
+        data = np.empty(counts.sum(), dtype=np.int32)
+        starts = np.concatenate([[0], np.cumsum(counts)])
+        data[starts[:-1]] = owner
+        slot = starts[pairs[0]] + 1 + (np.arange(pairs.shape[1]) - np.searchsorted(pairs[0],
+                                                                                  pairs[0]))
+        data[slot] = pairs[1]
+        return _adjacency_list(data, starts.astype(np.int32))
+
+    cpp = dolfinx.cpp.mesh
+    try:  # 0.6-0.9: the graph partitioner and the ghost mode
+        return cpp.create_cell_partitioner(partition, mesh.GhostMode.none)
+    except TypeError:  # 0.5.2: the graph partitioner alone
+        return cpp.create_cell_partitioner(partition)
+
+
+def _adjacency_list(data: np.ndarray, offsets: np.ndarray) -> typing.Any:
+    import dolfinx.graph
+    make = getattr(dolfinx.graph, "adjacencylist", None) or dolfinx.graph.create_adjacencylist
+    return make(np.ascontiguousarray(data, dtype=np.int32),
+                np.ascontiguousarray(offsets, dtype=np.int32))
+
+
+def model_to_mesh(model: typing.Any, comm: MPI.Comm, rank: int, gdim: int,
+                  partitioner: typing.Callable | None = None
+                  ) -> tuple[mesh.Mesh, mesh.MeshTagsMetaClass, mesh.MeshTagsMetaClass]:
     """A gmsh model (built on ``rank`` only) as a distributed mesh with its cell and facet tags.
 
     Only the physical groups of the two highest dimensions are read. The reader is
     ``dolfinx.io.gmshio.model_to_mesh`` up to 0.9 (a tuple) and ``dolfinx.io.gmsh.model_to_mesh``
     from 0.10 (a ``MeshData`` with ``mesh``, ``cell_tags``, ``facet_tags``). Imported here, not at
-    the top, so that the package works where gmsh is not installed.
+    the top, so that the package works where gmsh is not installed. ``partitioner``: a cell
+    partitioner (:func:`key_partitioner`) instead of dolfinx's graph partitioner; 0.5.2's
+    reader has no argument for it and is lent it for the call.
     """
-    import importlib
-    try:
-        reader = importlib.import_module("dolfinx.io.gmsh")  # dolfinx >= 0.10
-    except ImportError:
-        reader = importlib.import_module("dolfinx.io.gmshio")
-    data = reader.model_to_mesh(model, comm, rank, gdim=gdim)
+    reader = _gmsh_reader()
+    if partitioner is None:
+        data = reader.model_to_mesh(model, comm, rank, gdim=gdim)
+    elif "partitioner" in inspect.signature(reader.model_to_mesh).parameters:  # >= 0.6
+        data = reader.model_to_mesh(model, comm, rank, gdim=gdim, partitioner=partitioner)
+    else:  # 0.5.2's reader calls create_mesh with its default partitioner: lend it ours
+        create = reader.create_mesh
+        reader.create_mesh = functools.partial(create, partitioner=partitioner)
+        try:
+            data = reader.model_to_mesh(model, comm, rank, gdim=gdim)
+        finally:
+            reader.create_mesh = create
     if hasattr(data, "mesh"):
         return data.mesh, data.cell_tags, data.facet_tags
     msh, cell_tags, facet_tags = data

@@ -36,7 +36,7 @@ from dolfinx import fem
 from fenicsfriction.laws import check
 
 __all__ = ["AMG_TYPES", "LINEAR_SOLVER_PATHS", "amg_options", "attach_near_nullspace",
-           "bodies", "choose_linear_solver", "rigid_body_modes", "uses_amg"]
+           "bodies", "choose_linear_solver", "requested_amg", "rigid_body_modes", "uses_amg"]
 
 #: the AMG preconditioners :func:`amg_options` configures (PETSc ``pc_type``)
 AMG_TYPES = ("gamg", "hypre")
@@ -44,13 +44,25 @@ AMG_TYPES = ("gamg", "hypre")
 #: the paths :func:`choose_linear_solver` chooses from
 LINEAR_SOLVER_PATHS = ("lu", "condensed", "reused-lu", "amg")
 
-#: ``"auto"`` solves by AMG from this many unknowns per rank on in 3D (below: a reused LU or
-#: the condensation): measured on the 3D block's steady continuation (docs/solvers.md)
-AMG_MIN_UNKNOWNS_3D = 20_000
+#: ``"auto"`` solves by AMG from this many unknowns per rank on in 3D where the alternative
+#: is a sparse LU at every Newton iteration (contact-free dynamics, a Jacobian that does not
+#: split). Measured on the 3D block's steady continuation (Q2, μ = 0 → 0.5 in 5 steps, 13
+#: Newton iterations, load average 6-15 on 2 cores): LU/AMG wall time 0.85 at 18,525
+#: unknowns (38.0 s / 44.5 s, one run), 2.1 at 42,075 (536 s / 259 s, two runs): the
+#: crossover near 2.5e4
+AMG_MIN_UNKNOWNS_3D = 25_000
 
-#: and from this many in 2D, where the sparse factorisation fills like n log n and MUMPS
-#: stays faster far longer
-AMG_MIN_UNKNOWNS_2D = 400_000
+#: and from this many where the steady Jacobian splits and the LU of its bulk is reused
+#: (:mod:`fenicsfriction.reused_lu`): the reused LU was 3.4x faster than AMG at 18,525
+#: unknowns (12.9 s / 44.5 s), 3.5x and 2.3x at 42,075 (two runs) and 2.9x at 80,073 (273 s /
+#: 784 s), its time growing like n^2.0 against AMG's n^1.7 there. This bound is not a
+#: measured time crossover: it is where MUMPS's fill (n^(4/3)) rather than its time decides
+AMG_MIN_UNKNOWNS_3D_REUSED_LU = 250_000
+
+#: in 2D from this many: MUMPS's fill grows like n log n there and the condensation onto the
+#: interface is 4.6x faster than the LU at 99,202 unknowns (docs/benchmarks.md); no 2D
+#: crossover was measured, this bound keeps the direct paths on every 2D study mesh
+AMG_MIN_UNKNOWNS_2D = 1_000_000
 
 
 def bodies(V: fem.FunctionSpace) -> tuple[np.ndarray, int]:
@@ -199,13 +211,21 @@ def amg_options(dim: int, preconditioner: str = "gamg", symmetric: bool = False)
             "pc_hypre_boomeramg_agg_nl": 1}
 
 
+def requested_amg(prefix: str) -> str | None:
+    """The AMG preconditioner the options database asks for under ``prefix``
+    (``-<prefix>pc_type gamg`` or ``hypre``, e.g. from the command line), else ``None``: a
+    solver then takes the AMG path with that preconditioner's defaults."""
+    pc_type = PETSc.Options(prefix).getString("pc_type", "")
+    return pc_type if pc_type in AMG_TYPES else None
+
+
 def uses_amg(ksp: PETSc.KSP) -> bool:
     """Whether the options put an AMG preconditioner on ``ksp`` (else a factorisation)."""
     return ksp.getPC().getType() in AMG_TYPES
 
 
 def choose_linear_solver(dim: int, size: int, ranks: int, splits: bool,
-                         condensable: bool = False) -> str:
+                         condensable: bool = False, contact: bool = False) -> str:
     """The linear-solver path ``"auto"`` takes (one of :data:`LINEAR_SOLVER_PATHS`).
 
     Args:
@@ -216,14 +236,23 @@ def choose_linear_solver(dim: int, size: int, ranks: int, splits: bool,
             without contact couplings), which the condensation and the reused LU need.
         condensable: the interface is small enough to condense onto
             (``steady.AUTO_CONDENSE_MAX_FILL``).
+        contact: the residual has two-body contact couplings. Their penalty stiffness far
+            above the bulk's (the patch test: c_n = 1e4 against E/h ≈ 20) takes GMRES + GAMG
+            230 iterations per Newton step at 2,682 unknowns and past 500 at 10,090, whichever
+            near-nullspace (per body or global): the LU stays the automatic choice there, AMG
+            is available by ``linear_solver="amg"`` or the PETSc options.
 
-    AMG from :data:`AMG_MIN_UNKNOWNS_3D` unknowns per rank in 3D and
-    :data:`AMG_MIN_UNKNOWNS_2D` in 2D; below, the factorisations as before: condensed,
+    In 3D: AMG from :data:`AMG_MIN_UNKNOWNS_3D` unknowns per rank where the alternative is an
+    LU per iteration, from :data:`AMG_MIN_UNKNOWNS_3D_REUSED_LU` where the Jacobian splits; in
+    2D from :data:`AMG_MIN_UNKNOWNS_2D`. Below, the factorisations as before: condensed,
     reused LU where the Jacobian splits, else an LU per iteration.
     """
     check("dim", dim, dim in (2, 3), "use 2 or 3")
-    threshold = AMG_MIN_UNKNOWNS_3D if dim == 3 else AMG_MIN_UNKNOWNS_2D
-    if size >= threshold * ranks:
+    if dim == 2:
+        threshold = AMG_MIN_UNKNOWNS_2D
+    else:
+        threshold = AMG_MIN_UNKNOWNS_3D_REUSED_LU if splits else AMG_MIN_UNKNOWNS_3D
+    if not contact and size >= threshold * ranks:
         return "amg"
     if splits:
         return "condensed" if condensable else "reused-lu"

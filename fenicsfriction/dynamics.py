@@ -2,7 +2,8 @@ r"""Problem 1ε, dynamics: :math:`R(u, \dot u, \ddot u; v) = 0` integrated by PE
 
 The default scheme is PETSc's generalized-α method for second-order systems (``TSALPHA2``;
 Newmark's average acceleration is ``-dynamics_ts_alpha_radius 1``), with Newton (SNES, MUMPS)
-at each step. TS asks for
+at each step, or beyond the crossover of :func:`fenicsfriction.amg.choose_linear_solver`
+Newton–Krylov with GMRES and algebraic multigrid (``linear_solver``). TS asks for
 
 * the residual :math:`F(t, u, \dot u, \ddot u) = R(u, \dot u, \ddot u)` — the one residual of
   :mod:`fenicsfriction.forms`, nothing rewritten;
@@ -36,6 +37,13 @@ import ufl
 from dolfinx import fem
 
 from fenicsfriction import _compat
+from fenicsfriction.amg import (
+    amg_options,
+    attach_near_nullspace,
+    choose_linear_solver,
+    requested_amg,
+    uses_amg,
+)
 from fenicsfriction.assembly import (
     BulkWatcher,
     CoupledMatrix,
@@ -48,7 +56,11 @@ from fenicsfriction.forms import Residual
 from fenicsfriction.laws import check
 from fenicsfriction.timestepping import DEFAULT_OPTIONS, Alpha2Integrator, DynamicsError
 
-__all__ = ["DEFAULT_OPTIONS", "CentralDifference", "DynamicsError", "DynamicsSolver"]
+__all__ = ["DEFAULT_OPTIONS", "DYNAMICS_LINEAR_SOLVERS", "CentralDifference", "DynamicsError",
+           "DynamicsSolver"]
+
+#: the choices of ``DynamicsSolver(linear_solver=...)``
+DYNAMICS_LINEAR_SOLVERS = ("auto", "lu", "amg")
 
 
 class DynamicsSolver(Alpha2Integrator):
@@ -73,11 +85,23 @@ class DynamicsSolver(Alpha2Integrator):
             evaluated at the midpoint slip rate then dissipates exactly
             :math:`-\Delta t\, t_T\cdot w_{n+1/2} \ge 0` per step (Armero & Petőcz 1999),
             and the discrete energy balance closes to Newton's tolerance whatever ε.
+        linear_solver: ``"lu"`` (a sparse LU at every Newton iteration), ``"amg"`` (GMRES
+            preconditioned by GAMG with the bodies' rigid-body near-nullspace,
+            :mod:`fenicsfriction.amg`) or ``"auto"`` (default: AMG beyond the measured
+            crossover of :func:`~fenicsfriction.amg.choose_linear_solver`, else the LU). A PC
+            chosen in the PETSc options overrides it (``-<prefix>pc_type lu``: the LU;
+            ``gamg`` or ``hypre``: the AMG path with that preconditioner).
+
+    Attributes:
+        linear_solver: the path in effect (``"lu"`` or ``"amg"``).
+        near_nullspace: the rigid-body modes on the Jacobian (AMG path), else ``None``.
     """
 
     def __init__(self, residual: Residual, prefix: str = "dynamics_",
                  options: dict | None = None, atol: float = 1e-8, predictor: bool = True,
-                 energy_consistent: bool = False):
+                 energy_consistent: bool = False, linear_solver: str = "auto"):
+        check("linear_solver", linear_solver, linear_solver in DYNAMICS_LINEAR_SOLVERS,
+              f"use one of {', '.join(DYNAMICS_LINEAR_SOLVERS)}")
         self.residual = residual
         if energy_consistent:
             options = {**(options or {}), "ts_alpha_radius": 1.0}
@@ -121,7 +145,21 @@ class DynamicsSolver(Alpha2Integrator):
         self._coupled = CoupledMatrix(self.A) if self.couplings else None
         if self._coupled is not None:
             self.A = self._coupled.A
+        dim = msh.geometry.dim
+        amg_type = requested_amg(prefix)
+        if amg_type is not None:  # -<prefix>pc_type gamg|hypre: the AMG path, its defaults
+            linear_solver = "amg"
+        if linear_solver == "auto":
+            linear_solver = choose_linear_solver(dim, self.b.getSize(), msh.comm.size, False,
+                                                 contact=bool(self.couplings))
+        if linear_solver == "amg":
+            options = {**amg_options(dim, amg_type or "gamg"), **(options or {})}
         super().__init__(msh.comm, prefix, self.b, self.A, options, atol, predictor)
+        self.linear_solver, self.near_nullspace = "lu", None
+        if uses_amg(self.ts.getSNES().getKSP()):
+            self.near_nullspace = attach_near_nullspace(self.A, residual.V)
+            self.linear_solver = "amg"
+            self.run_defaults = self._defaults
         if self.couplings or energy_consistent:  # pairing searched at a step's first residual
             self.ts.setPreStep(self._pre_step)
 
@@ -188,6 +226,8 @@ class DynamicsSolver(Alpha2Integrator):
                               base=self._bulk.matrix(shift_v, shift_a))
         if self._coupled is not None and self._coupled.assemble(self.couplings, bcs):
             ts.getSNES().getKSP().getPC().reset()
+            if self.near_nullspace is not None:  # on the matrix whose storage was replaced
+                J.setNearNullSpace(self.near_nullspace)
         self.convergence.jacobian_assembled(J)
 
 

@@ -25,7 +25,8 @@ _model_numbers = itertools.count()
 
 
 def gmsh_mesh(comm: MPI.Comm, name: str, gdim: int,
-              construct: typing.Callable[[typing.Any], None], msh_file: str | None = None
+              construct: typing.Callable[[typing.Any], None], msh_file: str | None = None,
+              partition_key: typing.Callable[[np.ndarray], np.ndarray] | None = None
               ) -> tuple[typing.Any, typing.Any, typing.Any]:
     """Run ``construct(gmsh)`` (geometry, physical groups, size control) on rank 0, mesh it,
     write ``msh_file`` if given, and read the model into a mesh distributed over ``comm``.
@@ -39,6 +40,9 @@ def gmsh_mesh(comm: MPI.Comm, name: str, gdim: int,
         construct: ``construct(gmsh)`` builds the geometry, its physical groups and its mesh
             size control in the current gmsh model.
         msh_file: where to write the ``.msh`` file, or None.
+        partition_key: ``None``: dolfinx's graph partitioner; else a function of the cells'
+            centroids (cells, 3) giving one number per cell: the cells sorted by it are cut
+            into equal runs, one per rank (:func:`fenicsfriction._compat.key_partitioner`).
 
     Returns:
         ``(mesh, cell_tags, facet_tags)``, the tags from the physical groups.
@@ -48,6 +52,7 @@ def gmsh_mesh(comm: MPI.Comm, name: str, gdim: int,
     owns_session = True
     error = None
     session: typing.Any = None  # the gmsh module, once there is something to close (rank 0)
+    keys = np.zeros(0)
     if comm.rank == root:
         try:
             import gmsh
@@ -63,13 +68,17 @@ def gmsh_mesh(comm: MPI.Comm, name: str, gdim: int,
             if msh_file is not None:
                 gmsh.write(str(msh_file))
             model = gmsh.model
+            if partition_key is not None:
+                keys = partition_key(_compat.model_cell_centroids(model, gdim))
         except Exception as e:  # broadcast below: the other ranks must not wait for the mesh
             error = f"building the {name} mesh with gmsh failed: {type(e).__name__}: {e}"
     try:
         error = comm.bcast(error, root=root)
         if error is not None:
             raise RuntimeError(error)
-        msh, cell_tags, facet_tags = _compat.model_to_mesh(model, comm, root, gdim)
+        partitioner = None if partition_key is None else _compat.key_partitioner(keys)
+        msh, cell_tags, facet_tags = _compat.model_to_mesh(model, comm, root, gdim,
+                                                           partitioner)
     finally:
         if session is not None:
             if owns_session:

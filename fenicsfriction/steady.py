@@ -6,7 +6,10 @@ systems are solved without a factorisation per iteration (``linear_solver``): sm
 by condensing the bulk onto them (:mod:`fenicsfriction.condensation`: one MUMPS factorisation
 and one dense Schur complement for a whole continuation, a small dense system per iteration),
 large ones (3D) by flexible GMRES preconditioned with a factorisation kept across iterations
-and steps (:mod:`fenicsfriction.reused_lu`); elsewhere by a MUMPS LU per iteration. Every
+and steps (:mod:`fenicsfriction.reused_lu`); elsewhere by a MUMPS LU per iteration. Large
+problems (3D beyond 2.5e4-2.5e5 unknowns per rank) are solved by GMRES preconditioned with
+algebraic multigrid and the bodies' rigid-body near-nullspace (:mod:`fenicsfriction.amg`),
+which needs no factorisation at all. Every
 option can be changed through the PETSc options database under the solver's prefix (default
 ``steady_``), e.g. ``-steady_snes_rtol 1e-12``, or ``-steady_ksp_type preonly -steady_pc_type
 lu`` for the LU at every iteration.
@@ -35,6 +38,13 @@ import ufl
 from dolfinx import fem
 
 from fenicsfriction import _compat
+from fenicsfriction.amg import (
+    amg_options,
+    attach_near_nullspace,
+    choose_linear_solver,
+    requested_amg,
+    uses_amg,
+)
 from fenicsfriction.assembly import (
     BulkWatcher,
     CoupledMatrix,
@@ -79,7 +89,7 @@ KRYLOV_OPTIONS = {
 }
 
 #: the choices of ``SteadySolver(linear_solver=...)``
-LINEAR_SOLVERS = ("auto", "condensed", "reused-lu", "lu")
+LINEAR_SOLVERS = ("auto", "condensed", "reused-lu", "lu", "amg")
 
 #: ``"auto"`` condenses the bulk onto the interface Γ while its dense Schur complement holds
 #: at most this fraction of the Jacobian's nonzeros, |Γ|² <= f nnz(J), and reuses an LU beyond.
@@ -110,7 +120,8 @@ class ContinuationError(RuntimeError):
 @dataclasses.dataclass
 class SolveReport:
     """Outcome of one solve (``atol``: the absolute tolerance actually used; ``iterations``
-    summed over the ``rounds`` of Newton solves the contact search needed)."""
+    summed over the ``rounds`` of Newton solves the contact search needed; ``krylov_iterations``:
+    the Krylov iterations of the last round's linear solves, 0 or 1 each for a direct solve)."""
 
     converged: bool
     reason: str
@@ -119,6 +130,7 @@ class SolveReport:
     wall_time_s: float
     atol: float
     rounds: int = 1
+    krylov_iterations: int = 0
 
 
 _REASONS = {v: k for k, v in vars(PETSc.SNES.ConvergedReason).items() if not k.startswith("_")}
@@ -147,12 +159,19 @@ class SteadySolver:
             LU); ``"reused-lu"``: flexible GMRES preconditioned by the LU of an earlier
             iteration's Jacobian, renewed when the Krylov count grows
             (:mod:`fenicsfriction.reused_lu`); ``"lu"``: a sparse LU at every iteration;
-            ``"auto"`` (default): condensed while the dense Schur complement is small against
+            ``"amg"``: GMRES preconditioned by GAMG with the bodies' rigid-body
+            near-nullspace (:mod:`fenicsfriction.amg`); ``"auto"`` (default): AMG beyond the
+            measured crossover (:func:`fenicsfriction.amg.choose_linear_solver`: in 3D, from
+            :data:`~fenicsfriction.amg.AMG_MIN_UNKNOWNS_3D_REUSED_LU` unknowns per rank where
+            the Jacobian splits, :data:`~fenicsfriction.amg.AMG_MIN_UNKNOWNS_3D` where it does
+            not; never with contact couplings), else
+            condensed while the dense Schur complement is small against
             the Jacobian (:data:`AUTO_CONDENSE_MAX_FILL`: in 2D), the reused LU beyond (3D),
             the LU where the Jacobian does not split. A PC chosen
-            in the PETSc options (``-<prefix>pc_type lu``) overrides it. Where the Jacobian
-            splits, the first two assemble the constant bulk once and only the interface at
-            each iteration (docs/benchmarks.md has what each costs).
+            in the PETSc options overrides it: ``-<prefix>pc_type lu`` the direct path,
+            ``-<prefix>pc_type gamg`` or ``hypre`` the AMG path with that preconditioner.
+            Where the Jacobian splits, the first two and AMG assemble the constant bulk once
+            and only the interface at each iteration (docs/solvers.md has what each costs).
         search_rounds: how many Newton solves :meth:`solve_searched` (each step of
             :func:`continuation`) may run until a search of the contact couplings at the
             converged state keeps their pairing; 1 (default): one solve, no search after it.
@@ -164,7 +183,9 @@ class SteadySolver:
         L, a: the compiled residual and Jacobian forms.
         linear_solver: the choice in effect (``"auto"`` resolved).
         preconditioner: the ``PCPYTHON`` context of the first two choices (``None`` for the
-            LU); ``condensation`` is it when it condenses, else ``None``.
+            LU and AMG); ``condensation`` is it when it condenses, else ``None``.
+        near_nullspace: the rigid-body modes attached to the Jacobian on the AMG path (one set
+            per body), else ``None``.
     """
 
     def __init__(self, residual: Residual, prefix: str = "steady_",
@@ -195,8 +216,16 @@ class SteadySolver:
         if self._coupled is not None:
             self.A = self._coupled.A
         comm = self.u.function_space.mesh.comm
+        dim = self.u.function_space.mesh.geometry.dim
+        amg_type = requested_amg(prefix)
+        if amg_type is not None:  # -<prefix>pc_type gamg|hypre: the AMG path, its defaults
+            linear_solver = "amg"
         split = (None if linear_solver == "lu" or self.couplings
                  else interface_split(jacobian, self.u))
+        if linear_solver == "auto" and choose_linear_solver(
+                dim, self.A.getSize()[0], comm.size, splits=split is not None,
+                contact=bool(self.couplings)) == "amg":
+            linear_solver = "amg"
         self.preconditioner: InterfaceCondensation | ReusedFactorisation | None = None
         if split is not None and linear_solver in ("auto", "condensed"):
             nonzeros = self.A.getInfo(PETSc.Mat.InfoType.GLOBAL_SUM)["nz_allocated"]
@@ -215,6 +244,7 @@ class SteadySolver:
         self.snes.setFunction(self._F, self.b)
         self.snes.setJacobian(self._J, self.A)
         defaults = {**DEFAULT_OPTIONS, **(KRYLOV_OPTIONS if self.preconditioner else {}),
+                    **(amg_options(dim, amg_type or "gamg") if linear_solver == "amg" else {}),
                     **(options or {})}
         with options_with_defaults(prefix, defaults):
             self.snes.setFromOptions()
@@ -234,7 +264,13 @@ class SteadySolver:
         else:
             self.preconditioner = None
             self.linear_solver = "lu"
-        if self.preconditioner is not None and split is not None:
+        self.near_nullspace: PETSc.NullSpace | None = None
+        if uses_amg(self.snes.getKSP()):  # also when chosen by the options only
+            self.near_nullspace = attach_near_nullspace(self.A, self.u.function_space)
+            self.linear_solver = "amg"
+        # defaults in place during each solve: AMG configures its levels at the first
+        self._solve_defaults = defaults if self.linear_solver == "amg" else {}
+        if (self.preconditioner is not None or self.linear_solver == "amg") and split is not None:
             # the bulk's Jacobian is constant: assembled once, the interface at each iteration
             bulk_form, interface = split
             self._a_interface = _compat.form(ufl.Form(interface), jit_cache_dir)
@@ -270,8 +306,7 @@ class SteadySolver:
         if self.preconditioner is not None:
             self.preconditioner.krylov_count(snes.getKSP().getIterationNumber())
         if self._bulk_watcher is not None:
-            if self._bulk_watcher.refresh():
-                assert self.preconditioner is not None
+            if self._bulk_watcher.refresh() and self.preconditioner is not None:
                 self.preconditioner.stale = True
             assemble_jacobian(A, self._a_interface, self.residual.bcs, base=self._bulk)
         elif self._coupled is not None:
@@ -279,6 +314,8 @@ class SteadySolver:
                               self.residual.springs)
             if self._coupled.assemble(self.couplings, self.residual.bcs):
                 snes.getKSP().getPC().reset()
+                if self.near_nullspace is not None:  # on the matrix whose storage was replaced
+                    A.setNearNullSpace(self.near_nullspace)
         else:
             assemble_jacobian(A, self.a, self.residual.bcs, self.residual.springs)
         self.convergence.jacobian_assembled(A)
@@ -337,13 +374,16 @@ class SteadySolver:
             coupling.contact.search_pending = True
         _compat.petsc_vec(self.u).copy(self.x)
         t0 = time.perf_counter()
-        self.snes.solve(None, self.x)
+        # GAMG reads its levels' options when it builds them, at the first solve
+        with options_with_defaults(self.snes.getOptionsPrefix(), self._solve_defaults):
+            self.snes.solve(None, self.x)
         reason = self.snes.getConvergedReason()
         report = SolveReport(
             converged=reason > 0, reason=_REASONS.get(reason, str(reason)),
             iterations=self.snes.getIterationNumber(),
             residual_norm=float(self.snes.getFunctionNorm()),
-            wall_time_s=time.perf_counter() - t0, atol=self.convergence.atol_used)
+            wall_time_s=time.perf_counter() - t0, atol=self.convergence.atol_used,
+            krylov_iterations=self.snes.getLinearSolveIterations())
         report.converged = report.converged and bool(np.isfinite(report.residual_norm))
         if report.converged:
             self._update(self.x)

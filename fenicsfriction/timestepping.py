@@ -108,6 +108,10 @@ class Alpha2Integrator:
         self.ts.setI2Jacobian(self._J, J)
         defaults = {**DEFAULT_OPTIONS, **linear_solver_defaults(comm, F.getSize()),
                     "snes_atol": atol, **(options or {})}
+        #: the defaults a subclass keeps in place during the run (AMG builds its levels, and
+        #: reads their options, at the first step)
+        self.run_defaults: dict = {}
+        self._defaults = defaults
         with options_with_defaults(prefix, defaults) as opts:
             self.ts.setFromOptions()
             # petsc4py 3.18 does not wrap TSAdapt: read the choice from the options
@@ -193,7 +197,8 @@ class Alpha2Integrator:
         self.ts.setPostStep(regrow)
         error = None
         try:
-            self.ts.solve(u)
+            with options_with_defaults(self.ts.getOptionsPrefix(), self.run_defaults):
+                self.ts.solve(u)
         except PETSc.Error as err:  # e.g. a NaN in the error estimate: report, keep the state
             cause = callback_error(err)
             if not isinstance(cause, PETSc.Error):  # from a monitor (an interrupt): not a failure

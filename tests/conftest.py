@@ -40,3 +40,15 @@ def lu_factorisations():
     PETSc.Log.begin()
     event = PETSc.Log.Event("MatLUFactorNum")
     return lambda: event.getPerfInfo()["count"]
+
+
+def pytest_collection_modifyitems(config, items):
+    """Under ``mpirun`` the modules marked ``sequential`` (dense models on ``COMM_SELF``, no
+    mesh) are deselected: every rank would repeat the serial pass's computation, so they cost the
+    MPI pass their whole serial time and test nothing parallel."""
+    if MPI.COMM_WORLD.size == 1:
+        return
+    kept = [item for item in items if item.get_closest_marker("sequential") is None]
+    if len(kept) < len(items):
+        config.hook.pytest_deselected(items=[i for i in items if i not in kept])
+        items[:] = kept

@@ -12,6 +12,8 @@ from fenicsfriction import laws
 from fenicsfriction.statistics import BeltSummary, belt_summary, displacement_extrema, limit_cycle
 from fenicsfriction.studies.oscillators.belt import BeltOscillator
 
+pytestmark = pytest.mark.sequential
+
 
 def classic(**kwargs) -> BeltOscillator:
     """c = 0, μ_k = 0.3 < μ_s = 0.5, ω = 1, v_b = 1: T = 6.288, 6 % of it stuck."""

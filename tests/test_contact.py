@@ -105,7 +105,7 @@ def test_pairing_follows_finite_sliding():
     contact.update()
     pairing = contact.pairing
     xs = pairing.x_nodes[pairing.slave_nodes] + u.x.array.reshape(-1, 2)[pairing.slave_nodes]
-    N = surface_coordinates(xs, pairing._surface.current[pairing.facet])
+    N = surface_coordinates(xs, pairing.facet_coordinates(u))
     over = xs[:, 0] <= 1.0  # the slave nodes still above the lower block
     assert np.all(N[over] >= -1e-12) and np.all(N[over] <= 1 + 1e-12)
     assert pairing.changes >= 1

@@ -5,6 +5,8 @@ import pytest
 
 from fenicsfriction.studies.contact import closed_forms
 
+pytestmark = pytest.mark.sequential
+
 
 def test_hertz_fit_recovers_the_profile_from_nodes_that_miss_its_edge():
     """Nodes every 0.013 from 0 (none at the edge, a few outside at zero pressure):

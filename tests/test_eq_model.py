@@ -8,6 +8,8 @@ from scipy import integrate, stats
 
 from fenicsfriction.studies.multicontact import EQModel, critical_stiffness
 
+pytestmark = pytest.mark.sequential
+
 # P_c broad enough that the contacts forget their common start within a few lives (a renewal
 # process's oscillation decays like exp(−2π² σ²/x_c²) per life), and supported on x > 0
 THRESHOLDS = {"uniform 0.5-1.5": stats.uniform(loc=0.5, scale=1.0),

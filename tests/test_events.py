@@ -10,6 +10,8 @@ from fenicsfriction.events import HybridError, integrate_hybrid
 from fenicsfriction.petsc_options import EVENTS_LOCATED_TO_RESOLUTION
 from fenicsfriction.statistics import mode_intervals
 
+pytestmark = pytest.mark.sequential
+
 OMEGA = 2.0
 
 

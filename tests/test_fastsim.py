@@ -16,6 +16,8 @@ from fenicsfriction.studies.rolling.fastsim import (
 )
 from fenicsfriction.studies.rolling.kalker import creep_coefficients
 
+pytestmark = pytest.mark.sequential
+
 # the wheel-rail example, SI units
 A, B, G, NU, FN, MU = 6.304e-3, 12.61e-3, 82e9, 0.28, 106.7e3, 0.3
 C = math.sqrt(A * B)

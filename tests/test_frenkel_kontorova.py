@@ -11,6 +11,8 @@ from fenicsfriction.studies.multicontact.frenkel_kontorova import (
     front_speeds,
 )
 
+pytestmark = pytest.mark.sequential
+
 # κ = k + K = 1.25: f_min = 0.75, f_max = 1.25, kink width a sqrt(g/κ)
 PARAMETERS = {"m": 1.0, "eta": 1.0, "k": 1.0, "K": 0.25, "u_s": 1.0}
 

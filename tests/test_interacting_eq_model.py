@@ -15,6 +15,8 @@ from fenicsfriction.studies.multicontact import (
     lattice_compliance,
 )
 
+pytestmark = pytest.mark.sequential
+
 
 def _stiff_thresholds(interface, rng, hold):
     """A realisation in which only contact ``hold`` can break."""

@@ -17,6 +17,8 @@ from fenicsfriction.studies.multicontact.interaction import (
     self_compliance,
 )
 
+pytestmark = pytest.mark.sequential
+
 E, NU = 2.0, 0.3
 
 

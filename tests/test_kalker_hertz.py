@@ -17,6 +17,8 @@ from fenicsfriction.studies.rolling.hertz import (
 )
 from fenicsfriction.studies.rolling.kalker import NU, RATIO, TABLE, creep_coefficients
 
+pytestmark = pytest.mark.sequential
+
 # ---------------------------------------------------------------- Kalker's coefficients
 
 

@@ -7,6 +7,8 @@ from scipy import optimize, stats
 
 from fenicsfriction.studies.multicontact import EQModel, MasterEquation, critical_stiffness
 
+pytestmark = pytest.mark.sequential
+
 
 @pytest.mark.parametrize("newborn", [None, stats.norm(loc=0.0, scale=0.1)],
                          ids=["relaxed", "gaussian"])

@@ -20,6 +20,8 @@ from fenicsfriction.studies.oscillators.slider import (
     table2_slider,
 )
 
+pytestmark = pytest.mark.sequential
+
 
 def test_table2_natural_frequencies_are_the_roots_of_the_frequency_equation():
     # det(K - Ω² M) = 0 for M = diag(1, 0.01), K = [[11, -10], [-10, 10]]:

@@ -5,6 +5,8 @@ import pytest
 
 from fenicsfriction.statistics import stick_slip_statistics
 
+pytestmark = pytest.mark.sequential
+
 
 def records(n: int = 4001) -> list[dict]:
     """t ∈ [0, 1]: N = 2 + sin(10πt) (mean 2 over whole periods), F = 0.5 N - 0.1 while

@@ -205,6 +205,9 @@ class NodeToSegment(MirroredContact):
             its converged state keeps its pairing), ``"residual"`` at every residual
             evaluation (the pairing then moves within Newton's iterations, which can stall
             them where many slave nodes cross master facet edges).
+        exchange: how each rank obtains the master facets its search needs:
+            ``"neighbours"`` (default; those near its slave nodes) or ``"all"`` (the whole
+            master surface gathered; :class:`~fenicsfriction.contact.pairing.Pairing`).
 
     Attributes:
         V, W: the displacement space and the space of master quantities at slave nodes.
@@ -227,7 +230,8 @@ class NodeToSegment(MirroredContact):
                  fields: typing.Sequence[fem.Function] = (), transport: typing.Any = None,
                  weight: float = 1.0, frozen: bool = False, search: str = "solve",
                  enforcement: str = "compliance", penalty_T: Value | None = None,
-                 time_step: Value = 1.0, step_from: fem.Function | None = None):
+                 time_step: Value = 1.0, step_from: fem.Function | None = None,
+                 exchange: str = "neighbours"):
         V = u.function_space
         msh = V.mesh
         dim = msh.geometry.dim
@@ -256,7 +260,8 @@ class NodeToSegment(MirroredContact):
         self.W = _compat.lagrange_vector_space(msh, 1, dim * dim)
         slave_nodes = np.unique(facet_nodes(V, facet_tags, slave, outward=False))
         owned = slave_nodes[slave_nodes < V.dofmap.index_map.size_local]
-        self.pairing = Pairing(V, self.W, owned, facet_nodes(V, facet_tags, master))
+        self.pairing = Pairing(V, self.W, owned, facet_nodes(V, facet_tags, master),
+                               exchange=exchange)
         self.mirrors: dict[fem.Function, fem.Function] = {
             f: fem.Function(self.W, name=f"master_{f.name}")
             for f in (u, *fields, *([] if step_from is None else [step_from]))}

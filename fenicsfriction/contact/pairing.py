@@ -1,23 +1,37 @@
 """Contact search: each slave node paired with its closest master facet, in parallel.
 
-The master surface is gathered on every rank (its facets' global node indices and reference
-coordinates once, their nodes' displacements at each search), so a slave node and its master
-facet may live on different ranks; each rank then pairs its own slave nodes with a k-d tree of
-the master facets' centroids (SciPy), checking the exact point-to-facet distance of the nearest
-few. The pairing is the sparse 0/1 operator ``Q`` that carries the displacements of the master
+Each rank pairs its own slave nodes with a k-d tree of the centroids of the master facets it
+holds (SciPy), checking the exact point-to-facet distance of the nearest few
+(:data:`CANDIDATES`). A rank holds only the master facets near its slave nodes, not the whole
+master surface: its slave nodes are split once into at most :data:`BOXES` groups (coordinate
+bisection), and at each search every rank all-gathers the groups' bounding boxes at the current
+configuration with each group's search radius, and the bounding box of its own master facets'
+centroids (O(ranks) numbers). Two ranks whose boxes come within a radius of each other are
+neighbours: each sends the other (point to point) the master facets whose centroids lie within
+the radius of one of the other's boxes -- their global node indices, reference and current
+coordinates. A slave node's candidates are exact when its radius covers them: the search
+checks that every node's :data:`CANDIDATES`-th nearest centroid is closer than its group's
+radius, and repeats the exchange with larger radii where it is not (each group's radius is
+then kept for the next search, so one exchange is the rule). The candidates are the nearest
+:data:`CANDIDATES` centroids, extended to all centroids as close as the last one, and among
+them the closest facet wins, ties going to the facet whose reference centroid comes first in
+(x, y, z) order: the choice depends on the geometry only, not on which facets a rank holds, so
+the pairing is the same on any number of ranks and with the whole surface gathered
+(``exchange="all"``, the reference the tests compare with).
+
+The pairing is the sparse 0/1 operator ``Q`` that carries the displacements of the master
 nodes of each slave node's facet to the slave node (rows: the node's ``dim * nodes_per_facet``
 components in the space ``W``; columns: the master dofs of ``V``), a PETSc matrix whose
 columns may belong to any rank.
 
-Cost per search: an all-gather of the master facets' displacements (O(master facets)), one
-k-d tree build (O(m log m)) and O(s log m) queries for s slave nodes, against the O(n)
-assembly of the bulk.
+Cost per search: the boxes' all-gather (O(ranks)), the neighbours' facets near each rank's
+slave nodes, one k-d tree build over them (O(m log m)) and O(s log m) queries for s slave
+nodes, against the O(n) assembly of the bulk.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import functools
 import time
 
 from mpi4py import MPI
@@ -27,10 +41,19 @@ import numpy as np
 from dolfinx import fem, mesh
 from scipy.spatial import cKDTree
 
-__all__ = ["Pairing", "facet_nodes", "point_facet_distance", "surface_coordinates"]
+from fenicsfriction import _compat, laws
+
+__all__ = ["EXCHANGES", "Pairing", "facet_nodes", "point_facet_distance", "surface_coordinates"]
 
 #: how many master facets (by centroid distance) are checked exactly for each slave node
 CANDIDATES = 12
+
+#: at most this many groups of slave nodes per rank, each with its bounding box
+BOXES = 64
+
+#: the ways a rank obtains the master facets: from its neighbours, near its slave nodes, or
+#: all of them from every rank (the reference)
+EXCHANGES = ("neighbours", "all")
 
 #: a slave node keeps its facet while its projection's shape functions are all >= -this
 KEEP_TOLERANCE = 1e-2
@@ -119,13 +142,87 @@ def _point_segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.n
     return np.linalg.norm(p - a - s[..., None] * t, axis=-1)
 
 
+
 @dataclasses.dataclass
-class _MasterSurface:
-    """The master facets of all ranks: global node indices and coordinates, per facet."""
+class _Facets:
+    """Master facets held by one rank: global node indices and coordinates, per facet."""
 
     global_nodes: np.ndarray  # (m, nen) int64
     reference: np.ndarray  # (m, nen, dim)
     current: np.ndarray  # (m, nen, dim)
+
+    @classmethod
+    def join(cls, pieces: list[_Facets], nen: int, dim: int) -> _Facets:
+        """The pieces in order, each facet once (the first copy: a facet on a process boundary
+        may come from two ranks)."""
+        g = np.concatenate([p.global_nodes for p in pieces]).reshape(-1, nen).astype(np.int64)
+        ref = np.concatenate([p.reference for p in pieces]).reshape(-1, nen, dim)
+        cur = np.concatenate([p.current for p in pieces]).reshape(-1, nen, dim)
+        _, first = np.unique(np.sort(g, axis=1), axis=0, return_index=True)
+        first = np.sort(first)
+        return cls(g[first], ref[first], cur[first])
+
+    def take(self, rows: np.ndarray) -> _Facets:
+        return _Facets(self.global_nodes[rows], self.reference[rows], self.current[rows])
+
+
+def _canonical(nodes: np.ndarray) -> np.ndarray:
+    """Each triangle's nodes rotated (keeping their cyclic order, hence the normal) so that the
+    smallest global index comes first: two ranks' copies of a facet then agree to the bit.
+    Segments are left as they are (their order is their orientation)."""
+    if nodes.shape[1] != 3 or not len(nodes):
+        return np.arange(nodes.size).reshape(nodes.shape) % nodes.shape[1]
+    shift = np.argmin(nodes, axis=1)
+    return (shift[:, None] + np.arange(3)) % 3
+
+
+def _groups(x: np.ndarray, count: int) -> np.ndarray:
+    """The group of each point: recursive coordinate bisection (at the median of the longest
+    side) into at most ``count`` groups of nearly equal size."""
+    group = np.zeros(len(x), dtype=np.int64)
+    todo = [np.arange(len(x))]
+    parts: list[np.ndarray] = []
+    while todo:
+        rows = todo.pop()
+        if len(todo) + len(parts) + 2 > count or len(rows) < 2:
+            parts.append(rows)
+            continue
+        axis = int(np.argmax(np.ptp(x[rows], axis=0)))
+        order = rows[np.argsort(x[rows, axis], kind="stable")]
+        half = len(order) // 2
+        todo += [order[:half], order[half:]]
+    for g, rows in enumerate(parts):
+        group[rows] = g
+    return group
+
+
+def _box_distance(points: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
+    """The distance of each point to the box [lower, upper] (0 inside)."""
+    return np.linalg.norm(np.maximum(np.maximum(lower - points, points - upper), 0.0), axis=-1)
+
+
+def _near_boxes(tree: cKDTree | None, points: np.ndarray, boxes: np.ndarray) -> np.ndarray:
+    """Whether each point is within the radius of any of ``boxes`` (b, 3, dim): lower corner,
+    upper corner and the radius (in every column). ``tree``: a k-d tree of ``points``, whose
+    balls around the boxes' centres pick the points to check exactly."""
+    near = np.zeros(len(points), dtype=bool)
+    if tree is None or not len(boxes):
+        return near
+    centre = (boxes[:, 0] + boxes[:, 1]) / 2
+    reach = np.linalg.norm(boxes[:, 1] - boxes[:, 0], axis=1) / 2 + boxes[:, 2, 0]
+    for (lower, upper, radius), ball in zip(boxes, tree.query_ball_point(centre, reach * 1.01),
+                                            strict=True):
+        rows = np.asarray(ball, dtype=np.int64)
+        near[rows[_box_distance(points[rows], lower, upper) <= radius[0]]] = True
+    return near
+
+
+def _boxes_meet(a: np.ndarray, boxes: np.ndarray) -> bool:
+    """Whether box ``a`` (2, dim) comes within the radius of any of ``boxes`` (b, 3, dim)."""
+    if not len(boxes):
+        return False
+    gap = np.maximum(np.maximum(boxes[:, 0] - a[1], a[0] - boxes[:, 1]), 0.0)
+    return bool(np.any(np.linalg.norm(gap, axis=1) <= boxes[:, 2, 0]))
 
 
 class Pairing:
@@ -138,57 +235,112 @@ class Pairing:
         slave_nodes: the local indices of the slave nodes this rank pairs (owned ones).
         master_facets: (facets, nodes per facet) local node indices of this rank's master
             facets, ordered outward (:func:`facet_nodes`).
+        exchange: ``"neighbours"`` (default): each rank receives from its neighbours the master
+            facets near its slave nodes; ``"all"``: the whole master surface is all-gathered
+            on every rank (the reference: same pairing, memory O(master facets) per rank).
 
     Attributes:
         Q: the pairing operator, a PETSc matrix W x V (``None`` before :meth:`search`).
-        facet: for each slave node, the index of its master facet in the gathered surface.
+        facet_global_nodes: for each slave node, the global node indices of its master facet
+            (-1 before :meth:`search`).
         reference: a Function of W: the reference coordinates of each slave node's master
             nodes (the current ones are these plus ``Q u``).
+        held: how many master facets this rank held at the last search.
+        rounds: how many exchanges the last search needed (1 unless a radius grew).
         searches, changes: how many searches ran, how many changed the pairing.
-        time_s: seconds spent in ``"search"`` (gather, k-d tree, distances) and ``"build"``
-            (the operator Q), summed over calls.
+        time_s: seconds spent in ``"search"`` (exchange, k-d tree, distances) and ``"build"``
+            (the operator Q), summed over calls; ``"exchange"`` is the part of ``"search"``
+            spent obtaining the master facets (boxes, sends, receives).
     """
 
     def __init__(self, V: fem.FunctionSpace, W: fem.FunctionSpace, slave_nodes: np.ndarray,
-                 master_facets: np.ndarray):
+                 master_facets: np.ndarray, exchange: str = "neighbours"):
+        laws.check("exchange", exchange, exchange in EXCHANGES, f"one of {', '.join(EXCHANGES)}")
         self.V, self.W = V, W
+        self.exchange = exchange
         self.comm: MPI.Comm = V.mesh.comm
         self.dim = V.mesh.geometry.dim
         self.nodes_per_facet = master_facets.shape[1] if master_facets.ndim == 2 else self.dim
         self.slave_nodes = np.asarray(slave_nodes, dtype=np.int32)
-        self.master_facets = master_facets.reshape(-1, self.nodes_per_facet)
+        nodes = master_facets.reshape(-1, self.nodes_per_facet)
+        global_nodes = V.dofmap.index_map.local_to_global(nodes.ravel()).reshape(nodes.shape)
+        rotate = _canonical(global_nodes)
+        rows = np.arange(len(nodes))[:, None]
+        self.master_facets = nodes[rows, rotate]
+        self._master_global = global_nodes[rows, rotate].astype(np.int64)
         self.x_nodes = V.tabulate_dof_coordinates()[:, :self.dim]
         self.Q: PETSc.Mat | None = None
-        self.facet = np.full(len(self.slave_nodes), -1, dtype=np.int64)
+        self.facet_global_nodes = np.full((len(self.slave_nodes), self.nodes_per_facet), -1,
+                                          dtype=np.int64)
+        self._facet_reference = np.zeros((len(self.slave_nodes), self.nodes_per_facet,
+                                          self.dim))
         self.reference = fem.Function(W, name="master_reference")
+        self.held = 0
+        self.rounds = 0
         self.searches = 0
         self.changes = 0
-        self.time_s = {"search": 0.0, "build": 0.0}
-        self._surface: _MasterSurface | None = None
+        self.time_s = {"search": 0.0, "build": 0.0, "exchange": 0.0}
+        self._group = _groups(self.x_nodes[self.slave_nodes], BOXES)
+        self._radius = np.zeros(int(self._group.max(initial=-1)) + 1)
 
-    @functools.cached_property
-    def _fixed(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """What of the master surface never changes, gathered from every rank once: the
-        facets' global node indices and reference coordinates, and which rows of the gathered
-        pieces to keep (a facet on a process boundary may be listed by two ranks)."""
-        d, nen = self.dim, self.nodes_per_facet
-        nodes = self.master_facets
-        global_nodes = self.V.dofmap.index_map.local_to_global(nodes.ravel()).reshape(nodes.shape)
-        pieces = self.comm.allgather((global_nodes.astype(np.int64), self.x_nodes[nodes]))
-        g = np.concatenate([p[0] for p in pieces]).reshape(-1, nen)
-        ref = np.concatenate([p[1] for p in pieces]).reshape(-1, nen, d)
-        _, first = np.unique(np.sort(g, axis=1), axis=0, return_index=True)
-        first = np.sort(first)
-        return g[first], ref[first], first
+    # --- the master facets a rank holds ----------------------------------------------------
 
-    def gather(self, u: fem.Function) -> _MasterSurface:
-        """The master surface of every rank at displacement ``u``: an all-gather of the
-        facets' nodal displacements, in the same order at every search."""
-        global_nodes, reference, first = self._fixed
+    def _local_facets(self, u: fem.Function) -> _Facets:
+        reference = self.x_nodes[self.master_facets]
         displacement = u.x.array.reshape(-1, self.dim)[self.master_facets]
-        pieces = self.comm.allgather(displacement)
-        moved = np.concatenate(pieces).reshape(-1, self.nodes_per_facet, self.dim)[first]
-        return _MasterSurface(global_nodes, reference, reference + moved)
+        return _Facets(self._master_global, reference, reference + displacement)
+
+    def gather(self, u: fem.Function) -> _Facets:
+        """The whole master surface at displacement ``u``, on every rank (an all-gather)."""
+        pieces = self.comm.allgather(self._local_facets(u))
+        return _Facets.join(pieces, self.nodes_per_facet, self.dim)
+
+    def _boxes(self, x_slave: np.ndarray) -> np.ndarray:
+        """The groups' bounding boxes at ``x_slave`` with their radii (g, 3, dim): lower and
+        upper corners, the radius repeated (empty groups: none)."""
+        boxes = []
+        for g, radius in enumerate(self._radius):
+            x = x_slave[self._group == g]
+            if len(x):
+                boxes.append([x.min(axis=0), x.max(axis=0), np.full(self.dim, radius)])
+        return np.array(boxes, dtype=float).reshape(-1, 3, self.dim)
+
+    def _neighbour_facets(self, local: _Facets, x_slave: np.ndarray) -> tuple[_Facets, bool]:
+        """The master facets of every rank whose centroids lie within the radius of one of
+        this rank's boxes, and whether those hold the whole master surface (the candidates are
+        then complete whatever the radii)."""
+        centroid = local.current.mean(axis=1)
+        mine = np.array([centroid.min(axis=0), centroid.max(axis=0)]) if len(centroid) else \
+            np.full((2, self.dim), np.nan)
+        boxes = self._boxes(x_slave)
+        everyone = self.comm.allgather((mine, boxes))
+        masters = np.array([m for m, _ in everyone])
+        present = np.all(np.isfinite(masters[:, 0]), axis=1)
+        whole = (np.array([np.nanmin(masters[present, 0], axis=0),
+                           np.nanmax(masters[present, 1], axis=0)])
+                 if present.any() else np.zeros((2, self.dim)))
+        # the farthest corner of the whole surface's box within some box's radius
+        corners = np.array([[whole[i, k] for k, i in enumerate(bits)]
+                            for bits in np.ndindex(*(2,) * self.dim)])
+        complete = bool(any(np.all(_box_distance(corners, b[0], b[1]) <= b[2, 0])
+                            for b in boxes))
+        rank = self.comm.rank
+        tree = cKDTree(centroid) if len(centroid) else None
+        requests = []
+        for q, (_, their_boxes) in enumerate(everyone):
+            if q != rank and present[rank] and _boxes_meet(mine, their_boxes):
+                rows = np.flatnonzero(_near_boxes(tree, centroid, their_boxes))
+                requests.append(self.comm.isend(local.take(rows), dest=q, tag=7026))
+        pieces: list[_Facets] = []
+        for q, (theirs, _) in enumerate(everyone):
+            if q == rank:
+                pieces.append(local.take(np.flatnonzero(_near_boxes(tree, centroid, boxes))))
+            elif present[q] and _boxes_meet(theirs, boxes):
+                pieces.append(self.comm.recv(source=q, tag=7026))
+        MPI.Request.waitall(requests)
+        return _Facets.join(pieces, self.nodes_per_facet, self.dim), complete
+
+    # --- the search ------------------------------------------------------------------------
 
     def search(self, u: fem.Function) -> bool:
         """Pair every slave node with its closest master facet at displacement ``u``.
@@ -196,57 +348,103 @@ class Pairing:
         Returns True if the pairing changed (``Q`` and ``reference`` are then rebuilt).
         """
         t0 = time.perf_counter()
-        surface = self.gather(u)
         self.searches += 1
         d = self.dim
         x_slave = self.x_nodes[self.slave_nodes] + u.x.array.reshape(-1, d)[self.slave_nodes]
-        facet = np.zeros(len(self.slave_nodes), dtype=np.int64)
-        m = len(surface.global_nodes)
-        if m == 0:
+        local = self._local_facets(u)
+        count = self.comm.allreduce(len(local.global_nodes))
+        if count == 0:
             raise RuntimeError("contact search: the master surface has no facets on any rank")
-        if len(x_slave):
-            k = min(CANDIDATES, m)
-            _, candidates = cKDTree(surface.current.mean(axis=1)).query(x_slave, k=k)
-            candidates = candidates.reshape(len(x_slave), k)
-            distance = point_facet_distance(x_slave[:, None, :], surface.current[candidates])
-            best = _closest_by_geometry(distance, surface.reference[candidates].mean(axis=2))
-            facet = candidates[np.arange(len(x_slave)), best]
-            if self.Q is not None:
-                facet = self._keep_ties(facet, x_slave, surface)
-        changed = self.Q is None or not np.array_equal(facet, self.facet)
-        self._surface = surface
+        if self.searches == 1:
+            self._radius[:] = self._first_radius()
+        self.rounds = 0
+        while True:
+            self.rounds += 1
+            te = time.perf_counter()
+            if self.exchange == "all":
+                held, complete = self.gather(u), True
+            else:
+                held, complete = self._neighbour_facets(local, x_slave)
+            self.time_s["exchange"] += time.perf_counter() - te
+            candidates, reach = _candidates(held, x_slave)
+            ok = complete or bool(np.all(reach * (1 + 1e-9) < self._radius[self._group]))
+            if self.comm.allreduce(ok, op=MPI.LAND):
+                break
+            # each group's radius: beyond its farthest candidate among the facets held now
+            # (those of all facets are no farther), or four times larger if too few were held
+            for g in range(len(self._radius)):
+                need = reach[self._group == g].max(initial=0.0)
+                self._radius[g] = 4 * self._radius[g] if not np.isfinite(need) else max(
+                    self._radius[g], 1.1 * need)
+        self.held = len(held.global_nodes)
+        nodes, reference = self._closest(held, x_slave, candidates)
+        if self.Q is not None:
+            nodes, reference = self._keep_ties(u, x_slave, nodes, reference)
+        changed = self.Q is None or not np.array_equal(nodes, self.facet_global_nodes)
         changed = bool(self.comm.allreduce(changed, op=MPI.LOR))
-        self.facet = facet
+        self.facet_global_nodes, self._facet_reference = nodes, reference
         t1 = time.perf_counter()
         self.time_s["search"] += t1 - t0
         if changed:
             self.changes += 1
-            self._build(surface)
+            self._build()
             self.time_s["build"] += time.perf_counter() - t1
         return changed
 
-    def _keep_ties(self, facet: np.ndarray, x_slave: np.ndarray,
-                   surface: _MasterSurface) -> np.ndarray:
+    def _first_radius(self) -> float:
+        """The radius of the first exchange: the largest master facet's size (all ranks)."""
+        x = self.x_nodes[self.master_facets]
+        size = float(np.ptp(x, axis=1).max(initial=0.0)) if len(x) else 0.0
+        return self.comm.allreduce(size, op=MPI.MAX) or 1.0
+
+    def _closest(self, held: _Facets, x_slave: np.ndarray, candidates: list[np.ndarray]
+                 ) -> tuple[np.ndarray, np.ndarray]:
+        """Each slave node's closest candidate facet: its global nodes and reference
+        coordinates."""
+        facet = np.zeros(len(x_slave), dtype=np.int64)
+        for rows in _same_length(candidates):
+            c = np.array([candidates[i] for i in rows]).reshape(len(rows), -1)
+            distance = point_facet_distance(x_slave[rows, None, :], held.current[c])
+            best = _closest_by_geometry(distance, held.reference[c].mean(axis=2))
+            facet[rows] = c[np.arange(len(rows)), best]
+        return held.global_nodes[facet], held.reference[facet]
+
+    def facet_coordinates(self, u: fem.Function) -> np.ndarray:
+        """The current coordinates (s, nodes per facet, dim) of each slave node's master facet
+        at displacement ``u``: their reference ones plus ``Q u`` (no master facet needs to be
+        held). Needs a search first."""
+        if self.Q is None:
+            raise RuntimeError("Pairing.facet_coordinates: no search has run yet")
+        moved = self.Q.createVecLeft()
+        self.Q.mult(_compat.petsc_vec(u), moved)
+        shape = self._facet_reference.shape
+        x = self._facet_reference + moved.array.reshape(-1, *shape[1:])[self.slave_nodes]
+        moved.destroy()
+        return x
+
+    def _keep_ties(self, u: fem.Function, x_slave: np.ndarray, nodes: np.ndarray,
+                   reference: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Keep a slave node's facet while its projection stays on it (surface coordinates in
         the facet, to :data:`KEEP_TOLERANCE`): a node over a master edge or vertex is about as
         close to every facet there, and switching between them at each residual evaluation
-        would stall Newton on the kink of the master surface. (The gathered surface keeps its
-        order, so the last search's facet indices still name the same facets.)"""
-        shape = surface_coordinates(x_slave, surface.current[self.facet])
-        return np.where(np.all(shape >= -KEEP_TOLERANCE, axis=1), self.facet, facet)
+        would stall Newton on the kink of the master surface."""
+        last = self.facet_coordinates(u)
+        keep = np.all(surface_coordinates(x_slave, last) >= -KEEP_TOLERANCE, axis=1)
+        return (np.where(keep[:, None], self.facet_global_nodes, nodes),
+                np.where(keep[:, None, None], self._facet_reference, reference))
 
-    def _build(self, surface: _MasterSurface) -> None:
-        """Q and the master reference coordinates for the current ``facet``."""
+    def _build(self) -> None:
+        """Q and the master reference coordinates for the current pairing."""
         d, nen = self.dim, self.nodes_per_facet
         bs_w = d * nen
         reference = self.reference.x.array.reshape(-1, bs_w)
         reference[:] = 0.0
-        reference[self.slave_nodes] = surface.reference[self.facet].reshape(-1, bs_w)
+        reference[self.slave_nodes] = self._facet_reference.reshape(-1, bs_w)
         self.reference.x.scatter_forward()
         w_map, v_map = self.W.dofmap.index_map, self.V.dofmap.index_map
         # one entry per row of a slave node's components, none elsewhere: CSR of the local rows
         rows = (self.slave_nodes.astype(np.int64)[:, None] * bs_w + np.arange(bs_w)).ravel()
-        cols = (surface.global_nodes[self.facet][:, :, None] * d + np.arange(d)).ravel()
+        cols = (self.facet_global_nodes[:, :, None] * d + np.arange(d)).ravel()
         order = np.argsort(rows)
         counts = np.zeros(w_map.size_local * bs_w, dtype=np.int32)
         counts[rows] = 1
@@ -259,3 +457,36 @@ class Pairing:
             csr=(indptr, cols[order].astype(PETSc.IntType), np.ones(len(rows))),
             comm=self.comm)
         self.Q = Q
+
+
+def _candidates(held: _Facets, x: np.ndarray) -> tuple[list[np.ndarray], np.ndarray]:
+    """Each point's candidate facets among those held: the :data:`CANDIDATES` nearest
+    centroids, and every other centroid as close as the last of them (so that the set does
+    not depend on the k-d tree's order among equal distances); and that last distance (inf
+    when fewer facets are held than the candidates need: more must be fetched, unless these
+    are all)."""
+    m = len(held.global_nodes)
+    if not len(x):
+        return [], np.zeros(0)
+    if m == 0:
+        return [np.zeros(0, dtype=np.int64)] * len(x), np.full(len(x), np.inf)
+    tree = cKDTree(held.current.mean(axis=1))
+    k = min(CANDIDATES, m)
+    distance, index = tree.query(x, k=min(k + 1, m))
+    distance, index = distance.reshape(len(x), -1), index.reshape(len(x), -1)
+    reach = distance[:, k - 1].copy()
+    rows: list[np.ndarray] = list(index[:, :k])
+    if m > k:
+        tied = np.flatnonzero(distance[:, k] <= reach * (1 + 1e-12))
+        for i in tied:
+            ball = np.asarray(tree.query_ball_point(x[i], r=reach[i] * (1 + 1e-12)))
+            rows[i] = np.sort(ball).astype(np.int64)
+    else:
+        reach[:] = np.inf  # all held facets are candidates: complete only if they are all
+    return rows, reach
+
+
+def _same_length(rows: list[np.ndarray]) -> list[np.ndarray]:
+    """The indices of ``rows`` grouped by their lengths (one group when none is tied)."""
+    lengths = np.fromiter((len(r) for r in rows), dtype=np.int64, count=len(rows))
+    return [np.flatnonzero(lengths == n) for n in np.unique(lengths)]

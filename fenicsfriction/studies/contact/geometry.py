@@ -28,9 +28,15 @@ reports a session open already, they use it and remove only their own model. Geo
 the cylinder's arc and the sphere are approximated by the chords and flat triangles of their
 boundary facets, whose vertices lie on the exact surface.
 
-In parallel the mesh is partitioned by dolfinx's default graph partitioner, which sees two
-disconnected bodies: on two ranks it puts (nearly) all of body 1 on one rank and body 2 on the
-other, so that slave nodes and their master facets sit on different ranks.
+In parallel, ``partition="graph"`` (the default) leaves the mesh to dolfinx's graph
+partitioner, which sees two disconnected bodies: on two ranks it puts (nearly) all of body 1 on
+one rank and body 2 on the other, so that one rank has every slave node and the contact search
+and the slave side's contact work are all its own. ``partition="contact"`` cuts both bodies
+across the contact plane instead, by a coordinate in that plane (x for the cylinder and the
+patches; the angle about the z axis for the quarter sphere, whose contact patch is a quarter
+disc around the origin): the cells sorted by it are shared out in equal runs, so that each
+rank holds a slice of each body, of the slave surface and of the master surface under it
+(:func:`fenicsfriction._compat.key_partitioner`).
 """
 
 from __future__ import annotations
@@ -41,6 +47,8 @@ import numbers
 import typing
 
 from mpi4py import MPI
+
+import numpy as np
 
 from fenicsfriction import laws
 from fenicsfriction.meshing import gmsh_mesh
@@ -54,6 +62,7 @@ __all__ = [
     "SLAVE",
     "SYMMETRY_X",
     "SYMMETRY_Y",
+    "PARTITIONS",
     "TwoBodyMesh",
     "hertz_2d",
     "hertz_3d",
@@ -77,6 +86,9 @@ FIXED = 21
 SYMMETRY_X = 30
 #: facet tag of the symmetry plane y = 0 (both bodies; 3D quarter models)
 SYMMETRY_Y = 31
+
+#: how the mesh is partitioned: dolfinx's graph partitioner, or cut across the contact
+PARTITIONS = ("graph", "contact")
 
 _NAMES = {BODY1: "body1", BODY2: "body2", SLAVE: "slave", LOAD: "load", MASTER: "master",
           FIXED: "fixed", SYMMETRY_X: "symmetry_x", SYMMETRY_Y: "symmetry_y"}
@@ -130,10 +142,23 @@ def _default(value: float | None, scale: float) -> float:
 # --- the gmsh session on rank 0 (fenicsfriction.meshing) ---------------------------------------
 
 def _build(comm: MPI.Comm, name: str, gdim: int, construct: typing.Callable[[typing.Any], None],
-           msh_file: str | None, parameters: dict) -> TwoBodyMesh:
-    """:func:`~fenicsfriction.meshing.gmsh_mesh` with the parameters the mesh was made with."""
-    msh, cell_tags, facet_tags = gmsh_mesh(comm, name, gdim, construct, msh_file)
-    return TwoBodyMesh(msh, cell_tags, facet_tags, {"geometry": name, **parameters})
+           msh_file: str | None, parameters: dict, partition: str = "graph",
+           key: typing.Callable[[typing.Any], typing.Any] | None = None) -> TwoBodyMesh:
+    """:func:`~fenicsfriction.meshing.gmsh_mesh` with the parameters the mesh was made with;
+    ``partition="contact"`` cuts the cells by ``key`` of their centroids."""
+    laws.check("partition", partition, partition in PARTITIONS, f"one of {', '.join(PARTITIONS)}")
+    msh, cell_tags, facet_tags = gmsh_mesh(comm, name, gdim, construct, msh_file,
+                                           partition_key=key if partition == "contact" else None)
+    return TwoBodyMesh(msh, cell_tags, facet_tags,
+                       {"geometry": name, **parameters, "partition": partition})
+
+
+def _along_x(centroids: typing.Any) -> typing.Any:
+    return centroids[:, 0]
+
+
+def _around_z(centroids: typing.Any) -> typing.Any:
+    return np.arctan2(centroids[:, 1], centroids[:, 0])
 
 
 def _add_groups(gmsh: typing.Any, dim: int, groups: dict[int, list[int]]) -> None:
@@ -198,7 +223,8 @@ def _hertz_sizes(R: float, block_half_width: float | None, block_height: float |
 def hertz_2d(comm: MPI.Comm, R: float = 1.0, block_half_width: float | None = None,
              block_height: float | None = None, h_contact: float | None = None,
              h_far: float | None = None, refine_half_width: float | None = None,
-             refine: int = 0, grading: float = 0.3, msh_file: str | None = None) -> TwoBodyMesh:
+             refine: int = 0, grading: float = 0.3, msh_file: str | None = None,
+             partition: str = "graph") -> TwoBodyMesh:
     """A half-cylinder on a block, plane strain (triangles).
 
     Body 1 is the lower half-disc of radius ``R`` centred at (0, R): its lowest point touches the
@@ -220,6 +246,8 @@ def hertz_2d(comm: MPI.Comm, R: float = 1.0, block_half_width: float | None = No
         refine: Halve ``h_contact`` and ``h_far`` this many times.
         grading: Growth of the mesh size per unit distance from that square, up to ``h_far``.
         msh_file: If given, rank 0 writes the gmsh mesh there (``.msh``).
+        partition: ``"graph"`` (dolfinx's partitioner: one body per rank) or ``"contact"``
+            (both bodies cut across the contact plane; see the module's notes).
 
     Returns:
         The mesh and its tags; ``parameters`` holds the values above, the sizes after ``refine``.
@@ -251,13 +279,14 @@ def hertz_2d(comm: MPI.Comm, R: float = 1.0, block_half_width: float | None = No
 
     parameters = {"R": R, "block_half_width": W, "block_height": H, "h_contact": h_c,
                   "h_far": h_f, "refine_half_width": w, "refine": refine, "grading": grading}
-    return _build(comm, "hertz_2d", 2, construct, msh_file, parameters)
+    return _build(comm, "hertz_2d", 2, construct, msh_file, parameters, partition, _along_x)
 
 
 def hertz_3d(comm: MPI.Comm, R: float = 1.0, block_half_width: float | None = None,
              block_height: float | None = None, h_contact: float | None = None,
              h_far: float | None = None, refine_half_width: float | None = None,
-             refine: int = 0, grading: float = 0.3, msh_file: str | None = None) -> TwoBodyMesh:
+             refine: int = 0, grading: float = 0.3, msh_file: str | None = None,
+             partition: str = "graph") -> TwoBodyMesh:
     """A quarter of a hemisphere on a quarter block (x >= 0, y >= 0; tetrahedra).
 
     Body 1 is the quarter (x, y >= 0) of the lower hemisphere of radius ``R`` centred at
@@ -279,6 +308,8 @@ def hertz_3d(comm: MPI.Comm, R: float = 1.0, block_half_width: float | None = No
         refine: Halve ``h_contact`` and ``h_far`` this many times (about 8 times the cells).
         grading: Growth of the mesh size per unit distance from that cube, up to ``h_far``.
         msh_file: If given, rank 0 writes the gmsh mesh there (``.msh``).
+        partition: ``"graph"`` (dolfinx's partitioner: one body per rank) or ``"contact"``
+            (both bodies cut across the contact plane; see the module's notes).
 
     Returns:
         The mesh and its tags; ``parameters`` holds the values above, the sizes after ``refine``.
@@ -319,7 +350,7 @@ def hertz_3d(comm: MPI.Comm, R: float = 1.0, block_half_width: float | None = No
 
     parameters = {"R": R, "block_half_width": W, "block_height": H, "h_contact": h_c,
                   "h_far": h_f, "refine_half_width": w, "refine": refine, "grading": grading}
-    return _build(comm, "hertz_3d", 3, construct, msh_file, parameters)
+    return _build(comm, "hertz_3d", 3, construct, msh_file, parameters, partition, _around_z)
 
 
 # --- patch tests: two stacked blocks with non-matching interface meshes ------------------------
@@ -349,7 +380,7 @@ def _structured(gmsh: typing.Any, dim: int, body: int, n: int, width: float,
 
 
 def _patch(comm: MPI.Comm, dim: int, n_upper: int, n_lower: int, width: float, height: float,
-           msh_file: str | None) -> TwoBodyMesh:
+           msh_file: str | None, partition: str) -> TwoBodyMesh:
     _check_patch(n_upper, n_lower, width, height)
     normal = dim - 1  # the axis across the interface: y in 2D, z in 3D
 
@@ -377,11 +408,13 @@ def _patch(comm: MPI.Comm, dim: int, n_upper: int, n_lower: int, width: float, h
         _structured(gmsh, dim, lower, n_lower, width, height)
 
     parameters = {"n_upper": n_upper, "n_lower": n_lower, "width": width, "height": height}
-    return _build(comm, f"patch_{dim}d", dim, construct, msh_file, parameters)
+    return _build(comm, f"patch_{dim}d", dim, construct, msh_file, parameters, partition,
+                  _along_x)
 
 
 def patch_2d(comm: MPI.Comm, n_upper: int = 5, n_lower: int = 7, width: float = 1.0,
-             height: float = 1.0, msh_file: str | None = None) -> TwoBodyMesh:
+             height: float = 1.0, msh_file: str | None = None,
+             partition: str = "graph") -> TwoBodyMesh:
     """Two stacked rectangles touching along y = 0, meshed with structured triangles.
 
     Body 1 is [0, width] x [0, height] with ``n_upper`` elements across the width, body 2 is
@@ -398,6 +431,7 @@ def patch_2d(comm: MPI.Comm, n_upper: int = 5, n_lower: int = 7, width: float = 
         width: Both bodies' width.
         height: Each body's height.
         msh_file: If given, rank 0 writes the gmsh mesh there (``.msh``).
+        partition: ``"graph"`` (one body per rank) or ``"contact"`` (both cut along x).
 
     Returns:
         The mesh and its tags; ``parameters`` holds the values above.
@@ -405,11 +439,12 @@ def patch_2d(comm: MPI.Comm, n_upper: int = 5, n_lower: int = 7, width: float = 
     Raises:
         ValueError: A parameter is out of range.
     """
-    return _patch(comm, 2, n_upper, n_lower, width, height, msh_file)
+    return _patch(comm, 2, n_upper, n_lower, width, height, msh_file, partition)
 
 
 def patch_3d(comm: MPI.Comm, n_upper: int = 4, n_lower: int = 5, width: float = 1.0,
-             height: float = 1.0, msh_file: str | None = None) -> TwoBodyMesh:
+             height: float = 1.0, msh_file: str | None = None,
+             partition: str = "graph") -> TwoBodyMesh:
     """Two stacked boxes touching along z = 0 (tetrahedra), the 3D :func:`patch_2d`.
 
     Body 1 is [0, width]^2 x [0, height], body 2 is [0, width]^2 x [-height, 0]. Every face is
@@ -425,6 +460,7 @@ def patch_3d(comm: MPI.Comm, n_upper: int = 4, n_lower: int = 5, width: float = 
         width: Both bodies' width and depth.
         height: Each body's height.
         msh_file: If given, rank 0 writes the gmsh mesh there (``.msh``).
+        partition: ``"graph"`` (one body per rank) or ``"contact"`` (both cut along x).
 
     Returns:
         The mesh and its tags; ``parameters`` holds the values above.
@@ -432,4 +468,4 @@ def patch_3d(comm: MPI.Comm, n_upper: int = 4, n_lower: int = 5, width: float = 
     Raises:
         ValueError: A parameter is out of range.
     """
-    return _patch(comm, 3, n_upper, n_lower, width, height, msh_file)
+    return _patch(comm, 3, n_upper, n_lower, width, height, msh_file, partition)

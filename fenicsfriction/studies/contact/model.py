@@ -152,6 +152,9 @@ class TwoBodyModel:
         shear: the tangential traction on the LOAD face (a vector ``fem.Constant``).
         contacts: the contact couplings (one per pass).
         residual, solver: the residual and its :class:`~fenicsfriction.steady.SteadySolver`.
+        linear_solver: the solver's ``linear_solver`` (``"auto"``: the LU per iteration on
+            small meshes, Krylov + AMG beyond the crossover); set before ``solver``'s first
+            use.
     """
 
     def __init__(self, geometry: TwoBodyMesh, materials: tuple[Material, Material],
@@ -163,6 +166,7 @@ class TwoBodyModel:
         check("passes", passes, passes in (1, 2), "1 or 2")
         check_discretisation(formulation, degree, enforcement)
         self.formulation, self.degree, self.enforcement = formulation, degree, enforcement
+        self.linear_solver = "auto"
         self.geometry = geometry
         msh, cell_tags, facet_tags = geometry.mesh, geometry.cell_tags, geometry.facet_tags
         self.comm: MPI.Comm = msh.comm
@@ -221,7 +225,7 @@ class TwoBodyModel:
     def solver(self) -> SteadySolver:
         """Newton on the quasi-static residual (built at first use: a dynamic model, whose
         friction acts on u̇, is solved by the time integrators instead)."""
-        return SteadySolver(self.residual, prefix="contact_", linear_solver="lu")
+        return SteadySolver(self.residual, prefix="contact_", linear_solver=self.linear_solver)
 
     def _bcs(self, fix_load_face: bool, clamp: bool) -> list:
         V, facet_tags, fdim = self.V, self.geometry.facet_tags, self.dim - 1
