@@ -26,7 +26,6 @@ docs/scaling.md) and ``bench_scale_3d.png``, and prints the tables as markdown.
 
 from __future__ import annotations
 
-import inspect
 import json
 import logging
 import math
@@ -78,34 +77,15 @@ def _stage_times(stage: PETSc.Log.Stage, comm: MPI.Comm) -> dict[str, float]:
 
 
 def _solver_args(cls: type, path: str) -> dict[str, typing.Any]:
-    """How ``cls`` (SteadySolver or DynamicsSolver) is asked for ``path``, explicitly (its
+    """How ``cls`` (SteadySolver or DynamicsSolver) is asked for ``path``, explicitly (their
     ``"auto"`` may pick either). Direct: the steady solver's reused MUMPS LU under FGMRES (its
     3D path before AMG; the condensation, faster below ≈ 4e4 unknowns, fills a dense
     complement that grows like n^(4/3)), the dynamics' MUMPS LU at every Newton iteration.
-    AMG: ``linear_solver="amg"`` where the solver has it; else the options of
-    :func:`fenicsfriction.amg.amg_options` (GMRES + GAMG) with the near-nullspace
-    :func:`_attach_nullspace` gives the matrix, which ``amg_by_options`` records."""
-    from fenicsfriction import amg
-
-    has_choice = "linear_solver" in inspect.signature(cls).parameters
-    if path == "direct":
-        return {"linear_solver": "reused-lu" if cls.__name__ == "SteadySolver" else "lu"
-                } if has_choice else {}
-    if has_choice and "amg" in getattr(inspect.getmodule(cls), "LINEAR_SOLVERS", ()):
+    AMG: both solvers' ``linear_solver="amg"`` (GMRES + GAMG with the rigid-body
+    near-nullspace, :mod:`fenicsfriction.amg`)."""
+    if path == "amg":
         return {"linear_solver": "amg"}
-    return {"options": amg.amg_options(3)}
-
-
-def _attach_nullspace(solver: typing.Any, V: typing.Any) -> bool:
-    """Where the AMG path came from the options (the solver has none of its own): the block's
-    rigid-body near-nullspace on ``solver``'s matrix. False where the solver set it up."""
-    from fenicsfriction import amg
-
-    snes = getattr(solver, "snes", None) or solver.ts.getSNES()
-    if getattr(solver, "linear_solver", "") == "amg" or not amg.uses_amg(snes.getKSP()):
-        return False
-    amg.attach_near_nullspace(solver.A, V)
-    return True
+    return {"linear_solver": "reused-lu" if cls.__name__ == "SteadySolver" else "lu"}
 
 
 class _Observers:
@@ -151,7 +131,6 @@ def run(refine: int, path: str, mu_steps: int, steps: int, dt: float, comm: MPI.
     solver = ff.SteadySolver(model.residual, prefix="scale_s_",
                              **_merge(_solver_args(ff.SteadySolver, path),
                                       model.solver_options()))
-    out["amg_by_options"] = path == "amg" and _attach_nullspace(solver, model.V)
     model.initial_guess()
     records = ff.continuation(solver, model.mu, np.linspace(0.0, MU, mu_steps + 1),
                               observe=observe)
@@ -188,8 +167,6 @@ def run(refine: int, path: str, mu_steps: int, steps: int, dt: float, comm: MPI.
     t0, cpu0 = time.perf_counter(), time.process_time()
     dynamics = DynamicsSolver(r, prefix="scale_d_", atol=1e-10 * model.force_scale,
                               **_solver_args(DynamicsSolver, path))
-    if path == "amg":
-        out["amg_by_options_dynamics"] = _attach_nullspace(dynamics, model.V)
     setup_s, setup_cpu = time.perf_counter() - t0, time.process_time() - cpu0
     failure = None
     try:
