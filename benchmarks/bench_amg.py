@@ -13,7 +13,6 @@ paths' PETSc types. Used for the crossovers of ``fenicsfriction.amg`` (docs/solv
 
 from __future__ import annotations
 
-import json
 import os
 import resource
 import time
@@ -21,7 +20,7 @@ import time
 from mpi4py import MPI
 
 import numpy as np
-from _common import parser
+from _common import parser, write_summary
 
 import fenicsfriction as ff
 from fenicsfriction import amg
@@ -86,9 +85,7 @@ def main() -> None:
                       f"Krylov per step {row['krylov_per_step']}", flush=True)
         result["meshes"].append({"refine": refine, "rows": rows})
     result["load_average_end"] = os.getloadavg()
-    if comm.rank == 0:
-        args.out.mkdir(parents=True, exist_ok=True)
-        (args.out / "bench_amg.json").write_text(json.dumps(result, indent=1))
+    write_summary(args.out / "bench_amg.json", result, comm)
 
 
 if __name__ == "__main__":

@@ -35,10 +35,10 @@ from mpi4py import MPI
 
 import numpy as np
 from _common import parser as benchmark_parser
-from _common import save
+from _common import save, write_summary
 
 from fenicsfriction import cea
-from fenicsfriction.results import environment, get_logger, write_summary
+from fenicsfriction.results import environment, get_logger
 from fenicsfriction.studies.brake import geometry, model
 
 MODES = [20, 40, 80, 160]

@@ -39,7 +39,7 @@ from petsc4py import PETSc
 
 import numpy as np
 from _common import parser as benchmark_parser
-from _common import save
+from _common import save, write_summary
 
 import fenicsfriction as ff
 from fenicsfriction.cea import Band, BandSolver, ModalBasis, symmetric_part
@@ -214,7 +214,7 @@ def main(argv=None) -> None:
               "projected): "
               + "; ".join(f"{m} modes: " + ", ".join(f"N={n} {s:.1f}" for n, s in v.items())
                           for m, v in speedups.items()), flush=True)
-    ff.results.write_summary(args.out / "bench_cea.json",
+    write_summary(args.out / "bench_cea.json",
                              {"band_hz": [BAND.fmin, BAND.fmax], "max_rate": BAND.rate,
                               "mu_values": MU_VALUES, "modes": MODES, "total_time_s": total,
                               **to_plain(result)}, comm)

@@ -45,9 +45,8 @@ from petsc4py import PETSc
 
 import numpy as np
 from _common import parser as benchmark_parser
-from _common import save
+from _common import save, write_summary
 
-import fenicsfriction as ff
 from fenicsfriction.contact import Pairing, facet_nodes
 from fenicsfriction.studies.contact import closed_forms, geometry
 from fenicsfriction.studies.contact.model import TwoBodyModel
@@ -353,7 +352,7 @@ def main() -> int:
         if baseline is not None:
             print(f"two-pass / one-pass solve time (2D r0): {baseline:.2f}")
         plot(runs, scaling, args.out / "bench_contact.png", args.dpi)
-    ff.results.write_summary(args.out / "bench_contact.json",
+    write_summary(args.out / "bench_contact.json",
                              {"ranks": comm.size, "runs": runs, "search_scaling": scaling,
                               "two_pass_over_one_pass": baseline}, comm=comm)
     if comm.rank == 0:

@@ -32,9 +32,9 @@ import time
 from mpi4py import MPI
 
 import numpy as np
+from _common import environment as run_environment
 from _common import parser as benchmark_parser
 
-from fenicsfriction.results import environment
 from fenicsfriction.studies.contact import geometry
 from fenicsfriction.studies.contact.validation import Hertz
 
@@ -173,7 +173,7 @@ def main() -> None:
                       f"{np.round(record['peak_mib']).tolist()} MiB", file=sys.stderr,
                       flush=True)
     summary = {"ranks": comm.size, "runs": runs, "loadavg_start": load_start,
-               "loadavg_end": os.getloadavg(), "environment": environment(comm),
+               "loadavg_end": os.getloadavg(), "environment": run_environment(comm),
                "command": " ".join(sys.argv)}
     out = args.out
     if comm.rank == 0:

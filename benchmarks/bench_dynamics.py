@@ -44,8 +44,8 @@ import time
 from mpi4py import MPI
 
 import numpy as np
+from _common import note_solver, save, write_summary
 from _common import parser as benchmark_parser
-from _common import save
 from scipy.integrate import trapezoid
 
 import fenicsfriction as ff
@@ -70,6 +70,7 @@ class Scene:
         steady = ff.SteadySolver(self.model.residual, prefix="bench_steady_",
                                  options=self.model.solver_options())
         ff.continuation(steady, self.model.mu, np.linspace(0.0, MU, 13))
+        note_solver(steady)
         r = self.model.residual
         self._u, self._v = r.u.x.array.copy(), r.u_dot.x.array.copy()
 
@@ -126,6 +127,7 @@ def run(scene: Scene, name: str, make, dt: float, t_end: float, sample: float) -
     except DynamicsError as err:
         records, failure = err.records, str(err)
     wall = time.perf_counter() - t0 - observe.seconds
+    note_solver(solver)
     steps = len(records) - 1
     result = {"name": name, "dt": dt, "wall_time_s": wall, "observe_s": observe.seconds,
               "steps": steps,
@@ -276,7 +278,7 @@ def main(argv=None) -> None:
               f"U = {BELT_SPEED} cm/s, ε = {args.eps}; central differences: stable step "
               f"{central.stable_dt:.3g} s (elastic {central.stable_dt_elastic:.3g} s); "
               f"total {total:.0f} s\n\n{table(runs, reference)}", flush=True)
-    ff.results.write_summary(args.out / "bench_dynamics.json",
+    write_summary(args.out / "bench_dynamics.json",
                      {"mu": MU, "belt_speed": BELT_SPEED, "b_n": B_N, "eps": args.eps,
                       "perturbation": PERTURBATION, "t_end": args.t_end, "sample_s": sample,
                       "default_dt": DEFAULT_DT, "total_time_s": total,

@@ -35,8 +35,8 @@ import sys
 import time
 
 import numpy as np
+from _common import note_solver, save, write_summary
 from _common import parser as benchmark_parser
-from _common import save
 
 MU_STEPS = np.linspace(0.0, 1.5, 31)
 RTOL = 1e-10
@@ -150,6 +150,7 @@ def fenicsfriction_run(refine: int, repeats: int) -> dict:
             records = ff.continuation(solver, model.mu, MU_STEPS, observe=model.quantities,
                                       predictor=predictor)
             total = sum(r["wall_time_s"] for r in records)
+            note_solver(solver)
             if best is None or total < best[0]:
                 best = (total, records)
         out[name] = {"solve_time_s": best[0], "steps": [
@@ -203,7 +204,7 @@ def main() -> None:
     args = parser.parse_args()
     logging.getLogger("ffcx").setLevel(logging.WARNING)
     logging.getLogger().addFilter(lambda record: record.levelno >= logging.WARNING)
-    from fenicsfriction.results import get_logger, write_summary
+    from fenicsfriction.results import get_logger
 
     say = get_logger().info
     rows = []
@@ -230,8 +231,7 @@ def main() -> None:
             f"{row['ff_lu_s']:.2f} s), GetFEM {row['getfem_s']:.2f} s")
         rows.append(row)
     args.out.mkdir(parents=True, exist_ok=True)
-    write_summary(args.out / "bench_getfem.json", {"mu_steps": MU_STEPS.tolist(),
-                                                   "rows": rows})
+    write_summary(args.out / "bench_getfem.json", {"mu_steps": MU_STEPS.tolist(), "rows": rows})
     plot(rows, args.out / "bench_getfem.png")
     print("| dofs | fenicsfriction [s] | its | LU path [s] | its | GetFEM 5.4 [s] | its "
           "| GetFEM ÷ fenicsfriction | GetFEM ÷ LU path | agreement: spring force ÷ W, "

@@ -64,9 +64,8 @@ from petsc4py import PETSc
 
 import numpy as np
 from _common import parser as benchmark_parser
-from _common import save
+from _common import save, write_summary
 
-import fenicsfriction as ff
 from fenicsfriction.steady import DEFAULT_OPTIONS, SolveError
 from fenicsfriction.studies.contact import closed_forms, geometry
 from fenicsfriction.studies.contact.model import SurfaceValues, TwoBodyModel
@@ -355,7 +354,7 @@ def main() -> int:
                                args.c_n)
                 (failures if "failed" in row else runs).append(row)
                 # written after every run: a long ladder stopped keeps what it measured
-                ff.results.write_summary(json_path, {"ranks": comm.size, "runs": runs,
+                write_summary(json_path, {"ranks": comm.size, "runs": runs,
                                                      "failures": failures}, comm=comm)
     same_mesh = ratios(runs)
     if comm.rank == 0:
@@ -368,7 +367,7 @@ def main() -> int:
             print(f"failed: {row['dim']}D h = a/{row['a_over_h']} {row['formulation']} "
                   f"P{row['degree']}: {row['failed']}")
         plot(runs, args.out / "bench_hertz_formulations.png", args.dpi)
-    ff.results.write_summary(json_path,
+    write_summary(json_path,
                              {"ranks": comm.size, "runs": runs, "failures": failures,
                               "same_mesh_ratios": same_mesh},
                              comm=comm)

@@ -33,9 +33,9 @@ from mpi4py import MPI
 
 import numpy as np
 from _common import parser as benchmark_parser
-from _common import save
+from _common import save, write_summary
 
-from fenicsfriction.results import get_logger, write_summary
+from fenicsfriction.results import get_logger
 from fenicsfriction.studies.multicontact import ElasticSubstrate, SubstrateBlock
 from fenicsfriction.studies.multicontact.interaction import (
     LatticeInteraction,

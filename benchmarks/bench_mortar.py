@@ -23,9 +23,10 @@ from mpi4py import MPI
 
 import numpy as np
 from _common import parser as benchmark_parser
+from _common import write_summary
 from dolfinx import fem, mesh
 
-from fenicsfriction import _compat, results
+from fenicsfriction import _compat
 from fenicsfriction.contact import NodeToSegment
 from fenicsfriction.contact.mortar import SegmentToSegment
 from fenicsfriction.laws import InterfaceLaw
@@ -118,11 +119,11 @@ def main(argv: list[str]) -> None:
         rows.append((name, degree, setup, first, again, parts["search"], parts["build"]))
     keys = ("contact", "degree", "setup_s", "first_search_s", "later_search_median_s",
             "search_s", "build_s")
-    results.write_summary(args.out / "bench_mortar.json",
-                          {"slave_facets": 2 * args.n**2, "master_facets": 2 * args.m**2,
-                           "ranks": comm.size, "repeats": args.repeats,
-                           "runs": [dict(zip(keys, row, strict=True)) for row in rows]},
-                          comm=comm)
+    write_summary(args.out / "bench_mortar.json",
+                  {"slave_facets": 2 * args.n**2, "master_facets": 2 * args.m**2,
+                   "ranks": comm.size, "repeats": args.repeats,
+                   "runs": [dict(zip(keys, row, strict=True)) for row in rows]},
+                  comm=comm)
     if comm.rank == 0:
         facets = 2 * args.n**2
         print(f"{facets} slave facets against {2 * args.m**2}, {comm.size} rank(s)\n")

@@ -29,9 +29,8 @@ import time
 
 import numpy as np
 from _common import parser as benchmark_parser
-from _common import save
+from _common import save, write_summary
 
-from fenicsfriction.results import write_summary
 from fenicsfriction.studies.multicontact import (
     EQModel,
     InstabilityMap,

@@ -26,10 +26,9 @@ import time
 
 import numpy as np
 from _common import parser as benchmark_parser
-from _common import save
+from _common import save, write_summary
 
 from fenicsfriction import laws
-from fenicsfriction.results import write_summary
 from fenicsfriction.statistics import limit_cycle
 from fenicsfriction.studies.oscillators import BeltOscillator
 from fenicsfriction.studies.oscillators.slider import stability_map, table2_slider

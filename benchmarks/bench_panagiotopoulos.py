@@ -36,7 +36,7 @@ from mpi4py import MPI
 
 import numpy as np
 from _common import parser as benchmark_parser
-from _common import save
+from _common import save, write_summary
 
 import fenicsfriction as ff
 from fenicsfriction.panagiotopoulos import PanagiotopoulosSolver, ProcessError
@@ -292,7 +292,7 @@ def main() -> int:
                   f"{r['outer']} | {r['corner_penetration'] / r['local_corner_penetration']:.4f}"
                   f" | {bound} | {r['max_change']:.2e} |")
         plot(block, layered, args.out / "bench_panagiotopoulos.png", args.dpi)
-    ff.results.write_summary(args.out / "bench_panagiotopoulos.json",
+    write_summary(args.out / "bench_panagiotopoulos.json",
                              {"ranks": comm.size, "block": block, "layered": layered,
                               "de_pater": de_pater, "mollified": mollified}, comm=comm)
     return 0

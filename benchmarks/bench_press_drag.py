@@ -27,7 +27,6 @@ both schemes) to ``--out`` and prints a markdown table. Serial.
 
 from __future__ import annotations
 
-import json
 import logging
 import warnings
 
@@ -35,7 +34,7 @@ from mpi4py import MPI
 
 import numpy as np
 from _common import parser as benchmark_parser
-from _common import save
+from _common import save, write_summary
 
 from fenicsfriction.studies.contact.impact import PressAndDrag
 
@@ -110,7 +109,7 @@ def main(argv: list[str] | None = None) -> None:
                       f"{r['ratio_to_alpha2']['wall_time_s']:.2f}"]
         table.append("| " + " | ".join(cells) + " |")
     print("\n".join(table))
-    (args.out / "bench_press_drag.json").write_text(json.dumps({"runs": runs}, indent=1))
+    write_summary(args.out / "bench_press_drag.json", {"runs": runs}, MPI.COMM_SELF)
 
     import matplotlib
     matplotlib.use("Agg")

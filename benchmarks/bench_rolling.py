@@ -25,10 +25,9 @@ import math
 import sys
 
 import numpy as np
-from _common import best_time, save
+from _common import best_time, save, write_summary
 from _common import parser as benchmark_parser
 
-from fenicsfriction.results import write_summary
 from fenicsfriction.studies.rolling.fastsim import creep_curve, fastsim, linear_theory
 
 CASE = {"a": 6.304e-3, "b": 12.61e-3, "G": 82e9, "nu": 0.28, "mu": 0.3, "Fn": 106.7e3}

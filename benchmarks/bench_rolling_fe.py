@@ -15,13 +15,11 @@ markdown tables (rank 0). Serial, about 3 minutes with the defaults.
 
 from __future__ import annotations
 
-import json
-
 from mpi4py import MPI
 
 import numpy as np
 from _common import parser as benchmark_parser
-from _common import save
+from _common import save, write_summary
 
 from fenicsfriction.studies.rolling import closed_forms
 from fenicsfriction.studies.rolling.kalker import creep_coefficients
@@ -84,11 +82,10 @@ def main() -> None:
               for L in map(float, args.blocks_2d.split(","))]
     kalker = [kalker_row(n, nu, b) for n in map(int, args.cells_3d.split(","))
               for nu, b in ((0.0, 1.0), (0.25, 1.0), (0.25, 2.0))]
+    write_summary(args.out / "bench_rolling_fe.json", {"carter": carter, "kalker": kalker},
+                  comm)
     if comm.rank != 0:
         return
-    args.out.mkdir(parents=True, exist_ok=True)
-    (args.out / "bench_rolling_fe.json").write_text(
-        json.dumps({"carter": carter, "kalker": kalker}, indent=1, default=float))
     print("| cells/a | L/a | dofs | slope err | F err/μP (0.5) | stick end (Carter 0) | "
           "traction L2 | Newton | time [s] |\n|---|---|---|---|---|---|---|---|---|")
     for r in carter:

@@ -34,10 +34,9 @@ import time
 
 from mpi4py import MPI
 
-from _common import best_time, save
+from _common import best_time, save, write_summary
 from _common import parser as benchmark_parser
 
-from fenicsfriction.results import write_summary
 from fenicsfriction.studies.rolling import RollingContact
 from fenicsfriction.studies.rolling.fastsim import fastsim, linear_theory
 

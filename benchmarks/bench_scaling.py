@@ -27,6 +27,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 import numpy as np
+from _common import note_solver, write_summary
 from _common import parser as benchmark_parser
 
 import fenicsfriction as ff
@@ -75,6 +76,7 @@ def run(refine: int, comm: MPI.Comm) -> dict:
     ff.continuation(solver, model.mu, MU_STEPS, observe=model.quantities)
     steady_total = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
     steady = _stage_times(before, _snapshot(STEADY_STAGES), steady_total, comm)
+    note_solver(solver)
     pc_setup = PETSc.Log.Event("PCSetUp").getPerfInfo().get("time", 0.0)
 
     model.mu.value = MU_PEP
@@ -84,6 +86,7 @@ def run(refine: int, comm: MPI.Comm) -> dict:
     comm.Barrier()
     t0 = time.perf_counter()
     modes = stability.solve(max_modulus=8000)
+    note_solver(stability)
     pep_total = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
     pep = _stage_times(before, _snapshot(PEP_STAGES), pep_total, comm)
     return {"refine": refine, "dofs": dofs, "ranks": comm.size,
@@ -122,7 +125,7 @@ def main() -> None:
     say(f"{comm.size} rank(s), {result['dofs']} dofs: continuation "
         f"{result['steady_total_s']:.2f} s, PEP {result['pep_total_s']:.2f} s")
     out = args.out / f"bench_scaling_{comm.size}.json"
-    ff.results.write_summary(out, result, comm)
+    write_summary(out, result, comm)
     other = args.out / f"bench_scaling_{1 if comm.size == 2 else 2}.json"
     if comm.rank == 0 and other.exists():
         runs = sorted([result, json.loads(other.read_text())], key=lambda r: r["ranks"])

@@ -23,9 +23,8 @@ from mpi4py import MPI
 
 import numpy as np
 from _common import parser as benchmark_parser
-from _common import save
+from _common import save, write_summary
 
-from fenicsfriction.results import write_summary
 from fenicsfriction.studies.multicontact import ElasticSlider, ElasticSliderModel
 
 T_END = 4e-3

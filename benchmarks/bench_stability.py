@@ -52,8 +52,8 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 import numpy as np
+from _common import note_solver, save, write_summary
 from _common import parser as benchmark_parser
-from _common import save
 
 import fenicsfriction as ff
 from fenicsfriction.numerics import dense_eigenvalues
@@ -204,6 +204,7 @@ def steady_state(model, tag: str, comm: MPI.Comm) -> dict:
 
     wall, reports = timed(solve_and_polish, comm)
     preconditioner = solver.preconditioner
+    note_solver(solver)
     for obj in (solver.snes, solver.A, solver.b, solver.x):  # the SNES and its callbacks form
         obj.destroy()                                        # a cycle gc leaves
     return {"time_s": wall, "newton_iterations": [r.iterations for r in reports],
@@ -231,6 +232,7 @@ def run_mesh(dim: int, refine: int, comm: MPI.Comm, dense_max_dofs: int,
         options, solve_args = VARIANTS[name]
         solver = StabilitySolver(model.residual, prefix=f"{tag}v{i}_", options=options)
         variants[name] = best_of(lambda s=solver, a=solve_args: pep_solve(s, comm, a), comm)
+        note_solver(solver)
         if name == "default":
             stab = solver  # kept for the baselines and the dense check
         else:
@@ -458,7 +460,7 @@ def main(argv=None) -> None:
               f"variant and ≥ 1e4 dofs (or all with every variant): "
               + ", ".join(f"{k} {v:.2f}" for k, v in means.items()) + f"; best: {best}",
               flush=True)
-    ff.results.write_summary(args.out / "bench_stability.json",
+    write_summary(args.out / "bench_stability.json",
                      {"ranks": comm.size, "mu": MU, "max_modulus": MAX_MODULUS, "shift": SHIFT,
                       "repeats": REPEATS, "time_budget_s": TIME_BUDGET,
                       "variants": {k: {"options": o, "solve": s}

@@ -42,8 +42,8 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 import numpy as np
+from _common import note_solver, save, write_summary
 from _common import parser as benchmark_parser
-from _common import save
 
 import fenicsfriction as ff
 from fenicsfriction import _compat
@@ -155,6 +155,8 @@ def run_mesh(refine: int, comm: MPI.Comm) -> dict:
     direct_time, direct_records = best_of(direct, "none", repeats)
     solve_time, records = best_of(solver, "secant", repeats)  # the samples kept are these
     bare = bare_newton_iteration(solver, BARE_REPEATS)
+    note_solver(solver)
+    note_solver(direct)
     comm.Barrier()
     if comm.rank == 0:
         shutil.rmtree(cache, ignore_errors=True)
@@ -324,7 +326,7 @@ def main(argv=None) -> None:
     for run in runs:  # the sampled profiles are long and exist on rank 0 only
         for sample in run["samples"].values():
             sample.pop("penetration")
-    ff.results.write_summary(args.out / "bench_steady.json",
+    write_summary(args.out / "bench_steady.json",
                      {"ranks": comm.size, "mu_steps": MU_STEPS.tolist(), "mu_samples": MU_SAMPLES,
                       "base_points": NUM_BASE_POINTS, "corner_margin": CORNER_MARGIN,
                       "continuation_repeats": CONTINUATION_REPEATS, "bare_repeats": BARE_REPEATS,

@@ -20,16 +20,15 @@ markdown table. Serial; a few minutes at r = 1.
 
 from __future__ import annotations
 
-import json
 import sys
 import time
 
 import numpy as np
 
 try:
-    from benchmarks._common import parser, save
+    from benchmarks._common import parser, save, write_summary
 except ImportError:  # run as a script from benchmarks/
-    from _common import parser, save  # type: ignore[no-redef]
+    from _common import parser, save, write_summary  # type: ignore[no-redef]
 
 RATIOS = (1.0, 3.0, 10.0, 100.0, 1000.0)
 THICKNESSES = (2.5, 10.0, 30.0)
@@ -114,7 +113,7 @@ def main() -> int:
     result = {"refine": args.refine, "formulation": args.formulation, "degree": args.degree,
               "reference_rule": rule, "max_modulus": MAX_MODULUS, **settings,
               "rigid": reference, "slab": rows, "wall_time_s": time.perf_counter() - t_start}
-    (args.out / "block_on_slab_study.json").write_text(json.dumps(result, indent=1))
+    write_summary(args.out / "block_on_slab_study.json", result)
     print(table(reference, rows))
     plot(reference, rows, thicknesses, args.out / "block_on_slab_study.png", args.dpi)
     return 0

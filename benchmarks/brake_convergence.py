@@ -34,10 +34,10 @@ from mpi4py import MPI
 
 import numpy as np
 from _common import parser as benchmark_parser
-from _common import save
+from _common import save, write_summary
 
 from fenicsfriction import cea
-from fenicsfriction.results import get_logger, to_plain, write_summary
+from fenicsfriction.results import get_logger, to_plain
 from fenicsfriction.studies.brake import geometry, model
 
 SIZES = [0.006, 0.004, 0.003]

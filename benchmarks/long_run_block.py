@@ -39,6 +39,7 @@ from mpi4py import MPI
 
 import numpy as np
 from _common import parser as benchmark_parser
+from _common import write_summary
 from scipy.integrate import trapezoid
 
 import fenicsfriction as ff
@@ -179,7 +180,7 @@ def main(argv=None) -> None:
                   f"{w['elongation'][0]:.4f} → {w['elongation'][1]:.4f} | "
                   f"{w['some_stick']:.1%} | {w['whole_stick']:.1%} | "
                   f"{w['longest_whole_stick'] * 1e3:.1f} |")
-    ff.results.write_summary(args.out / "long_run_block.json", summary, MPI.COMM_SELF)
+    write_summary(args.out / "long_run_block.json", summary, MPI.COMM_SELF)
 
 
 if __name__ == "__main__":

@@ -19,7 +19,6 @@ markdown table. Serial; about 10 minutes with the default scales on an idle mach
 
 from __future__ import annotations
 
-import json
 import math
 import sys
 import time
@@ -27,9 +26,9 @@ import time
 import numpy as np
 
 try:
-    from benchmarks._common import parser, save
+    from benchmarks._common import parser, save, write_summary
 except ImportError:  # run as a script from benchmarks/
-    from _common import parser, save  # type: ignore[no-redef]
+    from _common import parser, save, write_summary  # type: ignore[no-redef]
 
 
 def one_mesh(scale: float, mus: list[float], tol: float) -> dict:
@@ -89,7 +88,7 @@ def main() -> None:
                   "f_coupling_high_hz": [r["f_coupling_hz"][1] for r in rows]}
     observed = {k: rates(v, ratio) for k, v in quantities.items()}
     summary = {"rows": rows, "observed_rates": observed, "ratio": ratio}
-    (args.out / "squeal_convergence.json").write_text(json.dumps(summary, indent=1))
+    write_summary(args.out / "squeal_convergence.json", summary)
     print("| h / h₀ | dofs | f₁ [Hz] | f₂ [Hz] | μ_crit (FE) | f at onset [Hz] | μ_c (two modes) "
           "| μ_c (12 modes) | time [s] |")
     print("|---|---|---|---|---|---|---|---|---|")
