@@ -182,7 +182,7 @@ def _groups(x: np.ndarray, count: int) -> np.ndarray:
     """The group of each point: recursive coordinate bisection (at the median of the longest
     side) into at most ``count`` groups of nearly equal size."""
     group = np.zeros(len(x), dtype=np.int64)
-    todo = [np.arange(len(x))]
+    todo: list[np.ndarray] = [np.arange(len(x))]
     parts: list[np.ndarray] = []
     while todo:
         rows = todo.pop()
