@@ -165,7 +165,7 @@ def test_the_near_nullspace_is_the_rigid_motions_of_each_body():
         A.mult(z, Az)
         assert Az.norm() <= 1e-12 * scale * z.norm()  # a free elastic body does not resist
         # supported on one body only
-        values = z.getArray().reshape(-1, 2)
+        values = z.getArray(readonly=True).reshape(-1, 2)
         bodies_touched = np.unique(body[:owned][np.abs(values).max(axis=1) > 0])
         assert MPI.COMM_WORLD.allreduce(set(bodies_touched.tolist()), op=MPI.BOR) == {i // 3}
         for y in modes[:i]:
