@@ -141,13 +141,9 @@ class LinearForces(typing.NamedTuple):
 class Flexibilities(typing.NamedTuple):
     r"""The simplified theory's flexibilities [length/(force/length²)], one per component of the
     rigid slip: in adhesion the traction grows from the leading edge as
-    :math:`\partial p/\partial x = w/L`.
-
-    Attributes:
-        L1: for the longitudinal creepage ξ.
-        L2: for the lateral creepage η.
-        L3: for the spin's lateral slip φx (Kalker 1982: fitted to C23).
-        L4: for the spin's longitudinal slip -φy (fitted to C33; Kalker 1982 uses L3).
+    :math:`\partial p/\partial x = w/L`. ``L1`` for the longitudinal creepage ξ, ``L2`` for
+    the lateral creepage η, ``L3`` for the spin's lateral slip φx (Kalker 1982: fitted to
+    C23), ``L4`` for the spin's longitudinal slip -φy (fitted to C33; Kalker 1982 uses L3).
     """
 
     L1: float
