@@ -331,3 +331,14 @@ def test_a_flexibility_that_is_not_four_positive_numbers_is_refused(flexibility)
         flexibility = Flexibilities(*flexibility)
     with pytest.raises(ValueError, match="^flexibility="):
         fastsim(A, B, G, NU, MU, FN, xi=1e-3, flexibility=flexibility)
+
+
+@pytest.mark.parametrize("on", [(x, e, p) for x in (0, 1) for e in (0, 1) for p in (0, 1)])
+def test_every_combination_of_creepages_gives_finite_forces_and_a_spin_moment(on):
+    # any of xi, eta, phi zero: both theories answer (no None), and no creepage gives nothing
+    xi, eta, phi = (v * s for v, s in zip(on, (1e-3, -5e-4, 2.0), strict=True))
+    linear = linear_theory(A, B, G, NU, xi=xi, eta=eta, phi=phi)
+    simplified = fastsim(A, B, G, NU, MU, FN, xi=xi, eta=eta, phi=phi)
+    for forces in (linear, (simplified.Fx, simplified.Fy, simplified.Mz)):
+        assert all(isinstance(v, float) and math.isfinite(v) for v in forces)
+    assert (np.any(np.array(linear) != 0) and simplified.adhesion_fraction < 1) == any(on)
