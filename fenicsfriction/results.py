@@ -322,7 +322,7 @@ class SampledRecords:
         tail: how many of the last records are kept in full.
     """
 
-    def __init__(self, capacity: int = 20000, tail: int = 5000):
+    def __init__(self, capacity: int = 4000, tail: int = 2000):
         for name, value, low in (("capacity", capacity, 2), ("tail", tail, 0)):
             if value < low:
                 raise ValueError(f"{name}={value!r} is invalid: must be >= {low}")
