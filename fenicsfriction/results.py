@@ -75,8 +75,12 @@ class StderrHandler(logging.StreamHandler):
 
 
 class StdoutHandler(logging.StreamHandler):
-    """Like :class:`StderrHandler`, to the current ``sys.stdout``, and for the records below
-    WARNING only (progress): warnings and errors go to stderr."""
+    """The package logger's progress handler: the records below WARNING (warnings and errors
+    go to stderr), to the current ``sys.stdout`` or ``sys.stderr`` as :func:`get_logger` last
+    chose (``progress``)."""
+
+    #: "stdout" or "stderr"
+    target = "stderr"
 
     def __init__(self) -> None:
         super().__init__()
@@ -84,8 +88,8 @@ class StdoutHandler(logging.StreamHandler):
 
     @property
     def stream(self) -> typing.Any:
-        """The current ``sys.stdout``."""
-        return sys.stdout
+        """The current ``sys.stdout`` or ``sys.stderr``."""
+        return sys.stdout if StdoutHandler.target == "stdout" else sys.stderr
 
     @stream.setter
     def stream(self, value: typing.Any) -> None:
@@ -127,9 +131,21 @@ def quiet_jit() -> None:
             handler.setLevel(logging.WARNING)
 
 
-def get_logger(comm: MPI.Comm = MPI.COMM_WORLD) -> logging.Logger:
-    """The package logger: INFO on rank 0 (progress, to stdout), warnings only elsewhere (to
-    stderr). Also keeps the JIT compiler's build lines quiet (:func:`quiet_jit`)."""
+def get_logger(comm: MPI.Comm = MPI.COMM_WORLD, progress: str | None = None) -> logging.Logger:
+    """The package logger: INFO on rank 0, warnings only elsewhere. Also keeps the JIT
+    compiler's build lines quiet (:func:`quiet_jit`).
+
+    Args:
+        comm: the ranks; rank 0 reports progress.
+        progress: where the INFO records go, ``"stdout"`` (the command line: progress on
+            stdout, the one closing line on stderr) or ``"stderr"`` (the default, for scripts
+            that print their results to stdout); None keeps the last choice. Warnings and
+            errors go to stderr.
+    """
+    if progress is not None:
+        if progress not in ("stdout", "stderr"):
+            raise ValueError(f"progress={progress!r} is invalid: use 'stdout' or 'stderr'")
+        StdoutHandler.target = progress
     quiet_jit()
     logger = logging.getLogger("fenicsfriction")
     if not logger.handlers:

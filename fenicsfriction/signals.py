@@ -12,10 +12,13 @@ exits with :attr:`Interrupted.exit_code` (130 for SIGINT, 143 for SIGTERM). A se
 while the first is pending raises ``KeyboardInterrupt`` at once, for a run stuck in one step.
 
 The flag belongs to the process, not to one :class:`StopSignals`: the command line installs
-the handler first thing (:func:`catch`, before MPI, PETSc or dolfinx are imported), so a
-signal that comes while the model is being set up (imports, mesh, just-in-time compilation)
-is pending when the run's own :class:`StopSignals` opens, and :func:`checkpoint` raises it
-between the stages of the set-up. This module imports mpi4py only when a check needs it.
+the handler first thing (:func:`catch`, before MPI, PETSc or dolfinx are imported). Until the
+run's first :class:`StopSignals` opens (the set-up: imports, mesh, just-in-time compilation,
+the first steady state; or the whole of a command that has no steps to stop at) the handler
+raises :class:`Interrupted` at once (:func:`raise_at_once`), naming the last stage the
+set-up passed (:func:`checkpoint`); from then on it only sets the flag. A signal that comes
+before ``main`` (``python -m fenicsfriction``'s own imports) is pending, and raised at the
+first :func:`checkpoint`. This module imports mpi4py only when a check needs it.
 """
 
 from __future__ import annotations
@@ -28,13 +31,17 @@ if typing.TYPE_CHECKING:
     from mpi4py import MPI
 
 __all__ = ["Interrupted", "StopSignals", "catch", "checkpoint", "pending", "pending_on",
-           "release"]
+           "raise_at_once", "release"]
 
 #: SIGINT and SIGTERM, the signals turned into a flag
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 #: the first signal received and not yet handled (0: none); one per process
 _received = [0]
+#: raise at once (the set-up) rather than set the flag (a run with steps to stop at)
+_immediate = [False]
+#: the last stage of the set-up passed (:func:`checkpoint`), for the message
+_stage = ["the start"]
 
 
 class Interrupted(Exception):
@@ -53,6 +60,8 @@ class Interrupted(Exception):
 def _handler(signum: int, frame: types.FrameType | None) -> None:
     if _received[0]:  # a second signal: do not wait for the step to end
         raise KeyboardInterrupt
+    if _immediate[0]:
+        raise Interrupted(signum, _stage[0])
     _received[0] = signum
 
 
@@ -65,11 +74,19 @@ def catch() -> dict[int, typing.Any]:
     return {sig: signal.signal(sig, _handler) for sig in SIGNALS}
 
 
+def raise_at_once() -> None:
+    """From now until a :class:`StopSignals` opens, a signal raises :class:`Interrupted` in
+    the handler (the set-up of a command, whose stages need not check)."""
+    _immediate[0] = True
+
+
 def release(previous: dict[int, typing.Any]) -> None:
     """Put back the handlers :func:`catch` replaced, and forget a pending signal."""
     for sig, handler in previous.items():
         signal.signal(sig, handler)
     _received[0] = 0
+    _immediate[0] = False
+    _stage[0] = "the start"
 
 
 def pending() -> int:
@@ -108,6 +125,7 @@ def checkpoint(where: str, comm: MPI.Comm | None = None) -> None:
     if signum:
         _received[0] = 0  # handled: the caller reports it; a later signal starts afresh
         raise Interrupted(signum, where)
+    _stage[0] = where
 
 
 class StopSignals:
@@ -138,6 +156,7 @@ class StopSignals:
 
     def __enter__(self) -> StopSignals:
         self._previous = catch()
+        _immediate[0] = False  # the run's steps have begun: a signal waits for a check
         return self
 
     def __exit__(self, *exc: object) -> None:

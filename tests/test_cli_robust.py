@@ -223,7 +223,7 @@ import ufl
 from dolfinx import fem, mesh
 import fenicsfriction as ff
 from fenicsfriction import _compat
-log = ff.results.get_logger(MPI.COMM_WORLD)
+log = ff.results.get_logger(MPI.COMM_WORLD, progress="stdout")
 msh = mesh.create_unit_square(MPI.COMM_WORLD, 2, 2)
 V = _compat.vector_function_space(msh, 1)
 u = fem.Function(V)

@@ -79,9 +79,11 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``fenicsfriction`` console script and ``python -m fenicsfriction``.
 
     SIGINT and SIGTERM are caught from the first line (:func:`fenicsfriction.signals.catch`):
-    a signal during the set-up (imports, mesh, just-in-time compilation) stops the command at
-    the next stage with ``summary.json`` in ``--out`` saying so, one line and status 130/143;
-    one that comes after the run's last step is reported the same way, its results complete.
+    one during the start-up (flags, MPI, PETSc) waits for its end; one during the set-up
+    (mesh, just-in-time compilation, the first steady state; a command with no steps to stop
+    at) stops the command at once. Either way ``summary.json`` in ``--out`` says after which
+    stage, one line and status 130/143. During the run's steps a signal stops it at the next
+    step; after its last step the results are complete and the status is still 130/143.
     """
     previous = signals.catch()
     try:
@@ -111,10 +113,11 @@ def _main(argv: list[str]) -> int:
 
     from fenicsfriction.cli.common import stop_line
     from fenicsfriction.results import blas_library, get_logger
-    log = get_logger(MPI.COMM_WORLD)  # also keeps the JIT compiler's build lines quiet
+    log = get_logger(MPI.COMM_WORLD, progress="stdout")  # and quiets the JIT's build lines
     comm = MPI.COMM_WORLD
     try:
         signals.checkpoint("the start-up (flags read, MPI and PETSc loaded)", comm)
+        signals.raise_at_once()  # the set-up's stages need not check
         blas = blas_library()
         if blas["optimized"] is False:
             log.warning("fenicsfriction: the reference BLAS is in use (%s): direct solvers and "
@@ -125,9 +128,16 @@ def _main(argv: list[str]) -> int:
         if comm.rank == 0:
             print(f"fenicsfriction: error: {err}", file=sys.stderr, flush=True)
         return 2
+    except ImportError as err:  # a signal inside an extension module's initialisation
+        cause = err.__cause__ or err.__context__
+        if not isinstance(cause, signals.Interrupted):
+            raise
+        _setup_summary(args, argv, cause, comm)
+        stop_line(f"{cause}; the run had not begun its steps", comm)
+        return cause.exit_code
     except signals.Interrupted as err:  # in the set-up, before the run's own steps
         _setup_summary(args, argv, err, comm)
-        stop_line(f"{err}; nothing was computed", comm)
+        stop_line(f"{err}; the run had not begun its steps", comm)
         return err.exit_code
     signum = signals.pending_on(comm)
     if signum:  # came after the run's last check: everything is written
