@@ -15,7 +15,7 @@ The flag belongs to the process, not to one :class:`StopSignals`: the command li
 the handler first thing (:func:`catch`, before MPI, PETSc or dolfinx are imported). Until the
 run's first :class:`StopSignals` opens (the set-up: imports, mesh, just-in-time compilation,
 the first steady state; or the whole of a command that has no steps to stop at) the handler
-raises :class:`Interrupted` at once (:func:`raise_at_once`), naming the last stage the
+raises at once (:func:`raise_at_once`, serial runs), naming the last stage the
 set-up passed (:func:`checkpoint`); from then on it only sets the flag. A signal that comes
 before ``main`` (``python -m fenicsfriction``'s own imports) is pending, and raised at the
 first :func:`checkpoint`. This module imports mpi4py only when a check needs it.
@@ -30,8 +30,8 @@ import typing
 if typing.TYPE_CHECKING:
     from mpi4py import MPI
 
-__all__ = ["Interrupted", "StopSignals", "catch", "checkpoint", "pending", "pending_on",
-           "raise_at_once", "release"]
+__all__ = ["Interrupted", "SetUpInterrupt", "StopSignals", "catch", "checkpoint",
+           "interruption", "pending", "pending_on", "raise_at_once", "release"]
 
 #: SIGINT and SIGTERM, the signals turned into a flag
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
@@ -57,11 +57,36 @@ class Interrupted(Exception):
         return 128 + self.signum
 
 
+class SetUpInterrupt(BaseException):
+    """What the handler raises during the set-up (:func:`raise_at_once`): a ``BaseException``,
+    like ``KeyboardInterrupt``, so that no ``except Exception`` on the way (a mesh generator's
+    error report, a solver's) turns it into a failure; ``interrupted`` is the
+    :class:`Interrupted` to report."""
+
+    def __init__(self, interrupted: Interrupted):
+        super().__init__(str(interrupted))
+        self.interrupted = interrupted
+
+
+def interruption(error: BaseException | None) -> Interrupted | None:
+    """The :class:`Interrupted` that ``error`` is, wraps or was raised from (a PETSc error
+    whose callback was interrupted, an import interrupted in its initialisation), or None."""
+    seen: set[int] = set()
+    while error is not None and id(error) not in seen:
+        if isinstance(error, Interrupted):
+            return error
+        if isinstance(error, SetUpInterrupt):
+            return error.interrupted
+        seen.add(id(error))
+        error = error.__cause__ or error.__context__
+    return None
+
+
 def _handler(signum: int, frame: types.FrameType | None) -> None:
     if _received[0]:  # a second signal: do not wait for the step to end
         raise KeyboardInterrupt
     if _immediate[0]:
-        raise Interrupted(signum, _stage[0])
+        raise SetUpInterrupt(Interrupted(signum, _stage[0]))
     _received[0] = signum
 
 
@@ -74,10 +99,18 @@ def catch() -> dict[int, typing.Any]:
     return {sig: signal.signal(sig, _handler) for sig in SIGNALS}
 
 
-def raise_at_once() -> None:
-    """From now until a :class:`StopSignals` opens, a signal raises :class:`Interrupted` in
-    the handler (the set-up of a command, whose stages need not check)."""
-    _immediate[0] = True
+def raise_at_once(comm: MPI.Comm | None = None) -> None:
+    """From now until a :class:`StopSignals` opens, a signal raises :class:`SetUpInterrupt` in
+    the handler (the set-up of a command, whose stages need not check).
+
+    Serial runs only: under MPI a rank interrupted outside a collective call would leave the
+    others waiting in it, so there the signal stays a flag, agreed on at the next
+    :func:`checkpoint` or step.
+    """
+    if comm is None:
+        from mpi4py import MPI
+        comm = MPI.COMM_WORLD
+    _immediate[0] = comm.size == 1
 
 
 def release(previous: dict[int, typing.Any]) -> None:

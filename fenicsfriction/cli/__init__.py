@@ -117,7 +117,7 @@ def _main(argv: list[str]) -> int:
     comm = MPI.COMM_WORLD
     try:
         signals.checkpoint("the start-up (flags read, MPI and PETSc loaded)", comm)
-        signals.raise_at_once()  # the set-up's stages need not check
+        signals.raise_at_once(comm)  # the set-up's stages need not check
         blas = blas_library()
         if blas["optimized"] is False:
             log.warning("fenicsfriction: the reference BLAS is in use (%s): direct solvers and "
@@ -128,17 +128,13 @@ def _main(argv: list[str]) -> int:
         if comm.rank == 0:
             print(f"fenicsfriction: error: {err}", file=sys.stderr, flush=True)
         return 2
-    except ImportError as err:  # a signal inside an extension module's initialisation
-        cause = err.__cause__ or err.__context__
-        if not isinstance(cause, signals.Interrupted):
+    except BaseException as err:  # a signal in the set-up, before the run's own steps
+        interrupted = signals.interruption(err)  # also inside an import or a PETSc callback
+        if interrupted is None:
             raise
-        _setup_summary(args, argv, cause, comm)
-        stop_line(f"{cause}; the run had not begun its steps", comm)
-        return cause.exit_code
-    except signals.Interrupted as err:  # in the set-up, before the run's own steps
-        _setup_summary(args, argv, err, comm)
-        stop_line(f"{err}; the run had not begun its steps", comm)
-        return err.exit_code
+        _setup_summary(args, argv, interrupted, comm)
+        stop_line(f"{interrupted}; the run had not begun its steps", comm)
+        return interrupted.exit_code
     signum = signals.pending_on(comm)
     if signum:  # came after the run's last check: everything is written
         stop_line(f"{signals.Interrupted(signum, 'the run had finished')}; its results are "
