@@ -167,23 +167,28 @@ def test_record_every_k_writes_every_kth_step_and_keeps_statistics_of_all(shared
     thinned = _table(shared_tmp_path / "k7" / "timeseries.csv")
     assert len(full) == 31
     assert [r["time"] for r in thinned] == [full[i]["time"] for i in [*range(0, 31, 7), 30]]
-    assert thinned[3]["normal_force"] == full[21]["normal_force"]
+    # the same steps; under MPI two runs differ by the round-off of parallel assembly, which
+    # Newton's tolerance (1e-10 of the load) lets through: 1e-7 relative between the runs
+    between = 1e-7
+    assert thinned[3]["normal_force"] == pytest.approx(full[21]["normal_force"], rel=between)
     t = np.array([r["time"] for r in full])
-    for name in ("k1", "k7"):
+    for name, rel in (("k1", 1e-12), ("k7", between)):
         summary = json.loads((shared_tmp_path / name / "summary.json").read_text())
         stats = summary["running_statistics"]
         assert stats["records"] == 31 and summary["steps"] == 30
         for key in ("normal_force", "energy_error", "spring_elongation"):
             x = np.array([r[key] for r in full])
-            got = stats["fields"][key]
-            assert got["min"] == pytest.approx(x.min(), rel=1e-12, abs=1e-300)
-            assert got["max"] == pytest.approx(x.max(), rel=1e-12, abs=1e-300)
-            assert got["max_abs"] == pytest.approx(np.abs(x).max(), rel=1e-12, abs=1e-300)
-            assert got["mean"] == pytest.approx(trapezoid(x, t) / (t[-1] - t[0]), rel=1e-12)
+            got, scale = stats["fields"][key], np.abs(x).max()
+            close = {"rel": rel, "abs": rel * scale}
+            assert got["min"] == pytest.approx(x.min(), **close)
+            assert got["max"] == pytest.approx(x.max(), **close)
+            assert got["max_abs"] == pytest.approx(scale, **close)
+            assert got["mean"] == pytest.approx(trapezoid(x, t) / (t[-1] - t[0]), **close)
         assert summary["statistics"]["max_energy_error"] == pytest.approx(
-            np.abs([r["energy_error"] for r in full]).max(), rel=1e-12)
-        assert summary["statistics"]["newton_iterations"] == sum(
-            int(r["newton_iterations"]) for r in full)
+            np.abs([r["energy_error"] for r in full]).max(), rel=rel)
+        if name == "k1":  # the same run's table
+            assert summary["statistics"]["newton_iterations"] == sum(
+                int(r["newton_iterations"]) for r in full)
 
 
 def test_running_statistics_window_and_counters_match_numpy():
