@@ -83,7 +83,9 @@ def main() -> None:
                             "rss_mb": status.get("VmRSS"), "peak_mb": status.get("VmHWM")})
         time.sleep(args.every)
     stderr = child.stderr.read() if child.stderr else ""
-    late = [s for s in samples[len(samples) // 2:] if s["steps"] > 0]
+    # the stepping's second half (the figures and statistics at the end are not growth)
+    done = samples[-1]["steps"] if samples else 0
+    late = [s for s in samples[len(samples) // 2:] if 0 < s["steps"] < done]
     slope = None
     if len(late) >= 2 and late[-1]["steps"] > late[0]["steps"]:
         fit = np.polyfit([s["steps"] for s in late], [s["rss_mb"] for s in late], 1)

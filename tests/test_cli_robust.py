@@ -114,9 +114,11 @@ def test_an_onset_tolerance_below_round_off_is_refused(shared_tmp_path, capsys):
 
 # --- signals from the first line ------------------------------------------------------------------
 
-#: a child that says when the interpreter is up, then runs ``python -m fenicsfriction ARGS``:
-#: the delays below count from there (before it, Python's own start-up cannot be caught)
-_LAUNCH = ("import runpy, sys; print('up', flush=True); sys.argv[0] = 'fenicsfriction'; "
+#: a child that says when the interpreter is up and the package's (3 ms) top level loaded,
+#: then runs ``python -m fenicsfriction ARGS``: the delays below count from there (before
+#: it, Python's own start-up cannot be caught; on a loaded machine it can take 0.1 s)
+_LAUNCH = ("import runpy, sys; import fenicsfriction.signals; print('up', flush=True); "
+           "sys.argv[0] = 'fenicsfriction'; "
            "runpy.run_module('fenicsfriction', run_name='__main__', alter_sys=True)")
 
 
