@@ -16,6 +16,8 @@ import numpy as np
 import pytest
 from scipy.integrate import trapezoid
 
+from cli_errors import assert_one_error_line
+
 from fenicsfriction.cli import main
 
 REQUIRED = {"mu", "normal_force", "friction_force", "spring_force", "centre_of_pressure",
@@ -109,6 +111,24 @@ def test_dynamics_cli_writes_a_time_series_whose_energy_balance_closes(out_dir):
         # the normal damping b_n d^{l_n} u̇_n adds to N while the block moves
         damped += abs(float(r["normal_force"]) - float(r["normal_force_elastic"])) > 1e-3
     assert damped > len(rows) // 2  # the damping part is present while the block moves
+
+
+def test_dynamics_beyond_the_tipping_limit_is_refused_in_one_line_before_any_work(tmp_path,
+                                                                                   capsys):
+    """μ = 2 > 1.5625: the block would tip, no steady sliding exists to start from. The limit
+    is the moment balance about the outermost contact point, μ W h_s = W (L/2 − s_1), with
+    s_1 the inset of the contact rule's first point: the 5-point Gauss-Legendre rule's
+    tabulated node ±0.9061798459, so s_1 = (1 − 0.9061798459)/2 of the L/4 facet."""
+    L, h_s = 48.8, 30.5 / 2
+    limit = (L / 2 - (1 - 0.9061798459) / 2 * L / 4) / h_s
+    out = tmp_path / "tipped"
+    assert main(["block", "dynamics", "--mu", "2.0", "--t-end", "1e-3", "--out",
+                 str(out)]) == 2
+    err = capsys.readouterr().err
+    assert_one_error_line(err, "--mu")
+    if MPI.COMM_WORLD.rank == 0:
+        assert "--mu=2.0" in err and f"{limit:.6g}" in err
+    assert not out.exists()  # refused before the output folder, the mesh and the solves
 
 
 def test_steady_cli_stops_at_discrete_tipping_limit_and_reports_it(out_dir):

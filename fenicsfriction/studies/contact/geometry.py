@@ -183,14 +183,16 @@ def _flat(box: list[float], axis: int, value: float, tol: float) -> bool:
 
 
 def _refine_near_origin(gmsh: typing.Any, h_contact: float, h_far: float, half_width: float,
-                        grading: float) -> None:
-    """Mesh size ``h_contact`` in the box |x|, |y|, |z| <= ``half_width``, growing linearly with
-    the distance from it (by ``grading`` per unit length) up to ``h_far``."""
+                        grading: float, depth: float | None = None) -> None:
+    """Mesh size ``h_contact`` in the box |x|, |y| <= ``half_width``, |z| <= ``depth``
+    (default ``half_width``), growing linearly with the distance from it (by ``grading`` per
+    unit length) up to ``h_far``."""
+    depth = half_width if depth is None else depth
     field = gmsh.model.mesh.field
     box = field.add("Box")
     for key, value in (("VIn", h_contact), ("VOut", h_far), ("XMin", -half_width),
                        ("XMax", half_width), ("YMin", -half_width), ("YMax", half_width),
-                       ("ZMin", -half_width), ("ZMax", half_width),
+                       ("ZMin", -depth), ("ZMax", depth),
                        ("Thickness", (h_far - h_contact) / grading)):
         field.setNumber(box, key, value)
     field.setAsBackgroundMesh(box)
