@@ -14,9 +14,8 @@ from mpi4py import MPI
 
 import numpy as np
 import pytest
-from scipy.integrate import trapezoid
-
 from cli_errors import assert_one_error_line
+from scipy.integrate import trapezoid
 
 from fenicsfriction.cli import main
 
