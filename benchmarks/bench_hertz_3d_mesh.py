@@ -20,6 +20,7 @@ markdown table. Serial; the ladder takes about 10 minutes on one core (a/20: 32,
 
 from __future__ import annotations
 
+import sys
 import time
 
 from mpi4py import MPI
@@ -28,12 +29,15 @@ import numpy as np
 from _common import parser as benchmark_parser
 from _common import save, write_summary
 
+from fenicsfriction.steady import SolveError
 from fenicsfriction.studies.contact import geometry
 from fenicsfriction.studies.contact.validation import Hertz
 
-#: name: (h_contact, refine_half_width, refine_depth) per unit R; depth None: the default cube
+#: name: (h_contact, refine_half_width, refine_depth) per unit R; depth None: the default cube.
+#: (a/15 is h = 0.0067 R: at 0.02/3 R the first solve's Newton line search diverges after 29
+#: iterations, residual 7.4e-5)
 LEVELS = {"a/5 (default)": (0.02, 0.25, None), "a/10 slab": (0.01, 0.14, 0.03),
-          "a/15 slab": (0.02 / 3, 0.14, 0.03), "a/20 slab": (0.005, 0.13, 0.025)}
+          "a/15 slab": (0.0067, 0.14, 0.03), "a/20 slab": (0.005, 0.13, 0.025)}
 
 
 def run(name: str) -> dict:
@@ -65,8 +69,17 @@ def main() -> None:
                        help="comma-separated rungs (default: all)")
     args = flags.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
-    rows = [run(name) for name in args.levels.split(",")]
-    write_summary(args.out / "bench_hertz_3d_mesh.json", {"rows": rows})
+    rows = []
+    for name in args.levels.split(","):
+        print(f"{name} ...", file=sys.stderr, flush=True)
+        try:
+            rows.append(run(name))
+        except SolveError as err:  # recorded, the ladder goes on
+            print(f"{name}: {err}", file=sys.stderr, flush=True)
+            rows.append({"level": name, "failure": str(err)})
+        write_summary(args.out / "bench_hertz_3d_mesh.json", {"rows": rows})
+    failed = [r for r in rows if "failure" in r]
+    rows = [r for r in rows if "failure" not in r]
     print("| mesh | unknowns | contact radius | peak nodal pressure | fitted a / p0 "
           "| nodal scatter rms / max (r < 0.8a) | Newton | wall time (s) |\n"
           "|---|---|---|---|---|---|---|---|")
@@ -75,6 +88,8 @@ def main() -> None:
               f"| {r['max_pressure_error']:+.1%} | {r['fitted_contact_radius_error']:+.2%} / "
               f"{r['fitted_max_pressure_error']:+.2%} | {r['scatter_rms']:.1%} / "
               f"{r['scatter_max']:.1%} | {r['newton_iterations']} | {r['wall_time_s']:.0f} |")
+    for r in failed:
+        print(f"| {r['level']} | failed: {r['failure']} |")
 
     import matplotlib
     matplotlib.use("Agg")
