@@ -176,14 +176,15 @@ def test_dynamics_beyond_the_tipping_limit_is_refused_in_one_line_before_any_wor
     tabulated node ±0.9061798459, so s_1 = (1 − 0.9061798459)/2 of the L/4 facet."""
     L, h_s = 48.8, 30.5 / 2
     limit = (L / 2 - (1 - 0.9061798459) / 2 * L / 4) / h_s
-    out = tmp_path / "tipped"
-    assert main(["block", "dynamics", "--mu", "2.0", "--t-end", "1e-3", "--out",
-                 str(out)]) == 2
-    err = capsys.readouterr().err
-    assert_one_error_line(err, "--mu")
-    if MPI.COMM_WORLD.rank == 0:
-        assert "--mu=2.0" in err and f"{limit:.6g}" in err
-    assert not out.exists()  # refused before the output folder, the mesh and the solves
+    for mu in ("2.0", "1.58"):  # 1.58: past the mesh's limit, short of L/(2 h_s) = 1.6
+        out = tmp_path / f"tipped-{mu}"
+        assert main(["block", "dynamics", "--mu", mu, "--t-end", "1e-3", "--out",
+                     str(out)]) == 2
+        err = capsys.readouterr().err
+        assert_one_error_line(err, "--mu")
+        if MPI.COMM_WORLD.rank == 0:
+            assert f"--mu={mu}" in err and f"{limit:.6g}" in err
+        assert not out.exists()  # refused before the output folder, the mesh and the solves
 
 
 def test_steady_cli_stops_at_discrete_tipping_limit_and_reports_it(out_dir):
