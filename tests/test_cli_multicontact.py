@@ -61,6 +61,28 @@ def test_master_equation_conserves_the_contacts(shared_tmp_path):
     assert summary["kinetic_force"] == pytest.approx(1000 * (1 + 0.09) / 2, rel=1e-3)
 
 
+def test_master_equation_reports_each_figure_as_its_name_says(shared_tmp_path):
+    """The defaults (N = 1000, σ = 0.1 x_c, five lives): every key of multicontact.json
+    against its definition, by a closed form or recomputed from the stored X, F, x, Q."""
+    out = shared_tmp_path / "me-names"
+    assert main(["multicontact", "master-equation", "--out", str(out)]) == 0
+    s = _json(out)
+    X, F, x, Q, h = (np.array(s[key]) for key in ("X", "F", "x", "Q", "h"))
+    assert s["h"] == 0.01 and s["parameters"]["N"] == 1000 and s["parameters"]["x_s_std"] == 0.1
+    # kinetic: the sliding state, N k ⟨x_s²⟩/(2⟨x_s⟩) = 1000 (1 + 0.01)/2 (the truncation at
+    # x_s > 0 is 1e-23 at 10σ), to the scheme's O(h²) = 1.7e-5
+    assert s["kinetic_force"] == pytest.approx(505.0, rel=1e-4)
+    # the transient's end, named apart: F and N k Σ x Q at X_max = 5 x_c, still 2.5 % above
+    assert s["X_max"] == X[-1] == 5.0
+    assert s["force_at_X_max"] == F[-1] == pytest.approx(1000 * float(x @ Q), rel=1e-14)
+    assert s["force_at_X_max"] / s["kinetic_force"] - 1 == pytest.approx(0.025, abs=0.002)
+    assert s["static_force"] == F.max()
+    assert s["K_star"] == pytest.approx(-np.min(np.gradient(F, h)), rel=1e-14)
+    assert abs(Q.sum() - 1) <= s["mass_error"] < 1e-12
+    rows = np.loadtxt(out / "force.csv", delimiter=",", skiprows=1)
+    np.testing.assert_array_equal(rows, np.column_stack([X, F]))
+
+
 def test_stability_map_is_smooth_well_above_K_star_and_stick_slip_well_below(shared_tmp_path):
     out = shared_tmp_path / "map"
     assert main(["multicontact", "stability-map", "--N", "300", "--K", "25,1000", "--spreads",

@@ -432,6 +432,11 @@ def run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
     check("--stride", args.stride, args.stride >= 1, "must be >= 1")
     check("--record-every", args.record_every, args.record_every >= 1, "must be >= 1")
     scene = _scene(args, mu=args.mu)
+    # beyond the tipping limit no steady sliding exists to start from: refuse before meshing
+    check("--mu", args.mu, args.mu < scene.discrete_tipping_limit,
+          f"must be < {scene.discrete_tipping_limit:.6g}, the tipping limit of this block "
+          f"(L/(2 h_s) = {scene.tipping_limit:.6g}, less the outermost contact point's inset): "
+          "beyond it no steady sliding exists to start the dynamics from")
     check("--scheme", args.scheme, args.scheme == "alpha2" or args.scene == "block",
           f"the scene {args.scene} needs alpha2 (central differences have no contact "
           "couplings)")

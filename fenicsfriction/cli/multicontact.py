@@ -185,7 +185,8 @@ def _run_eq(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> in
     me = MasterEquation(model, args.h).solve(X_max)
     summary = {"command": "eq", **_record(run), "K_star": me.K_star,
                "master_equation": {"kinetic_force": me.kinetic_force,
-                                   "static_force": me.static_force, "h": me.h}}
+                                   "static_force": me.static_force, "X_max": me.X_max,
+                                   "force_at_X_max": me.force_at_X_max, "h": me.h}}
     results.write_summary(out / "multicontact.json", summary, comm)
     write_rows(out / "force.csv", ({"X": x, "F": f, "F_std": e}
                              for x, f, e in zip(run.X, run.F, run.F_std, strict=True)), comm)
@@ -221,7 +222,9 @@ def _run_master_equation(args: argparse.Namespace, log: logging.Logger, comm: MP
     write_rows(out / "force.csv", ({"X": x, "F": f} for x, f in zip(me.X, me.F, strict=True)), comm)
     if comm.rank == 0:
         figures.master_equation_figure(me, out / "master_equation.png")
-    log.info(f"static force {me.static_force:.6g}, kinetic {me.kinetic_force:.6g}, "
+    log.info(f"static force {me.static_force:.6g}, kinetic (steady state) "
+             f"{me.kinetic_force:.6g}, force at X_max = {me.X_max:g} {me.force_at_X_max:.6g} "
+             f"({me.force_at_X_max / me.kinetic_force - 1:+.2%} from kinetic), "
              f"K* = {me.K_star:.6g}, mass error {me.mass_error:.1e}; results in {out}/: "
              "multicontact.json, force.csv, master_equation.png")
     return 0
