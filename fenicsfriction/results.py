@@ -149,12 +149,12 @@ def get_logger(comm: MPI.Comm = MPI.COMM_WORLD, progress: str | None = None) -> 
     quiet_jit()
     logger = logging.getLogger("fenicsfriction")
     if not logger.handlers:
-        progress = StdoutHandler()
-        progress.setFormatter(logging.Formatter("%(message)s"))
+        to_stdout = StdoutHandler()
+        to_stdout.setFormatter(logging.Formatter("%(message)s"))
         warnings = StderrHandler()
         warnings.setLevel(logging.WARNING)
         warnings.setFormatter(logging.Formatter("%(message)s"))
-        logger.addHandler(progress)
+        logger.addHandler(to_stdout)
         logger.addHandler(warnings)
         logger.propagate = False
     logger.setLevel(logging.INFO if comm.rank == 0 else logging.WARNING)
