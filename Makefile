@@ -17,6 +17,10 @@ BENCH_PACKAGES := python3-getfem
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 MPIRUN := mpirun -n $(NP) $(shell [ "$$(id -u)" = 0 ] && echo --allow-run-as-root) --oversubscribe
 export OMPI_MCA_rmaps_base_oversubscribe := 1
+# a pass takes about 8 min on 2 cores; past PASS_LIMIT it has hung (each test has its own
+# 600 s limit, but a worker killed by it can leave pytest-xdist waiting): stop it and fail
+PASS_LIMIT ?= 1200
+GUARD := timeout --kill-after=30 $(PASS_LIMIT)
 export PYTHONDONTWRITEBYTECODE := 1
 
 .PHONY: setup demo lint docs test test-serial test-mpi test-debian13 benchmark clean
@@ -54,10 +58,12 @@ lint: setup
 # the serial pass on every core (pytest-xdist), one test file per worker so that a module's
 # fixtures are built once; the MPI pass cannot share its ranks' cores and runs as one job
 test-serial: setup
-	$(PY) -m pytest -q --durations=25 -n $(NP) --dist loadfile tests
+	$(GUARD) $(PY) -m pytest -q --durations=25 -n $(NP) --dist loadfile tests \
+	    || { rc=$$?; [ $$rc != 124 ] || echo "test-serial: stopped after $(PASS_LIMIT) s" >&2; exit $$rc; }
 
 test-mpi: setup
-	$(MPIRUN) $(PY) -m mpi4py -m pytest -q --durations=25 --with-mpi tests
+	$(GUARD) $(MPIRUN) $(PY) -m mpi4py -m pytest -q --durations=25 --with-mpi tests \
+	    || { rc=$$?; [ $$rc != 124 ] || echo "test-mpi: stopped after $(PASS_LIMIT) s" >&2; exit $$rc; }
 
 # the HTML documentation (Sphinx + MyST, Debian's packages, nothing downloaded), warnings as errors
 docs: setup
