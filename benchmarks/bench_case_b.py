@@ -208,7 +208,8 @@ def plot(rigid: list[dict], fe: list[dict], path: pathlib.Path) -> None:
                    color="C3" if r["sticks"] else "C0", s=60)
     for name, K in K_READINGS.items():
         ax.axvline(K, color="0.7", lw=0.8)
-        ax.text(K, 0.3, name, rotation=90, fontsize=7, va="top")
+        ax.text(K, 0.98, name, rotation=90, fontsize=7, va="top",
+                transform=ax.get_xaxis_transform())
     ax.set(xscale="log", xlabel="K_x [10³ kg s⁻²]", ylabel="belt speed U [cm/s]",
            title="rigid block, Fig. 13 data: o stick (case b), x no stick")
     for r in [*plane, *fe]:
