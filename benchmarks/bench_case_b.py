@@ -241,6 +241,13 @@ def row(r: dict[str, typing.Any]) -> str:
             f"{e[0]:.4f}, {e[1]:.4f}, {e[2]:.4f} | {r['wall_time_s']:.0f} |")
 
 
+def keep(r: dict[str, typing.Any], out: pathlib.Path) -> None:
+    """Append a finished run to ``case_b_runs.jsonl`` (what a stopped study has done)."""
+    if MPI.COMM_WORLD.rank == 0:
+        with open(out / "case_b_runs.jsonl", "a") as f:
+            f.write(json.dumps(r) + "\n")
+
+
 def parse_points(text: str, dt: float, t_end: float) -> list[Point]:
     """'K:U[:ε[:b_n[:μ[:t_end]]]]' separated by commas (ValueError if malformed)."""
     points = []
@@ -298,11 +305,13 @@ def main(argv: list[str] | None = None) -> None:
         for r in pool.imap_unordered(_rigid_job, [(p, args.stick_min) for p in points]):
             rigid.append(r)
             print(row(r), flush=True)
+            keep(r, args.out)
     rigid_wall = time.perf_counter() - t0
     fe = []
     for p in lists["fe_points"]:
         fe.append(run_fe(p, args.stick_min, MPI.COMM_WORLD))
         print(row(fe[-1]), flush=True)
+        keep(fe[-1], args.out)
     summary = {"stick_min": args.stick_min, "K_readings": K_READINGS,
                "rigid_wall_time_s": rigid_wall, "rigid": rigid, "fe": fe}
     if MPI.COMM_WORLD.rank == 0:
