@@ -16,7 +16,7 @@ import scipy.optimize
 
 import fenicsfriction as ff
 from fenicsfriction.stability import StabilitySolver
-from fenicsfriction.studies.block import RigidBlock
+from fenicsfriction.studies.block import RigidBlock, rigid_block_observables
 from fenicsfriction.studies.block.rigid import rigid_loci
 from fenicsfriction.timestepping import ReducedDynamics
 
@@ -307,3 +307,25 @@ def test_block_reaches_the_belt_and_sticks_exactly_when_the_closed_form_says():
     capacity = law.friction_coefficient(eps)
     duration = ((capacity - mu_k) * W / block.K_x + np.sqrt(xi0**2 - (U / omega) ** 2)) / U
     assert np.sum(np.diff(t)[stuck[1:]]) == pytest.approx(duration, rel=1e-2)
+
+
+def test_rigid_observables_tell_stick_from_slip_by_the_slip_against_eps():
+    """``rigid_block_observables``: the base sticks when |w| < ε, w = u̇_xG + θ̇ H/2 - U (the
+    rotation's share included), slips otherwise, is open when lifted; the friction force is
+    the C1 law's -μ N w/ε inside the band and -μ N sgn(w) outside (N the elastic normal force;
+    no normal damping here). ε, U and μ are away from 1 and from each other."""
+    eps, U, mu = 2e-3, 0.3, 0.4
+    block = RigidBlock(belt_speed=U, law=ff.InterfaceLaw(mu=mu, eps=eps))
+    q = block.steady_state()
+    h2 = block.H / 2
+    for q_dot, ratio in (([U + 0.9 * eps, 0, 0], 0.9), ([U - 0.9 * eps, 0, 0], -0.9),
+                         ([U + 1.1 * eps, 0, 0], 1.1), ([U - 1.1 * eps, 0, 0], -1.1),
+                         ([U, 0, 0.95 * eps / h2], 0.95), ([U, 0, -1.05 * eps / h2], -1.05)):
+        seen = rigid_block_observables(block, q, np.array(q_dot, float))
+        assert seen["slip_velocity"] == pytest.approx(ratio * eps, rel=1e-9)
+        assert seen["contact"] == ("stick" if abs(ratio) < 1 else "slip")
+        coulomb = -mu * seen["normal_force_elastic"]
+        assert seen["friction_force"] == pytest.approx(
+            coulomb * (ratio if abs(ratio) < 1 else np.sign(ratio)), rel=1e-9)
+    lifted = rigid_block_observables(block, np.array([q[0], 1e-3, 0.0]), np.zeros(3))
+    assert lifted["contact"] == "open" and lifted["normal_force"] == 0.0
