@@ -89,14 +89,17 @@ def run(nx: int, ny: int, dt: float, seed: int, args, comm: MPI.Comm) -> dict:
 
 
 def richardson(q: list[float]) -> dict:
-    """Observed order and extrapolated value of three levels refined by 2 each."""
-    d1, d2 = q[0] - q[1], q[1] - q[2]
-    if d1 * d2 <= 0 or not math.isfinite(d1 / d2):
+    """Observed order p and extrapolated value q₃ − (q₂ − q₃) / (2ᵖ − 1) of three levels
+    q = q* + C hᵖ refined by 2 each; ``nan`` unless the differences keep their sign and
+    shrink (p > 0): then the levels are not in the asymptotic range."""
+    if len(q) != 3:
         return {"values": q, "order": float("nan"), "extrapolated": float("nan"),
-                "monotone": False, "spread": max(q) - min(q)}
-    p = math.log2(d1 / d2)
-    return {"values": q, "order": p, "extrapolated": q[2] + d2 / (2**p - 1) if p != 0
-            else float("nan"), "monotone": True, "spread": max(q) - min(q)}
+                "monotone": False, "spread": max(q, default=0.0) - min(q, default=0.0)}
+    d1, d2 = q[0] - q[1], q[1] - q[2]
+    p = math.log2(d1 / d2) if d1 * d2 > 0 else float("nan")
+    converging = math.isfinite(p) and p > 0
+    return {"values": q, "order": p, "extrapolated": q[2] - d2 / (2**p - 1) if converging
+            else float("nan"), "monotone": d1 * d2 > 0, "spread": max(q) - min(q)}
 
 
 def main() -> int:
@@ -115,7 +118,7 @@ def main() -> int:
     comm = MPI.COMM_WORLD
     seeds = [int(v) for v in args.seeds.split(",")]
     meshes = [tuple(int(v) for v in m.split("x")) for m in args.meshes.split(",")]
-    steps = [float(v) for v in args.steps.split(",")]
+    steps = [float(v) for v in args.steps.split(",") if v]
     dt_mesh = tuple(int(v) for v in args.dt_mesh.split("x"))
     runs: dict[tuple, list[dict]] = {}
 
@@ -129,7 +132,7 @@ def main() -> int:
                           file=sys.stderr, flush=True)
         return runs[nx, ny, dt]
 
-    studies = {"time_step": [level(*dt_mesh, dt) for dt in steps],
+    studies = {"time_step": [level(*dt_mesh, dt) for dt in steps if dt > 0],
                "mesh": [level(nx, ny, args.mesh_dt) for nx, ny in meshes]}
     summary = {name: {q: richardson([float(np.mean([r[q] for r in lv])) for lv in levels])
                       for q in QUANTITIES} for name, levels in studies.items()}

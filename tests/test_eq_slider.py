@@ -209,7 +209,10 @@ def test_patched_thresholds_are_the_same_realisation_on_every_mesh():
                           fine.draw_threshold(4 * j, np.zeros(11)))
     # within a patch one value, patch to patch another, each re-formation a new draw
     values = fine.draw_threshold(np.arange(41), np.zeros(41))
-    assert len(np.unique(values)) == 5 and len(np.unique(values[:8])) == 1
+    # patch m is [m L/5, (m + 1) L/5): nodes 8m to 8m + 7, the far-edge node in the last
+    assert len(np.unique(values)) == 5 and values[40] == values[32]
+    assert all(len(np.unique(values[8 * m:8 * m + 8])) == 1 for m in range(5))
+    assert np.all(values[8:40:8] != values[7:39:8])
     assert fine.draw_threshold(np.array([3]), np.array([1]))[0] != values[3]
     with pytest.raises(ValueError, match="patches"):
         ElasticSlider(nx=10, patches=3)
