@@ -91,13 +91,13 @@ def run(nx: int, ny: int, dt: float, seed: int, args, comm: MPI.Comm) -> dict:
 def richardson(q: list[float]) -> dict:
     """Observed order p and extrapolated value q₃ − (q₂ − q₃) / (2ᵖ − 1) of three levels
     q = q* + C hᵖ refined by 2 each; ``nan`` unless the differences keep their sign and
-    shrink (p > 0): then the levels are not in the asymptotic range."""
+    shrink (observed p > 0.5), else the levels are not in the asymptotic range."""
     if len(q) != 3:
         return {"values": q, "order": float("nan"), "extrapolated": float("nan"),
                 "monotone": False, "spread": max(q, default=0.0) - min(q, default=0.0)}
     d1, d2 = q[0] - q[1], q[1] - q[2]
     p = math.log2(d1 / d2) if d1 * d2 > 0 else float("nan")
-    converging = math.isfinite(p) and p > 0
+    converging = math.isfinite(p) and p > 0.5  # below: not yet in the asymptotic range
     return {"values": q, "order": p, "extrapolated": q[2] - d2 / (2**p - 1) if converging
             else float("nan"), "monotone": d1 * d2 > 0, "spread": max(q) - min(q)}
 
