@@ -12,9 +12,8 @@ What makes the quantities converge (``--viscosity``, ``--spread``, ``--patches``
 * every break radiates waves; undamped (generalized-α at spectral radius 1 keeps them all),
   they ring at ±30 N/m in the push force forever, the peak force is the largest of that noise
   and the contacts near their thresholds break on its crests: a Kelvin-Voigt relaxation time
-  τ (``--viscosity``, default 2 µs: a wave of 2 mm, the finest mesh's scale, loses ωτ/2 ≈ 1
-  of critical damping, the slider's first modes < 2 %) makes them decay, a physical model
-  whose limit exists;
+  τ (``--viscosity``, default 2 µs: a 2 mm shear wave has ωτ/2 ≈ 2, overdamped; the
+  slider's first modes ωτ/2 ≈ 0.01) makes them decay, a physical model whose limit exists;
 * random thresholds drawn per node are a different realisation on every mesh: ``--spread 0``
   (default: all thresholds x̄_s) or thresholds shared by ``--patches`` patches of the base
   (the same realisation on every mesh), averaged over ``--seeds`` realisations.
@@ -29,8 +28,10 @@ p = log₂(|q₁ − q₂| / |q₂ − q₃|) and q₃ + (q₃ − q₂) / (2ᵖ
 differences change sign.
 
 Writes ``bench_slider.json`` and ``bench_slider.png`` (push force against time, per level) to
-``--out``. Serial or under MPI (the history is the same on any number of ranks). About 3
-minutes on a free core with the defaults (the 80 × 8 mesh is two thirds of it).
+``--out``. Serial or under MPI (the history is the same on any number of ranks). About 4
+minutes with the defaults on the shared 2-core machine (the 80 × 8 mesh 1.6 min, 0.5 µs on
+40 × 4 1.3 min); ``--meshes 40x4,80x8,160x16 --steps ""`` (the mesh study one level finer)
+takes 19 min (160 × 16: 15 min).
 """
 
 from __future__ import annotations
