@@ -124,6 +124,7 @@ def test_interaction_response_falls_like_r_minus_3_beyond_the_correlation_length
     (["master-equation", "--h", "-1"], "--h"),
     (["eq", "--newborn", "gaussian", "--newborn-std", "0"], "--newborn-std"),
     (["fk", "--g", "-1"], "--g"),
+    (["slider", "--nx", "10", "--patches", "3"], "--patches"),
     (["eq", "--coupling", "0.1"], "--N"),
     (["stability-map", "--N", "100", "--couplings", "0.1", "--K", "3"], "--K"),
     (["stability-map"], "--K"),
@@ -140,9 +141,12 @@ def test_bad_value_is_one_line_naming_the_parameter_and_exit_2(shared_tmp_path, 
 def test_slider_writes_its_fronts_and_fields(shared_tmp_path):
     out = shared_tmp_path / "slider"
     assert main(["multicontact", "slider", "--nx", "10", "--ny", "2", "--t-end", "1.6e-3",
-                 "--dt", "4e-6", "--spread", "0.05", "--push-speed", "1e-3",
-                 "--out", str(out)]) == 0
+                 "--dt", "4e-6", "--spread", "0.05", "--push-speed", "1e-3", "--patches", "5",
+                 "--viscosity", "2e-6", "--out", str(out)]) == 0
     summary = _json(out)
     assert summary["breaks"] >= 1 and np.isfinite(summary["peak_push_force"])
+    assert (summary["parameters"]["patches"], summary["parameters"]["viscosity"]) == (5, 2e-6)
+    speeds = [f["speed"] for f in summary["fronts"] if f["speed"] is not None]  # NaN: null
+    assert max(speeds, default=0.0) <= summary["wave_speeds"]["c_p"]
     for name in ("slider.csv", "fronts.png", "slider.xdmf"):
         assert (out / name).stat().st_size > 0
