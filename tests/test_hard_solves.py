@@ -24,8 +24,23 @@ def test_two_pass_cattaneo_loads_normally_by_cutting_back_the_approach():
     measured; one pass on this mesh -2.1 %, +0.9 %), and the tangential forces both passes
     transmit balance Q (equilibrium, to Newton's tolerance)."""
     scene = Cattaneo(passes=2, h_contact=0.04, increments=1)
-    summary, model = scene.run(COMM)
-    assert summary["cutbacks"] >= 1
+    model = scene.build(COMM)
+    approaches = []
+    solve_at = model.solve_at
+    model.solve_at = lambda approach: solve_at(approaches.append(approach) or approach)
+    summary, model = scene.run(COMM, model)
+    assert summary["cutbacks"] == 1
+    # the approach that failed was cut back to the middle of its step; no later step of
+    # the normal loading is longer than that half (on h = a/5 the secant's longer steps fail
+    # again, 50 iterations lost each)
+    normal = approaches[:summary["solves"] + summary["cutbacks"]]
+    before = [0.0, *normal[:-1]]
+    failed = [k for k in range(len(normal) - 1)
+              if np.isclose(normal[k + 1], (before[k] + normal[k]) / 2, rtol=1e-12)]
+    assert len(failed) == 1
+    k = failed[0]
+    half = (normal[k] - before[k]) / 2
+    assert np.all(np.abs(np.diff(normal[k + 1:])) <= half * (1 + 1e-12))
     assert summary["load"] == pytest.approx(scene.load, rel=1e-5)
     assert abs(summary["fitted_half_width_error"]) < 0.05
     assert abs(summary["fitted_max_pressure_error"]) < 0.03
@@ -111,3 +126,19 @@ def test_stiff_perturbed_lagrangian_increment_converges_with_more_newton_iterati
     c = closed_forms.cattaneo_stick_half_width(a, scene.q_ratio)
     # the stick zone located to within the nodes' reach
     assert abs(summary["stick_half_width"] - c) < 1.5 * 0.02
+
+
+def test_secant_predictor_saves_newton_iterations_on_a_smooth_path():
+    """The block on the belt, μ from 0 to 1 in steps of 0.1: starting each solve from the
+    secant extrapolation of the last two states (Keller 1977) instead of the last state
+    saves Newton iterations on a smooth path (its error is second order in the step)."""
+    import fenicsfriction as ff
+    model = ff.BlockOnBelt().build(COMM, with_friction=True)
+    solver = SteadySolver(model.residual, options=model.solver_options())
+    counts = {}
+    for predictor in ("none", "secant"):
+        model.mu.value = 0.0
+        model.initial_guess()
+        records = continuation(solver, model.mu, np.linspace(0.1, 1.0, 10), predictor=predictor)
+        counts[predictor] = sum(r["newton_iterations"] for r in records[2:])
+    assert counts["secant"] < counts["none"], counts
