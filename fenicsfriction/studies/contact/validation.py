@@ -382,9 +382,10 @@ class Cattaneo(Hertz):
         """One increment of Q; under the perturbed Lagrangian a failed solve is repeated from
         the increment's start with :data:`PENALTY_MAX_IT` Newton iterations allowed: a stiff
         stick spring κ_T makes Newton move the stick-slip boundary by about a node per
-        iteration (the residual falls slowly but steadily: 44 iterations at κ_T = 1e5 E*/R,
-        h = a/20, q = 1/5 against the 50 allowed; continuation in κ_T, tenfold steps up from
-        a converged softer spring, needs as many at each step). Returns the Newton
+        iteration (the residual falls slowly but steadily: at κ_T = 1e5 E*/R, h = a/20 and
+        Q = μP/10 the first increment needs 80, against the 50 allowed; continuation in κ_T,
+        tenfold steps up from a softer spring's solution, needs as many at each step).
+        Returns the Newton
         iterations (the failed solve's included) and the iteration limit of the repeated
         solve (``None``: solved directly)."""
         approach = float(model.approach.value)
