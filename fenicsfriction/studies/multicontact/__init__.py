@@ -19,6 +19,7 @@ from fenicsfriction._lazy import attach
 __getattr__, __dir__, __all__ = attach(__name__, {
     "EQModel": "eq_model", "QuasistaticResult": "eq_model",
     "SpringDrivenResult": "eq_model", "describe_distribution": "eq_model",
+    "SpringQuasistaticResult": "eq_model", "SlipEvents": "eq_model", "slip_events": "eq_model",
     "MasterEquation": "master_equation", "MasterEquationResult": "master_equation",
     "InstabilityMap": "instability", "instability_map": "instability",
     "critical_stiffness": "instability", "CouplingMap": "instability",
@@ -38,8 +39,11 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers
     from fenicsfriction.studies.multicontact.eq_model import (
         EQModel,
         QuasistaticResult,
+        SlipEvents,
         SpringDrivenResult,
+        SpringQuasistaticResult,
         describe_distribution,
+        slip_events,
     )
     from fenicsfriction.studies.multicontact.frenkel_kontorova import (
         FKChain,

@@ -59,8 +59,10 @@ from fenicsfriction.studies.multicontact.eq_model import (
     EQModel,
     QuasistaticResult,
     SpringDrivenResult,
+    SpringQuasistaticResult,
     check_quasistatic,
     drive,
+    drive_quasistatic,
 )
 from fenicsfriction.studies.multicontact.interaction import interaction_matrix
 
@@ -306,12 +308,22 @@ class InteractingEQModel:
 
     def spring_driven(self, K: float, v: float, mass: float, damping: float, t_end: float,
                       dt: float, seed: int | None = 0, late_from: float | None = None,
-                      slip_speed: float = 10.0, prefix: str = "eq_",
-                      options: dict | None = None) -> SpringDrivenResult:
+                      drop_threshold: float = 0.05, slip_speed: float = 10.0,
+                      prefix: str = "eq_", options: dict | None = None) -> SpringDrivenResult:
         """The slider pulled through a spring K (arguments and result as
         :meth:`EQModel.spring_driven`); an avalanche is resolved within the step whose end
         puts a contact over its threshold."""
         contacts = self.contacts(np.random.default_rng(seed))
         return drive(contacts, self.parameters(), K=K, v=v, mass=mass, damping=damping,
-                     t_end=t_end, dt=dt, late_from=late_from, slip_speed=slip_speed,
-                     prefix=prefix, options=options)
+                     t_end=t_end, dt=dt, late_from=late_from, drop_threshold=drop_threshold,
+                     slip_speed=slip_speed, prefix=prefix, options=options)
+
+    def spring_quasistatic(self, K: float, D_max: float, seed: int | None = 0,
+                           late_from: float | None = None,
+                           drop_threshold: float = 0.05) -> SpringQuasistaticResult:
+        """The slider pulled through a spring K infinitely slowly, event by event (arguments
+        and result as :meth:`EQModel.spring_quasistatic`); an event's breaks include the
+        avalanches through the bodies."""
+        contacts = self.contacts(np.random.default_rng(seed))
+        return drive_quasistatic(contacts, self.parameters(), K=K, D_max=D_max,
+                                 late_from=late_from, drop_threshold=drop_threshold)
