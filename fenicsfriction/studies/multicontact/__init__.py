@@ -25,6 +25,7 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "critical_stiffness": "instability", "CouplingMap": "instability",
     "coupling_map": "instability", "InteractingEQModel": "interacting",
     "InteractingQuasistaticResult": "interacting", "lattice_compliance": "interacting",
+    "LatticeEQModel": "interacting", "LatticeCompliance": "interacting",
     "FKChain": "frenkel_kontorova",
     "FKResult": "frenkel_kontorova", "FrontSpeeds": "frenkel_kontorova",
     "TriangleRamp": "frenkel_kontorova", "front_speeds": "frenkel_kontorova",
@@ -62,6 +63,8 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers
     from fenicsfriction.studies.multicontact.interacting import (
         InteractingEQModel,
         InteractingQuasistaticResult,
+        LatticeCompliance,
+        LatticeEQModel,
         lattice_compliance,
     )
     from fenicsfriction.studies.multicontact.interaction import (
