@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy import integrate, stats
 
-from fenicsfriction.studies.multicontact import EQModel, critical_stiffness
+from fenicsfriction.studies.multicontact import EQModel, critical_stiffness, instability_map
 
 pytestmark = pytest.mark.sequential
 
@@ -172,3 +172,16 @@ def test_bad_drive_parameters_are_named_in_the_error():
         model.quasistatic(X_max=1.0, realisations=0)
     with pytest.raises(ValueError, match="damping"):
         model.spring_driven(K=1.0, v=1.0, mass=1.0, damping=-1.0, t_end=1.0, dt=0.1)
+
+
+def test_the_map_classifies_by_the_jump_at_the_static_peak_which_K_star_predicts():
+    # σ = 0.3 x_c, K = 0.8 K*: the slider jumps at the peak (a drop of ~F_s − F(X) where the
+    # drive's line meets F again, over 10 % of F_s), while later the contacts' phases have
+    # spread and the largest late event of 1000 contacts stays below 5 % of the mean force
+    model = EQModel(n_contacts=1000, x_s_std=0.3)
+    K = 0.8 * critical_stiffness(model)
+    # (the late window starts past 3 x_c; the runs with inertia beside, coarse: not tested)
+    smap = instability_map([K], [0.3], n_contacts=1000, steps_per_period=4)
+    assert smap.K[0] < smap.K_star[0]
+    assert smap.onset_drop[0, 0] > 0.1 and smap.stick_slip[0, 0]
+    assert smap.late_drop[0, 0] < smap.drop_threshold
