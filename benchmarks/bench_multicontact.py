@@ -33,7 +33,9 @@ contacts) over its first breaks: the time per break and the iterations per solve
 at couplings 0, 0.1, 0.3, σ = 0.3 x_c, K = S/2 (S the interface's stiffness): onset and late
 drops against N.
 
-``--sections`` picks some of: convergence, noise, map, events, interacting, interacting-events.
+``--sections`` picks some of: convergence, noise, map, events, interacting, interacting-events;
+``--sizes`` the N of the events study, ``--sides`` the lattices compared dense against
+matrix-free (a busy machine may want fewer).
 
 Writes ``bench_multicontact.json`` and ``bench_multicontact.png`` to ``--out`` and prints markdown
 tables. Serial (vectorised NumPy and a two-unknown TS).
@@ -283,7 +285,18 @@ def main() -> None:
     flags = benchmark_parser(__doc__)
     flags.add_argument("--sections", default=",".join(SECTIONS),
                        help=f"comma-separated, of {', '.join(SECTIONS)} (all)")
+    flags.add_argument("--sizes", default=",".join(map(str, EVENT_SIZES)),
+                       help="N of the events study (100,300,1000,3000)")
+    flags.add_argument("--sides", default=",".join(map(str, SIDES)),
+                       help="lattice sides, dense against matrix-free (8,12,16,24,32)")
+    flags.add_argument("--large-sides", default="64:500,128:200",
+                       help="matrix-free alone, side:breaks (64:500,128:200)")
     args = flags.parse_args()
+    EVENT_SIZES[:] = [int(v) for v in args.sizes.split(",")]
+    SIDES[:] = [int(v) for v in args.sides.split(",")]
+    LARGE_SIDES.clear()
+    LARGE_SIDES.update({int(a): int(b) for a, b in
+                        (item.split(":") for item in args.large_sides.split(","))})
     chosen = [name.strip() for name in args.sections.split(",") if name.strip()]
     unknown = sorted(set(chosen) - set(SECTIONS))
     if unknown:
@@ -291,18 +304,18 @@ def main() -> None:
                     f"{', '.join(SECTIONS)}")
     args.out.mkdir(parents=True, exist_ok=True)
     out: dict = {"sections": chosen}
-    if "convergence" in chosen:
-        _convergence(out)
-    if "noise" in chosen:
-        _noise(out)
-    result = _map(out) if "map" in chosen else None
-    if "events" in chosen:
-        _events(out)
-    if "interacting" in chosen:
-        _interacting(out)
-    if "interacting-events" in chosen:
-        _interacting_events(out)
-    write_summary(args.out / "bench_multicontact.json", out)
+    result = None
+    steps = {"convergence": _convergence, "noise": _noise, "events": _events,
+             "interacting": _interacting, "interacting-events": _interacting_events}
+    for name in SECTIONS:
+        if name not in chosen:
+            continue
+        if name == "map":
+            result = _map(out)
+        else:
+            steps[name](out)
+        # written after each section: a long run keeps what it measured
+        write_summary(args.out / "bench_multicontact.json", out)
     _figure(out, result, args.out / "bench_multicontact.png")
 
 
