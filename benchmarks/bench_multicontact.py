@@ -335,7 +335,11 @@ def _figure(out: dict, result: InstabilityMap | None, path) -> None:
         ax1.set_xlabel("N")
         ax1.set_ylabel("rms difference of F/N (k x_c)")
         ax1.legend()
-    if result is not None:
+    else:
+        ax1.set_visible(False)
+    if result is None:
+        ax2.set_visible(False)
+    else:
         n = result.parameters["N"]
         K_grid, spread_grid = np.meshgrid(result.K / n, result.relative_spread)
         ax2.scatter(K_grid[result.stick_slip], spread_grid[result.stick_slip], marker="x",
@@ -365,6 +369,9 @@ def _figure(out: dict, result: InstabilityMap | None, path) -> None:
             ax.set_ylabel(name)
             ax.set_title(f"slow spring drive, σ = {EVENT_SPREADS[0]} x_c", fontsize=9)
         ax3.legend(fontsize=7)
+    else:
+        ax3.set_visible(False)
+        ax4.set_visible(False)
     save(fig, path, dpi=120)
 
 
