@@ -1,21 +1,42 @@
-"""The elastic slider on EQ contacts: its cost per simulated front, against mesh and time step.
+"""The elastic slider on EQ contacts: its peak (static) and slip forces converged in time step
+and mesh, with the observed orders and Richardson's estimate, and its fronts' speeds.
 
-The scene of :mod:`fenicsfriction.studies.multicontact` (a 10 cm × 1 cm slider, E = 1 GPa,
-plane strain; EQ contacts of threshold 1 μm ± 5 %, re-forming relaxed after 0.1 ms; pushed at
-1 mm/s at its trailing edge) run to 4 ms, through the precursors to the front that spans the base,
-on the meshes ``--meshes`` (nx × ny) and steps ``--steps``. For each run: the wall time, the time
-steps, the breaks and fronts, the wall time per front and per step, and the observables whose
-convergence the time per front buys: the first break's time and push force, the peak push force
-and the slip force (the push force when the first front spans the base). Same-run baseline: each
-run's time per step over the coarsest run's.
+The scene of :mod:`fenicsfriction.studies.multicontact.slider` (a 10 cm × 1 cm slider,
+E = 1 GPa, plane strain; EQ contacts of threshold 1 μm, re-forming relaxed after 0.1 ms;
+pushed at 1 mm/s at its trailing edge) run to 4.6 ms, through the precursors to the front that
+spans the base. Two refinements of three levels each: the time step ``--steps`` on the mesh
+``--dt-mesh``, and the mesh ``--meshes`` (nx × ny, each halving h) at the step ``--mesh-dt``.
 
-Writes ``bench_slider.json`` and ``bench_slider.png`` (time per front against the front count;
-the slip force against the time step) to ``--out``. Serial or under MPI (the history is the same
-on any number of ranks). About a minute with the defaults.
+What makes the quantities converge (``--viscosity``, ``--spread``, ``--patches``):
+
+* every break radiates waves; undamped (generalized-α at spectral radius 1 keeps them all),
+  they ring at ±30 N/m in the push force forever, the peak force is the largest of that noise
+  and the contacts near their thresholds break on its crests: a Kelvin-Voigt relaxation time
+  τ (``--viscosity``, default 2 µs: a 2 mm shear wave has ωτ/2 ≈ 2, overdamped; the
+  slider's first modes ωτ/2 ≈ 0.01) makes them decay, a physical model whose limit exists;
+* random thresholds drawn per node are a different realisation on every mesh: ``--spread 0``
+  (default: all thresholds x̄_s) or thresholds shared by ``--patches`` patches of the base
+  (the same realisation on every mesh), averaged over ``--seeds`` realisations.
+
+For each run: the first break's time and force, the pusher force when the front (the
+furthest broken contact) reaches L/4 and L/2, the peak force, the slip force (when the
+far-edge contact first breaks), the fronts' largest speed under the causal grouping
+(:func:`~fenicsfriction.studies.multicontact.slider.fronts`, bounded by c_p) and under the
+time gap alone, wall time. For each quantity and each refinement: the observed order
+p = log₂(|q₁ − q₂| / |q₂ − q₃|) and q₃ + (q₃ − q₂) / (2ᵖ − 1) (Richardson 1911; Roache 1998,
+*Verification and Validation in Computational Science and Engineering*), ``nan`` where the
+differences change sign.
+
+Writes ``bench_slider.json`` and ``bench_slider.png`` (push force against time, per level) to
+``--out``. Serial or under MPI (the history is the same on any number of ranks). About 4
+minutes with the defaults on the shared 2-core machine (the 80 × 8 mesh 1.6 min, 0.5 µs on
+40 × 4 1.3 min); ``--meshes 40x4,80x8,160x16 --steps ""`` (the mesh study one level finer)
+takes 19 min (160 × 16: 15 min).
 """
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 
@@ -25,75 +46,140 @@ import numpy as np
 from _common import parser as benchmark_parser
 from _common import save, write_summary
 
-from fenicsfriction.studies.multicontact import ElasticSlider, ElasticSliderModel
+from fenicsfriction.studies.multicontact import ElasticSlider, ElasticSliderModel, fronts
 
-T_END = 4e-3
+T_END = 4.6e-3
+QUANTITIES = ("first_break_force", "force_at_quarter", "force_at_half", "peak_force",
+              "slip_force", "slip_time")
 
 
-def run(nx: int, ny: int, dt: float, comm: MPI.Comm) -> dict:
-    scene = ElasticSlider(nx=nx, ny=ny, spread=0.05, delay=1e-4, push_speed=1e-3, seed=3)
+def _force_when_front_reaches(history, x: float) -> float:
+    position = np.nan_to_num(np.array(history.front_position), nan=-1.0)
+    reached = np.flatnonzero(position >= x - 1e-12)
+    return float(history.push_force[reached[0]]) if len(reached) else float("nan")
+
+
+def run(nx: int, ny: int, dt: float, seed: int, args, comm: MPI.Comm) -> dict:
+    scene = ElasticSlider(nx=nx, ny=ny, spread=args.spread, delay=1e-4, push_speed=1e-3,
+                          seed=seed, patches=args.patches, viscosity=args.viscosity)
     model = ElasticSliderModel(scene, comm)
     t0 = time.perf_counter()
     history = model.run(T_END, dt)
     seconds = time.perf_counter() - t0
-    steps = len(history.time) - 1
-    fronts = len(history.fronts)
-    return {"nx": nx, "ny": ny, "dt": dt, "ranks": comm.size, "wall_time_s": seconds,
-            "steps": steps, "breaks": len(history.breaks), "fronts": fronts,
+    c_p, c_s = scene.wave_speeds
+    position = np.nan_to_num(np.array(history.front_position), nan=-1.0)
+    spanned = np.flatnonzero(position >= scene.L - 0.5 * scene.h)
+    by_gap = fronts(history.breaks, lambda t: 0.0, 5 * dt, scene.L - 0.5 * scene.h)
+
+    def fastest(found) -> float:
+        return max((f.speed for f in found if np.isfinite(f.speed)), default=float("nan"))
+
+    return {"nx": nx, "ny": ny, "dt": dt, "seed": seed, "ranks": comm.size,
+            "wall_time_s": seconds, "steps": len(history.time) - 1,
+            "breaks": len(history.breaks), "fronts": len(history.fronts),
             "arrested_fronts": sum(f.arrested for f in history.fronts),
-            "time_per_front_s": seconds / max(fronts, 1), "time_per_step_s": seconds / steps,
-            "first_break_time": history.breaks[0].time if history.breaks else None,
-            "first_break_force": (history.fronts[0].push_force if history.fronts else None),
-            "peak_force": float(np.max(history.push_force)),
-            "slip_force": history.slip_force}
+            "first_break_time": history.breaks[0].time,
+            "first_break_force": _force_when_front_reaches(history, 0.0),
+            "force_at_quarter": _force_when_front_reaches(history, 0.25 * scene.L),
+            "force_at_half": _force_when_front_reaches(history, 0.5 * scene.L),
+            "peak_force": history.peak_force, "slip_force": history.slip_force,
+            "slip_time": history.time[spanned[0]] if len(spanned) else float("nan"),
+            "fastest_front_causal": fastest(history.fronts),
+            "fastest_front_by_gap": fastest(by_gap), "c_p": c_p, "c_s": c_s,
+            "time": history.time, "push_force": history.push_force}
+
+
+def richardson(q: list[float]) -> dict:
+    """Observed order p and extrapolated value q₃ − (q₂ − q₃) / (2ᵖ − 1) of three levels
+    q = q* + C hᵖ refined by 2 each; ``nan`` unless the differences keep their sign and
+    shrink (observed p > 0.5), else the levels are not in the asymptotic range."""
+    if len(q) != 3:
+        return {"values": q, "order": float("nan"), "extrapolated": float("nan"),
+                "monotone": False, "spread": max(q, default=0.0) - min(q, default=0.0)}
+    d1, d2 = q[0] - q[1], q[1] - q[2]
+    p = math.log2(d1 / d2) if d1 * d2 > 0 else float("nan")
+    converging = math.isfinite(p) and p > 0.5  # below: not yet in the asymptotic range
+    return {"values": q, "order": p, "extrapolated": q[2] - d2 / (2**p - 1) if converging
+            else float("nan"), "monotone": d1 * d2 > 0, "spread": max(q) - min(q)}
 
 
 def main() -> int:
     flags = benchmark_parser(__doc__)
-    flags.add_argument("--meshes", default="20x2,40x4", help="nx x ny, comma-separated")
-    flags.add_argument("--steps", default="2e-6,1e-6", help="time steps [s], comma-separated")
+    flags.add_argument("--meshes", default="20x2,40x4,80x8", help="three meshes nx x ny")
+    flags.add_argument("--mesh-dt", type=float, default=1e-6, help="step of the mesh study [s]")
+    flags.add_argument("--steps", default="2e-6,1e-6,5e-7", help="three time steps [s]")
+    flags.add_argument("--dt-mesh", default="40x4", help="mesh of the time-step study")
+    flags.add_argument("--viscosity", type=float, default=2e-6,
+                       help="Kelvin-Voigt relaxation time [s] (0: undamped)")
+    flags.add_argument("--spread", type=float, default=0.0, help="threshold spread δ")
+    flags.add_argument("--patches", type=int, default=0, help="threshold patches (0: per node)")
+    flags.add_argument("--seeds", default="3", help="threshold seeds, comma-separated")
     flags.add_argument("--dpi", type=int, default=110)
     args = flags.parse_args()
     comm = MPI.COMM_WORLD
-    rows = []
-    for mesh in args.meshes.split(","):
-        nx, ny = (int(v) for v in mesh.split("x"))
-        for dt in (float(v) for v in args.steps.split(",")):
-            rows.append(run(nx, ny, dt, comm))
+    seeds = [int(v) for v in args.seeds.split(",")]
+    meshes = [tuple(int(v) for v in m.split("x")) for m in args.meshes.split(",")]
+    steps = [float(v) for v in args.steps.split(",") if v]
+    dt_mesh = tuple(int(v) for v in args.dt_mesh.split("x"))
+    runs: dict[tuple, list[dict]] = {}
+
+    def level(nx: int, ny: int, dt: float) -> list[dict]:
+        if (nx, ny, dt) not in runs:
+            runs[nx, ny, dt] = [run(nx, ny, dt, seed, args, comm) for seed in seeds]
             if comm.rank == 0:
-                r = rows[-1]
-                print(f"  {nx} x {ny}, dt {dt:g}: {r['wall_time_s']:.1f} s, {r['fronts']} fronts, "
-                      f"{r['time_per_front_s']:.3f} s per front", file=sys.stderr, flush=True)
-    base = rows[0]["time_per_step_s"]
-    for r in rows:
-        r["time_per_step_over_coarsest"] = r["time_per_step_s"] / base
+                for r in runs[nx, ny, dt]:
+                    print(f"  {nx} x {ny}, dt {dt:g}, seed {r['seed']}: {r['wall_time_s']:.1f} s,"
+                          f" peak {r['peak_force']:.1f}, slip {r['slip_force']:.1f} N/m",
+                          file=sys.stderr, flush=True)
+        return runs[nx, ny, dt]
+
+    studies = {"time_step": [level(*dt_mesh, dt) for dt in steps if dt > 0],
+               "mesh": [level(nx, ny, args.mesh_dt) for nx, ny in meshes]}
+    summary = {name: {q: richardson([float(np.mean([r[q] for r in lv])) for lv in levels])
+                      for q in QUANTITIES} for name, levels in studies.items()}
+    for name, levels in studies.items():
+        for q in QUANTITIES:
+            summary[name][q]["seed_std"] = [float(np.std([r[q] for r in lv])) for lv in levels]
+    rows = [{k: v for k, v in r.items() if k not in ("time", "push_force")}
+            for lv in runs.values() for r in lv]
+    worst = max(r["fastest_front_causal"] / r["c_p"] for r in rows)
     if comm.rank == 0:
         args.out.mkdir(parents=True, exist_ok=True)
-        print("| mesh | dt | steps | fronts (arrested) | wall time | per front | per step "
-              "(/ coarsest) | first break: t, force | peak force | slip force |")
-        print("|---|---|---|---|---|---|---|---|---|---|")
+        print("| run | wall | breaks | fronts (arrested) | first break F | F at L/4 | F at L/2 "
+              "| peak F | slip F | slip t | fastest front: causal, by gap (/ c_p) |")
+        print("|---|---|---|---|---|---|---|---|---|---|---|")
         for r in rows:
-            print(f"| {r['nx']} × {r['ny']} | {r['dt']:g} | {r['steps']} | {r['fronts']} "
-                  f"({r['arrested_fronts']}) | {r['wall_time_s']:.1f} s | "
-                  f"{r['time_per_front_s']:.3f} s | {1e3 * r['time_per_step_s']:.2f} ms "
-                  f"({r['time_per_step_over_coarsest']:.2f}) | "
-                  f"{1e3 * r['first_break_time']:.3f} ms, {r['first_break_force']:.0f} N/m | "
-                  f"{r['peak_force']:.0f} N/m | {r['slip_force']:.0f} N/m |")
+            print(f"| {r['nx']} × {r['ny']}, {r['dt'] * 1e6:g} µs, seed {r['seed']} | "
+                  f"{r['wall_time_s']:.1f} s | {r['breaks']} | {r['fronts']} "
+                  f"({r['arrested_fronts']}) | {r['first_break_force']:.1f} | "
+                  f"{r['force_at_quarter']:.1f} | {r['force_at_half']:.1f} | "
+                  f"{r['peak_force']:.1f} | {r['slip_force']:.1f} | "
+                  f"{r['slip_time'] * 1e3:.4f} ms | {r['fastest_front_causal'] / r['c_p']:.2f}, "
+                  f"{r['fastest_front_by_gap'] / r['c_p']:.2f} |")
+        print("\n| study | quantity | three levels | observed order | Richardson |")
+        print("|---|---|---|---|---|")
+        for name, table in summary.items():
+            for q, s in table.items():
+                print(f"| {name} | {q} | {', '.join(f'{v:.4g}' for v in s['values'])} | "
+                      f"{s['order']:.2f} | {s['extrapolated']:.4g} |")
+        print(f"\nfastest causal front / c_p over all runs: {worst:.3f}")
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
-        fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 3.8))
-        for mesh in sorted({(r["nx"], r["ny"]) for r in rows}):
-            sel = [r for r in rows if (r["nx"], r["ny"]) == mesh]
-            a1.plot([r["fronts"] for r in sel], [r["time_per_front_s"] for r in sel], "o-",
-                    label=f"{mesh[0]} × {mesh[1]}")
-            a2.plot([r["dt"] for r in sel], [r["slip_force"] for r in sel], "o-",
-                    label=f"{mesh[0]} × {mesh[1]}")
-        a1.set(xlabel="fronts simulated", ylabel="wall time per front [s]")
-        a2.set(xscale="log", xlabel="time step [s]", ylabel="slip force [N/m]")
-        a1.legend(fontsize=8)
+        fig, axes = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
+        for ax, (name, levels) in zip(axes, studies.items(), strict=True):
+            for lv in levels:
+                r = lv[0]
+                ax.plot(np.array(r["time"]) * 1e3, r["push_force"], lw=0.7,
+                        label=f"{r['nx']} × {r['ny']}, {r['dt'] * 1e6:g} µs")
+            ax.set(xlabel="t [ms]", title=f"{name.replace('_', ' ')} study", xlim=(1.0, 4.6))
+            ax.legend(fontsize=8)
+        axes[0].set(ylabel="push force [N/m]")
         save(fig, args.out / "bench_slider.png", args.dpi)
-    write_summary(args.out / "bench_slider.json", {"t_end": T_END, "rows": rows}, comm)
+    write_summary(args.out / "bench_slider.json",
+                  {"t_end": T_END, "viscosity": args.viscosity, "spread": args.spread,
+                   "patches": args.patches, "seeds": seeds, "studies": summary,
+                   "fastest_causal_front_over_c_p": worst, "rows": rows}, comm)
     return 0
 
 

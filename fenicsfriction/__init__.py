@@ -15,14 +15,8 @@ import dolfinx.
 from __future__ import annotations
 
 import typing
-from importlib import metadata as _metadata
 
 from fenicsfriction._lazy import attach
-
-try:
-    __version__ = _metadata.version("fenicsfriction")
-except _metadata.PackageNotFoundError:  # running from a source tree
-    __version__ = "0.0.0+unknown"
 
 #: public name -> the module that defines it
 _EXPORTS: dict[str, str] = {
@@ -82,8 +76,22 @@ _SUBMODULES = ("amg", "contact", "dynamics", "events", "forms", "io", "laws", "m
                "mollification", "numerics", "panagiotopoulos", "plotting", "results", "rotation",
                "signals", "stability", "statistics", "steady", "studies", "timestepping")
 
-__getattr__, __dir__, __all__ = attach(__name__, _EXPORTS, _SUBMODULES)
+_getattr, __dir__, __all__ = attach(__name__, _EXPORTS, _SUBMODULES)
 __all__.append("__version__")  # the same list __dir__ returns
+
+
+def __getattr__(name: str) -> typing.Any:
+    if name != "__version__":
+        return _getattr(name)
+    # read on first use: importlib.metadata costs a third of the package's import, the time
+    # in which a command line's Ctrl-C would otherwise still end in a traceback
+    from importlib import metadata
+    try:
+        version = metadata.version("fenicsfriction")
+    except metadata.PackageNotFoundError:  # running from a source tree
+        version = "0.0.0+unknown"
+    globals()["__version__"] = version
+    return version
 
 
 if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers and IDEs

@@ -378,10 +378,12 @@ class CentralDifference:
 
     def run(self, t_end: float, dt: float,
             observe: typing.Callable[[float], dict] | None = None,
-            on_step: typing.Callable[[dict], None] | None = None) -> list[dict]:
+            on_step: typing.Callable[[dict], None] | None = None,
+            keep_records: bool = True) -> list[dict]:
         """Integrate to ``t_end``; ``dt`` above ``safety × stable_dt`` is reduced to it.
 
-        Records as :meth:`DynamicsSolver.run` (``newton_iterations`` is 0: nothing to solve).
+        Records as :meth:`DynamicsSolver.run` (``newton_iterations`` is 0: nothing to solve;
+        none kept if not ``keep_records``).
         """
         check("t_end", t_end, t_end > 0, "must be > 0")
         check("dt", dt, 0 < dt <= t_end, f"must lie in (0, t_end = {t_end}]")
@@ -407,7 +409,8 @@ class CentralDifference:
             clock = time.perf_counter()
             if observe is not None:
                 entry.update(observe(t))
-            records.append(entry)
+            if keep_records:
+                records.append(entry)
             if on_step is not None:
                 on_step(entry)
 

@@ -529,13 +529,17 @@ class Loci:
         parameter: the ``fem.Constant`` continued.
         max_modulus: every eigenvalue with |λ| <= max_modulus is computed at each step.
         growth_tol: a mode is unstable when Re λ > growth_tol |λ|.
+        max_halvings: how many times a failing step of the steady state (to the next value,
+            or a bisection's jump) may be halved.
     """
 
     def __init__(self, steady: typing.Any, stability: Eigensolver, parameter: typing.Any,
                  max_modulus: float,
-                 growth_tol: float = 1e-6):
+                 growth_tol: float = 1e-6, max_halvings: int = 8):
         check("growth_tol", growth_tol, growth_tol > 0, "must be > 0")
+        check("max_halvings", max_halvings, max_halvings >= 0, "must be >= 0")
         self.steady, self.stability, self.parameter = steady, stability, parameter
+        self.max_halvings = max_halvings
         self.max_modulus, self.growth_tol = max_modulus, growth_tol
         self.comm = stability.comm
         self._next = 0
@@ -543,7 +547,7 @@ class Loci:
 
     def _solve_at(self, value: float) -> list[Mode]:
         from fenicsfriction.steady import continuation
-        continuation(self.steady, self.parameter, [value])
+        continuation(self.steady, self.parameter, [value], max_halvings=self.max_halvings)
         return self.stability.solve(self.max_modulus)
 
     def follow(self, values: typing.Iterable[float],

@@ -495,13 +495,15 @@ def _row(values: typing.Any) -> dict[str, typing.Any]:
 
 
 def epsilon_sequence(solver: SteadySolver, eps: fem.Constant, values: typing.Iterable[float],
-                     observe: typing.Callable[[], typing.Any] | None = None) -> list[dict]:
+                     observe: typing.Callable[[], typing.Any] | None = None,
+                     on_step: typing.Callable[[dict], None] | None = None) -> list[dict]:
     """Kalker's sequential ε process: solve for each ε in ``values``, warm-starting each solve.
 
     Each record has ``eps``, ``newton_iterations``, ``change`` (the max-norm of the solution
     change from the previous ε; ``None`` for the first), ``residual_norm``, ``atol`` and what
-    ``observe`` adds. A failing solve raises :class:`SolveError` with ``u`` and ``eps`` at the
-    last converged ε.
+    ``observe`` adds; ``on_step`` sees each record as soon as it exists (a caller keeps the
+    ones done when a later solve fails). A failing solve raises :class:`SolveError` with ``u``
+    and ``eps`` at the last converged ε.
     """
     records: list[dict] = []
     u_vec = _compat.petsc_vec(solver.u)
@@ -526,6 +528,8 @@ def epsilon_sequence(solver: SteadySolver, eps: fem.Constant, values: typing.Ite
         if observe is not None:
             record.update(_row(observe()))
         records.append(record)
+        if on_step is not None:
+            on_step(record)
     if previous is not None:
         previous.destroy()
     return records

@@ -142,16 +142,20 @@ class Alpha2Integrator:
 
     def run(self, t_end: float, dt: float,
             observe: typing.Callable[[float], dict] | None = None,
-            on_step: typing.Callable[[dict], None] | None = None) -> list[dict]:
+            on_step: typing.Callable[[dict], None] | None = None,
+            keep_records: bool = True) -> list[dict]:
         """Integrate from t = 0 to ``t_end`` with (initial) step ``dt``.
 
         Args:
             observe: called after every accepted step (fields hold the state), its dict is
                 merged into the step's record.
             on_step: called with each record (progress output, field output).
+            keep_records: return (and attach to a :class:`DynamicsError`) every record; False
+                for a long run whose ``on_step`` streams them: the memory then stays flat.
 
         Returns:
-            One record per accepted step (and one for t = 0): ``time``, ``dt``,
+            One record per accepted step (and one for t = 0; none if not ``keep_records``):
+            ``time``, ``dt``,
             ``newton_iterations`` (rejected attempts included), ``rejected_steps`` (cut-backs
             and error-control rejections before this step), ``wall_time_s`` and what
             ``observe`` adds.
@@ -171,6 +175,7 @@ class Alpha2Integrator:
         self.ts.setMaxSteps(10**9)
         records: list[dict] = []
         clock = [time.perf_counter(), 0, 0]
+        last_time = [0.0]  # of the last accepted step
 
         def regrow(ts):  # after a cut-back, back to the step asked for (not past t_end)
             remaining = t_end - ts.getTime()
@@ -186,10 +191,12 @@ class Alpha2Integrator:
             clock[:] = time.perf_counter(), snes_its, rejected
             if step:  # the fields hold the last residual evaluation: load the accepted state
                 self._load(x, ts.getSolution2()[1], None)
-                record["dt"] = float(t - records[-1]["time"])
+                record["dt"] = float(t - last_time[0])
+            last_time[0] = float(t)
             if observe is not None:
                 record.update(observe(float(t)))
-            records.append(record)
+            if keep_records:
+                records.append(record)
             if on_step is not None:
                 on_step(record)
 

@@ -14,6 +14,7 @@ from mpi4py import MPI
 
 import numpy as np
 import pytest
+from cli_errors import assert_one_error_line
 from scipy.integrate import trapezoid
 
 from fenicsfriction.cli import main
@@ -109,6 +110,81 @@ def test_dynamics_cli_writes_a_time_series_whose_energy_balance_closes(out_dir):
         # the normal damping b_n d^{l_n} u̇_n adds to N while the block moves
         damped += abs(float(r["normal_force"]) - float(r["normal_force_elastic"])) > 1e-3
     assert damped > len(rows) // 2  # the damping part is present while the block moves
+    _summary_is_what_its_names_say(out_dir, rows, mu=0.6)
+
+
+def _summary_is_what_its_names_say(out_dir: pathlib.Path, rows: list[dict], mu: float) -> None:
+    """Every figure of ``block dynamics``'s summary.json recomputed from timeseries.csv by its
+    definition (statistics over the second half, time means by the trapezoidal rule), and
+    the table's derived columns from their own definitions."""
+    summary = json.loads((out_dir / "summary.json").read_text())
+    table = {key: np.array([float(r[key]) for r in rows]) for key in rows[0]}
+    t = table["time"]
+    assert summary["failure"] is None and summary["interrupted"] is None
+    assert summary["steps"] == len(rows) - 1 and summary["dt"] == 1e-5
+    parameters = summary["parameters"]
+    assert parameters["law"]["mu"] == mu
+    # the table: the spring's elongation is −F_s/K_x; every base node open, stuck or slipping
+    np.testing.assert_allclose(table["spring_elongation"],
+                               -table["spring_force"] / parameters["K_x"], rtol=1e-12)
+    counts = table["n_open"] + table["n_stick"] + table["n_slip"]
+    assert np.all(counts == counts[0]) and counts[0] == 9  # 2 × 4 Q2 facets + 1
+    # sliding at |slip| ≫ ε: the friction force is μ times the compliance's (elastic) normal
+    # force, the damping adding to N only (regularisation |w|/√(w² + ε²): below 1e-6 here)
+    np.testing.assert_allclose(np.abs(table["friction_force"]),
+                               mu * table["normal_force_elastic"], rtol=1e-4)
+    stats = summary["statistics"]
+    window = t >= 0.5 * t[-1]
+    tw = t[window]
+
+    def mean(values):
+        return trapezoid(values[window], tw) / (tw[-1] - tw[0])
+
+    assert (stats["t_from"], stats["t_to"], stats["mu"]) == (tw[0], tw[-1], mu)
+    N, F = mean(table["normal_force"]), mean(table["friction_force"])
+    assert stats["mean_normal_force"] == pytest.approx(N, rel=1e-12)
+    assert stats["mean_friction_force"] == pytest.approx(F, rel=1e-12)
+    assert stats["normal_force_range"] == [table["normal_force"][window].min(),
+                                           table["normal_force"][window].max()]
+    assert stats["apparent_coefficient"] == pytest.approx(abs(F) / N, rel=1e-12)
+    assert stats["ratio_to_mu"] == pytest.approx(abs(F) / N / mu, rel=1e-12)
+    in_contact = table["probe_pressure"] > 0
+    sticks = in_contact & (np.abs(table["probe_slip"]) < stats["eps"])
+    assert stats["probe_stick_fraction"] == pytest.approx(mean(sticks.astype(float)), abs=1e-12)
+    assert stats["probe_open_fraction"] == pytest.approx(mean((~in_contact).astype(float)),
+                                                         abs=1e-12)
+    assert stats["any_stick_fraction"] == pytest.approx(mean((table["n_stick"] > 0) * 1.0),
+                                                        abs=1e-12)
+    assert stats["probe_longest_stick"] == 0.0 and not sticks[window].any()  # all sliding
+    elongation = table["spring_elongation"]
+    assert stats["spring_elongation"] == pytest.approx(
+        {"start": elongation[window][0], "end": elongation[-1], "mean": mean(elongation)},
+        rel=1e-12)
+    assert stats["max_energy_error"] == pytest.approx(np.abs(table["energy_error"]).max(),
+                                                      rel=1e-12)
+    assert stats["duration"] == pytest.approx(t[-1] - t[0], rel=1e-12)
+    assert stats["steps"] == len(rows) - 1
+    assert stats["newton_iterations"] == table["newton_iterations"].sum()
+    assert stats["rejected_steps"] == table["rejected_steps"].sum()
+
+
+def test_dynamics_beyond_the_tipping_limit_is_refused_in_one_line_before_any_work(tmp_path,
+                                                                                   capsys):
+    """μ = 2 > 1.5625: the block would tip, no steady sliding exists to start from. The limit
+    is the moment balance about the outermost contact point, μ W h_s = W (L/2 − s_1), with
+    s_1 the inset of the contact rule's first point: the 5-point Gauss-Legendre rule's
+    tabulated node ±0.9061798459, so s_1 = (1 − 0.9061798459)/2 of the L/4 facet."""
+    L, h_s = 48.8, 30.5 / 2
+    limit = (L / 2 - (1 - 0.9061798459) / 2 * L / 4) / h_s
+    for mu in ("2.0", "1.58"):  # 1.58: past the mesh's limit, short of L/(2 h_s) = 1.6
+        out = tmp_path / f"tipped-{mu}"
+        assert main(["block", "dynamics", "--mu", mu, "--t-end", "1e-3", "--out",
+                     str(out)]) == 2
+        err = capsys.readouterr().err
+        assert_one_error_line(err, "--mu")
+        if MPI.COMM_WORLD.rank == 0:
+            assert f"--mu={mu}" in err and f"{limit:.6g}" in err
+        assert not out.exists()  # refused before the output folder, the mesh and the solves
 
 
 def test_steady_cli_stops_at_discrete_tipping_limit_and_reports_it(out_dir):

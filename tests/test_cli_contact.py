@@ -92,6 +92,21 @@ def test_hertz_2d_matches_hertz_and_writes_its_outputs(shared_tmp_path):
     # error shifts the ellipse by 0.4 % of a, largest near the edges)
     inside = np.abs(x) < 0.9 * a
     assert np.abs(pressure - _column(rows, "hertz_pressure"))[inside].max() < 0.01 * p0
+    # each remaining figure by its definition: the errors are relative to Hertz's; the fit is
+    # Hertz's ellipse through the nodal pressures (the table's, the law's, 1e-4 from the
+    # transmitted ones it was fitted to: 2.6e-4 on a, measured, where the edge-crossing
+    # half-width is 2e-3 away); the law is linear, p = c_n d, so the table's gap is
+    # −p/c_n wherever the node presses
+    assert summary["max_pressure_error"] == pytest.approx(
+        summary["max_pressure"] / summary["hertz_max_pressure"] - 1, abs=1e-12)
+    fitted = closed_forms.fit_hertz_pressure(np.abs(x), pressure)
+    assert summary["fitted_half_width"] == pytest.approx(fitted[0], rel=1e-3)
+    assert summary["fitted_max_pressure"] == pytest.approx(fitted[1], rel=1e-3)
+    for key, reference in (("half_width", a), ("max_pressure", p0)):
+        assert summary[f"fitted_{key}_error"] == pytest.approx(
+            summary[f"fitted_{key}"] / reference - 1, abs=1e-12)
+    np.testing.assert_allclose(gap[pressure > 0], -pressure[pressure > 0] / 1e4, rtol=1e-6)
+    assert summary["solves"] >= 1 and summary["newton_iterations"] >= summary["solves"]
     _files(out, "pressure.png", "deformed.png", "bodies.xdmf", "bodies.h5")
     xdmf = (out / "bodies.xdmf").read_text()
     assert all(name in xdmf for name in ("displacement", "bodies", "surfaces"))

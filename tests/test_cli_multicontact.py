@@ -61,6 +61,28 @@ def test_master_equation_conserves_the_contacts(shared_tmp_path):
     assert summary["kinetic_force"] == pytest.approx(1000 * (1 + 0.09) / 2, rel=1e-3)
 
 
+def test_master_equation_reports_each_figure_as_its_name_says(shared_tmp_path):
+    """The defaults (N = 1000, σ = 0.1 x_c, five lives): every key of multicontact.json
+    against its definition, by a closed form or recomputed from the stored X, F, x, Q."""
+    out = shared_tmp_path / "me-names"
+    assert main(["multicontact", "master-equation", "--out", str(out)]) == 0
+    s = _json(out)
+    X, F, x, Q, h = (np.array(s[key]) for key in ("X", "F", "x", "Q", "h"))
+    assert s["h"] == 0.01 and s["parameters"]["N"] == 1000 and s["parameters"]["x_s_std"] == 0.1
+    # kinetic: the sliding state, N k ⟨x_s²⟩/(2⟨x_s⟩) = 1000 (1 + 0.01)/2 (the truncation at
+    # x_s > 0 is 1e-23 at 10σ), to the scheme's O(h²) = 1.7e-5
+    assert s["kinetic_force"] == pytest.approx(505.0, rel=1e-4)
+    # the transient's end, named apart: F and N k Σ x Q at X_max = 5 x_c, still 2.5 % above
+    assert s["X_max"] == X[-1] == 5.0
+    assert s["force_at_X_max"] == F[-1] == pytest.approx(1000 * float(x @ Q), rel=1e-14)
+    assert s["force_at_X_max"] / s["kinetic_force"] - 1 == pytest.approx(0.025, abs=0.002)
+    assert s["static_force"] == F.max()
+    assert s["K_star"] == pytest.approx(-np.min(np.gradient(F, h)), rel=1e-14)
+    assert abs(Q.sum() - 1) <= s["mass_error"] < 1e-12
+    rows = np.loadtxt(out / "force.csv", delimiter=",", skiprows=1)
+    np.testing.assert_array_equal(rows, np.column_stack([X, F]))
+
+
 def test_stability_map_is_smooth_well_above_K_star_and_stick_slip_well_below(shared_tmp_path):
     out = shared_tmp_path / "map"
     assert main(["multicontact", "stability-map", "--N", "300", "--K", "25,1000", "--spreads",
@@ -102,6 +124,7 @@ def test_interaction_response_falls_like_r_minus_3_beyond_the_correlation_length
     (["master-equation", "--h", "-1"], "--h"),
     (["eq", "--newborn", "gaussian", "--newborn-std", "0"], "--newborn-std"),
     (["fk", "--g", "-1"], "--g"),
+    (["slider", "--nx", "10", "--patches", "3"], "--patches"),
     (["eq", "--coupling", "0.1"], "--N"),
     (["stability-map", "--N", "100", "--couplings", "0.1", "--K", "3"], "--K"),
     (["stability-map"], "--K"),
@@ -118,9 +141,12 @@ def test_bad_value_is_one_line_naming_the_parameter_and_exit_2(shared_tmp_path, 
 def test_slider_writes_its_fronts_and_fields(shared_tmp_path):
     out = shared_tmp_path / "slider"
     assert main(["multicontact", "slider", "--nx", "10", "--ny", "2", "--t-end", "1.6e-3",
-                 "--dt", "4e-6", "--spread", "0.05", "--push-speed", "1e-3",
-                 "--out", str(out)]) == 0
+                 "--dt", "4e-6", "--spread", "0.05", "--push-speed", "1e-3", "--patches", "5",
+                 "--viscosity", "2e-6", "--out", str(out)]) == 0
     summary = _json(out)
     assert summary["breaks"] >= 1 and np.isfinite(summary["peak_push_force"])
+    assert (summary["parameters"]["patches"], summary["parameters"]["viscosity"]) == (5, 2e-6)
+    speeds = [f["speed"] for f in summary["fronts"] if f["speed"] is not None]  # NaN: null
+    assert max(speeds, default=0.0) <= summary["wave_speeds"]["c_p"]
     for name in ("slider.csv", "fronts.png", "slider.xdmf"):
         assert (out / name).stat().st_size > 0

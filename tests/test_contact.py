@@ -216,3 +216,52 @@ def test_hertz_sphere_matches_hertz_within_its_mesh_accuracy():
     assert p0 == pytest.approx(summary["hertz_max_pressure"], rel=0.02)
     assert abs(summary["contact_radius_error"]) < 0.2
     assert summary["load"] == pytest.approx(scene.load, rel=1e-4)  # 4 × the quarter's force
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_friction_is_tangential_and_opposes_the_slip_on_a_tilted_interface(dim):
+    """Both blocks turned rigidly by 0.3 rad (the interface tilted), the upper one moving
+    with a velocity that has a normal part: the friction traction at every slave node in
+    contact has no normal component and points against the tangential slip, with the
+    magnitude of the regularised law, μ c_n d^m_n |w_T| / √(|w_T|² + ε²) (Martins & Oden
+    1986; slip 0.3 ≫ ε = 1e-2, so within 0.1 % of μ p)."""
+    import ufl
+
+    msh, cell_tags, ft = stacked_blocks(MPI.COMM_WORLD, dim, 3, 4, overlap=0.02)
+    V = _compat.vector_function_space(msh, 1)
+    u, u_old = fem.Function(V, name="u"), fem.Function(V, name="u_old")
+    theta = 0.3
+    c, s = np.cos(theta), np.sin(theta)
+    turn = np.eye(dim)
+    turn[:2, :2] = [[c, -s], [s, c]]
+    up = turn[:, dim - 1]  # the interface's normal e_y (2D) / e_z (3D), turned
+    if dim == 3:  # turn about x as well, so that no axis stays in the interface
+        turn = turn @ np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+        up = turn[:, 2]
+    x = V.tabulate_dof_coordinates()[:, :dim]
+    u.x.array[:] = (x @ (turn - np.eye(dim)).T).ravel()
+    slip = 0.3 * turn[:, 0] + (0.1 * turn[:, 1] if dim == 3 else 0.0)
+    velocity = slip + 0.2 * turn[:, dim - 1]  # a normal part the friction must not see
+    upper = _compat.cell_dofs(V, cell_tags.indices[cell_tags.values == UPPER])
+    moving = u.x.array.copy().reshape(-1, dim)
+    moving[upper] -= 0.1 * velocity
+    u_old.x.array[:] = moving.ravel()
+    for f in (u, u_old):
+        f.x.scatter_forward()
+    law = InterfaceLaw(c_n=100.0, m_n=2.0, mu=0.5, eps=1e-2)
+    contact = NodeToSegment(u, ft, SLAVE, MASTER, law, velocity=(u - u_old) / 0.1,
+                            fields=[u_old])
+    contact.update()
+    t, n = contact.traction, contact.normal
+    direction = ufl.as_vector(list(-slip / np.linalg.norm(slip)))
+    values = contact.nodal_values([ufl.dot(t, n), ufl.dot(t, direction),
+                                   ufl.sqrt(ufl.dot(t, t)), contact.pressure,
+                                   ufl.dot(n, ufl.as_vector(list(up)))])()
+    touching = values[:, 3] > 0
+    assert MPI.COMM_WORLD.allreduce(int(touching.sum())) >= 4 * (dim - 1)
+    normal_part, along, size, pressure, aligned = values[touching].T
+    largest = MPI.COMM_WORLD.allreduce(float(size.max(initial=0.0)), op=MPI.MAX)
+    np.testing.assert_allclose(aligned, 1.0, atol=1e-10)  # the master's normal is turned
+    np.testing.assert_allclose(normal_part, 0.0, atol=1e-12 * largest)
+    np.testing.assert_allclose(along, size, rtol=1e-10)  # all of it against the slip
+    np.testing.assert_allclose(size, 0.5 * pressure, rtol=1e-3)

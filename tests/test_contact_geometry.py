@@ -221,6 +221,26 @@ def test_hertz_3d_is_refined_near_the_contact(hertz3):
         assert np.any(np.all(np.isclose(p, 0.0, atol=1e-14), axis=2))
 
 
+def test_hertz_3d_refine_depth_refines_a_slab_along_the_contact_plane_only():
+    """With ``refine_depth`` the fine size holds in |z| <= depth and the cells below it grow
+    (the cube would refine them down to |z| = refine_half_width): on the block's symmetry face
+    x = 0, triangles within the slab have edges near h_contact, those centred 3-4 depths below
+    it (within the half-width) are more than twice as long."""
+    h, width, depth = 0.02, 0.3, 0.05
+    m = geometry.hertz_3d(MPI.COMM_WORLD, R=R, h_contact=h, refine_half_width=width,
+                          refine_depth=depth)
+    assert m.parameters["refine_depth"] == depth
+    p = facet_points(m, SYMMETRY_X)
+    longest = triangles(p)[2]
+    y, z = p[..., 1].max(axis=1), p[..., 2]
+    inside = (y < width / 2) & (z.min(axis=1) > -depth) & (z.max(axis=1) <= 0)
+    centre = z.mean(axis=1)
+    below = (y < width) & (centre < -3 * depth) & (centre > -4 * depth)
+    assert inside.any() and below.any()
+    assert longest[inside].max() <= 1.5 * h
+    assert np.median(longest[below]) > 2 * h
+
+
 # --- patches -----------------------------------------------------------------------------------
 
 def test_patch_2d_interface_meshes_do_not_match(patch2):
@@ -312,6 +332,7 @@ def test_meshes_are_distributed_over_the_ranks(hertz2, hertz3):
     (geometry.hertz_3d, {"refine": -1}, "refine=-1 is invalid: must be an integer >= 0"),
     (geometry.hertz_3d, {"refine": 1.5}, "refine=1.5 is invalid"),
     (geometry.hertz_3d, {"grading": 0.0}, "grading=0.0 is invalid"),
+    (geometry.hertz_3d, {"refine_depth": 1.0}, "refine_depth=1.0 is invalid"),
     (geometry.patch_2d, {"n_upper": 0}, "n_upper=0 is invalid: must be an integer >= 1"),
     (geometry.patch_3d, {"width": float("nan")}, "width=nan is invalid"),
 ])

@@ -18,7 +18,7 @@ import pytest
 import ufl
 
 from fenicsfriction.io import FieldWriter
-from fenicsfriction.studies.multicontact import ElasticSlider, ElasticSliderModel
+from fenicsfriction.studies.multicontact import Break, ElasticSlider, ElasticSliderModel, fronts
 
 #: a slider whose contacts break one after the other from the pushed edge: thresholds within
 #: ±5 %, so the stretch (decaying from the edge over sqrt(E H / k) = 6 node spacings) decides
@@ -135,6 +135,116 @@ def test_fronts_start_at_the_pushed_edge_and_advance_contact_by_contact():
     # then the whole interface slips, below the force all contacts could hold together
     assert np.isfinite(history.slip_force)
     assert history.slip_force < PUSHED.k * PUSHED.L * PUSHED.threshold * (1 + PUSHED.spread)
+    # the slip force is the force at the step the far-edge contact first broke
+    far = min(b.time for b in history.breaks if b.x == PUSHED.L)
+    assert history.slip_force == history.push_force[history.time.index(far)]
+    assert history.peak_force == max(history.push_force) >= history.slip_force
+    # no front outruns the P waves; grouped by the time gap alone, some would (the old rule)
+    c_p = PUSHED.wave_speeds[0]
+    speeds = np.array([f.speed for f in history.fronts])
+    assert np.sum(np.isfinite(speeds)) >= 5 and np.nanmax(speeds) <= c_p
+    by_gap = fronts(history.breaks, lambda t: 0.0, 10e-6, PUSHED.L - PUSHED.h / 2)
+    assert max(f.speed for f in by_gap if np.isfinite(f.speed)) > c_p
+    assert sum(f.size for f in history.fronts) == len(history.breaks)
+
+
+def test_wave_speeds_against_the_ratio_of_the_p_to_the_s_wave_speed():
+    # (c_p / c_s)^2 = 2 (1 - nu) / (1 - 2 nu) in plane strain, 2 / (1 - nu) in plane stress;
+    # c_s^2 = E / (2 (1 + nu) rho)
+    scene = ElasticSlider(E=2e9, nu=0.25, rho=1200.0)
+    c_p, c_s = scene.wave_speeds
+    assert c_s == pytest.approx(np.sqrt(2e9 / (2 * 1.25 * 1200.0)), rel=1e-14)
+    assert (c_p / c_s) ** 2 == pytest.approx(2 * 0.75 / 0.5, rel=1e-14)
+    c_p, c_s = ElasticSlider(E=2e9, nu=0.25, rho=1200.0, plane_stress=True).wave_speeds
+    assert (c_p / c_s) ** 2 == pytest.approx(2 / 0.75, rel=1e-14)
+
+
+def _front(start_x: float, start_time: float, speed: float, count: int, h: float = 1e-3):
+    return [Break(time=start_time + i * h / abs(speed), x=start_x + np.sign(speed) * i * h,
+                  stretch=1e-6, energy=0.0) for i in range(count)]
+
+
+def test_causal_grouping_finds_a_known_front_and_two_simultaneous_ones():
+    c = 1000.0
+    one = fronts(_front(0.0, 1e-3, 300.0, 20), lambda t: 2 * t, 1e-4, 0.05, c)
+    assert len(one) == 1 and one[0].size == 20 and one[0].arrested
+    assert one[0].speed == pytest.approx(300.0, rel=1e-12)
+    assert (one[0].start_x, one[0].tip_x, one[0].push_force) == (0.0, pytest.approx(0.019),
+                                                                 2e-3)
+    # two fronts starting together 5 cm apart, one running right at 300 m/s, one left at
+    # 200 m/s, their breaks interleaved in time: each break is reachable only from its own
+    # front within c, so the two come apart
+    both = _front(0.0, 1e-3, 300.0, 12) + _front(0.05, 1e-3, -200.0, 12)
+    found = fronts(both, lambda t: 0.0, 1e-4, 0.1, c)
+    assert sorted((f.start_x, f.size) for f in found) == [(0.0, 12), (0.05, 12)]
+    assert found[0].speed == pytest.approx(300.0, rel=1e-12)
+    # by the time gap alone they were one "front" that reached 5 cm in no time
+    merged = fronts(both, lambda t: 0.0, 1e-4, 0.1)
+    assert len(merged) == 1 and merged[0].tip_x == 0.05 and np.isnan(merged[0].speed)
+
+
+def test_a_run_of_breaks_faster_than_the_wave_speed_is_not_a_front():
+    c = 1000.0
+    found = fronts(_front(0.0, 0.0, 2 * c, 10), lambda t: 0.0, 1e-4, 0.05, c)
+    assert len(found) == 10 and all(np.isnan(f.speed) for f in found)
+    # breaks in the same step at different places are never one front's
+    same_step = [Break(time=1e-3, x=x, stretch=0.0, energy=0.0) for x in (0.0, 1e-3, 2e-3)]
+    assert len(fronts(same_step, lambda t: 0.0, 1e-4, 0.05, c)) == 3
+    # random breaks: every break in one front, no front faster than c
+    rng = np.random.default_rng(1)
+    breaks = [Break(time=float(t), x=float(x), stretch=0.0, energy=0.0)
+              for t, x in zip(np.round(rng.uniform(0, 1e-3, 300), 6),
+                              rng.integers(0, 40, 300) * 2.5e-3, strict=True)]
+    found = fronts(breaks, lambda t: 0.0, 2e-5, 0.1, c)
+    assert sum(f.size for f in found) == 300
+    assert np.nanmax([f.speed for f in found]) <= c and len(found) < 300
+    with pytest.raises(ValueError, match="wave_speed"):
+        fronts(breaks, lambda t: 0.0, 2e-5, 0.1, 0.0)
+
+
+def test_patched_thresholds_are_the_same_realisation_on_every_mesh():
+    coarse, fine = (ElasticSlider(nx=nx, patches=5, spread=0.5) for nx in (10, 40))
+    j = np.arange(11)
+    assert np.array_equal(coarse.draw_threshold(j, np.zeros(11)),
+                          fine.draw_threshold(4 * j, np.zeros(11)))
+    # within a patch one value, patch to patch another, each re-formation a new draw
+    values = fine.draw_threshold(np.arange(41), np.zeros(41))
+    # patch m is [m L/5, (m + 1) L/5): nodes 8m to 8m + 7, the far-edge node in the last
+    assert len(np.unique(values)) == 5 and values[40] == values[32]
+    assert all(len(np.unique(values[8 * m:8 * m + 8])) == 1 for m in range(5))
+    assert np.all(values[8:40:8] != values[7:39:8])
+    assert fine.draw_threshold(np.array([3]), np.array([1]))[0] != values[3]
+    with pytest.raises(ValueError, match="patches"):
+        ElasticSlider(nx=10, patches=3)
+
+
+def test_kelvin_voigt_viscosity_dissipates_tau_times_the_strain_rate_power():
+    # unbreakable contacts, no pusher: the energy changes only by the viscous dissipation
+    # tau int C eps(v):eps(v) over each step, v the step's mean velocity (the trapezoidal
+    # rule evaluates the linear residual at the mid-step state): round-off only
+    scene = ElasticSlider(nx=10, ny=2, threshold=np.inf, k_push=0.0, viscosity=3e-6)
+    model = ElasticSliderModel(scene, MPI.COMM_WORLD)
+    x = model.V.tabulate_dof_coordinates()
+    model.residual.u_dot.x.array[0::2] = 0.1 * np.sin(np.pi * x[:, 0] / scene.L)
+    mean = dolfinx.fem.Function(model.V)
+    from fenicsfriction.forms import elasticity
+    power = dolfinx.fem.form(scene.viscosity * elasticity(mean, mean, scene.E, scene.nu,
+                                                           ufl.dx(domain=model.msh)))
+    previous = {"v": model.residual.u_dot.x.array.copy()}
+
+    def balance(t: float) -> dict:
+        v = model.residual.u_dot.x.array
+        mean.x.array[:] = 0.5 * (v + previous["v"])
+        previous["v"] = v.copy()
+        rate = model.msh.comm.allreduce(dolfinx.fem.assemble_scalar(power))
+        return {"energy": sum(model.energies().values()), "rate": rate}
+
+    records = model.solver().run(2e-4, 2e-6, observe=balance)
+    lost = records[0]["energy"] - records[-1]["energy"]
+    assert lost > 0.05 * records[0]["energy"]  # the damping is felt: the check has teeth
+    for old, new in zip(records[:-1], records[1:], strict=True):
+        assert old["energy"] - new["energy"] == pytest.approx(
+            new["dt"] * new["rate"], rel=1e-8, abs=1e-12 * records[0]["energy"])
 
 
 @pytest.mark.mpi(min_size=2)
@@ -158,7 +268,8 @@ def test_front_history_is_the_same_on_one_and_on_all_ranks(shared_tmp_path):
 
 
 @pytest.mark.parametrize(("name", "value"), [("spread", 1.0), ("threshold", 0.0), ("nx", 0),
-                                             ("delay", -1.0)])
+                                             ("delay", -1.0), ("viscosity", -1e-6),
+                                             ("patches", -1)])
 def test_bad_scene_parameter_is_named(name, value):
     with pytest.raises(ValueError, match=name):
         ElasticSlider(**{name: value})

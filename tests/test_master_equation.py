@@ -4,6 +4,7 @@ first break in closed form, second-order convergence, and agreement with the mod
 import numpy as np
 import pytest
 from scipy import optimize, stats
+from scipy.integrate import trapezoid
 
 from fenicsfriction.studies.multicontact import EQModel, MasterEquation, critical_stiffness
 
@@ -27,8 +28,77 @@ def test_steady_force_is_N_k_mean_square_threshold_over_twice_the_mean(P_c):
     equation = MasterEquation(model, h=0.005)
     # the quadrature of Q_s(x) ∝ ∫_x^∞ P_c, to QUADPACK's accuracy
     assert equation.steady_force() == pytest.approx(closed_form, rel=1e-8)
+    # the steady state of the scheme: its O(h²) error, (h/σ)² ~ 1e-4 at most here
+    assert equation.kinetic_force() == pytest.approx(closed_form, rel=1e-4)
     # the transient after 30 mean thresholds: O(h²) ~ 1e-5 and a decayed start
-    assert equation.solve(X_max=30.0).kinetic_force == pytest.approx(closed_form, rel=1e-4)
+    assert equation.solve(X_max=30.0).force_at_X_max == pytest.approx(closed_form, rel=1e-4)
+
+
+def test_kinetic_force_converges_to_the_closed_form_at_second_order():
+    model = EQModel(n_contacts=1000, x_s_std=0.1)
+    closed_form = 1000 * stats.truncnorm(a=-10.0, b=np.inf, loc=1.0, scale=0.1).moment(2) / 2
+    errors = [abs(MasterEquation(model, h=h).kinetic_force() - closed_form)
+              for h in (0.04, 0.02, 0.01)]
+    np.testing.assert_allclose(np.log2(np.array(errors[:-1]) / errors[1:]), 2.0, atol=0.05)
+
+
+@pytest.mark.parametrize("newborn", [None, stats.norm(loc=0.2, scale=0.1)],
+                         ids=["relaxed", "gaussian"])
+def test_steady_state_is_a_fixed_point_of_the_step(newborn):
+    equation = MasterEquation(EQModel(x_s_std=0.2, newborn=newborn), h=0.01)
+    q = equation.steady_state()
+    assert np.sum(q) == pytest.approx(1.0, abs=1e-14) and np.all(q >= 0)
+    np.testing.assert_allclose(equation.step(q), q, rtol=0, atol=1e-14)
+
+
+def test_gaussian_newborn_kinetic_force_is_the_continuous_steady_state():
+    """Q_s(x) ∝ s(x) ∫_{-∞}^x r(ξ)/s(ξ) dξ (the steady equation's solution along the
+    characteristics, s the survival of P_c), by quadrature on a grid 100 times finer than
+    the scheme's: the scheme's O(h) error (reborn contacts may break within a step) is
+    (h/σ)·P(x)·h-sized, below 1e-3 here."""
+    P_c = stats.truncnorm(a=-10.0, b=np.inf, loc=1.0, scale=0.1)
+    newborn = stats.norm(loc=0.2, scale=0.1)
+    model = EQModel(n_contacts=300, k=2.0, x_s_std=0.1, newborn=newborn)
+    x = np.linspace(-0.5, 2.0, 250_001)
+    s = P_c.sf(x)
+    inner = np.concatenate([[0.0], np.cumsum(0.5 * (newborn.pdf(x[1:]) / s[1:]
+                                                   + newborn.pdf(x[:-1]) / s[:-1])
+                                             * np.diff(x))])
+    Q = s * inner
+    quadrature = 300 * 2.0 * trapezoid(x * Q, x) / trapezoid(Q, x)
+    assert MasterEquation(model, h=0.005).kinetic_force() == pytest.approx(quadrature,
+                                                                            rel=1e-3)
+
+
+def test_kinetic_force_is_the_steady_one_and_the_transient_end_is_named_apart():
+    """N = 1000, σ = 0.1 x_c: five lives leave the transient 2.5 % above the steady force;
+    after 100 lives it has reached it (the decay is geometric, 2e-9 measured)."""
+    equation = MasterEquation(EQModel(n_contacts=1000, x_s_std=0.1), h=0.01)
+    closed_form = equation.steady_force()
+    short, long = equation.solve(X_max=5.0), equation.solve(X_max=100.0)
+    for result in (short, long):
+        assert result.kinetic_force == pytest.approx(closed_form, rel=1e-4)  # O(h²) = 2e-5
+        assert result.X_max == result.X[-1] and result.force_at_X_max == result.F[-1]
+        # the force is N k ∫ x Q at the last X: recomputed from the stored Q
+        assert result.force_at_X_max == pytest.approx(1000 * float(result.x @ result.Q),
+                                                      rel=1e-14)
+    assert short.X_max == 5.0 and short.force_at_X_max / short.kinetic_force - 1 > 0.02
+    assert long.force_at_X_max == pytest.approx(long.kinetic_force, rel=1e-7)
+
+
+def test_static_force_is_the_peak_of_the_first_break_in_closed_form():
+    """Before any re-formed contact breaks, F/(N k) = X s(X) + ∫_0^X p(ξ)(X − ξ) dξ
+    = X − ∫_0^X ξ p(ξ) dξ (s, p: P_c's survival and density given x_s > 0), whose maximum,
+    where X p(X) = 1, is the static force (re-formed contacts break from X ≈ 1.4 on)."""
+    P_c = stats.norm(loc=1.0, scale=0.1)
+    X = np.linspace(0.0, 1.4, 140_001)
+    xp = X * P_c.pdf(X) / P_c.sf(0.0)
+    closed_form = 50 * 2.0 * float(np.max(
+        X - np.concatenate([[0.0], np.cumsum(0.5 * (xp[1:] + xp[:-1]) * np.diff(X))])))
+    result = MasterEquation(EQModel(n_contacts=50, k=2.0, x_s_std=0.1), h=0.005).solve(3.0)
+    assert result.static_force == float(np.max(result.F))
+    # the scheme's O(h²) with h/σ = 0.05
+    assert result.static_force == pytest.approx(closed_form, rel=1e-4)  # 4e-6 measured
 
 
 def test_the_default_gaussian_steady_force_uses_thresholds_above_zero():

@@ -16,8 +16,9 @@ import scipy.optimize
 
 import fenicsfriction as ff
 from fenicsfriction.stability import StabilitySolver
-from fenicsfriction.studies.block import RigidBlock
+from fenicsfriction.studies.block import RigidBlock, rigid_block_observables
 from fenicsfriction.studies.block.rigid import rigid_loci
+from fenicsfriction.timestepping import ReducedDynamics
 
 _COUNTER = itertools.count()
 
@@ -249,3 +250,82 @@ def test_rigid_generalised_forces_integrate_the_pointwise_tractions():
     arm = block.spring_height - block.H / 2
     assert forces == pytest.approx([area * t + F_s, area * p - block.weight,
                                     area * t * block.H / 2 - F_s * arm], rel=1e-10)
+
+
+# --- stick or no stick: the tangential oscillator on the belt ---------------------------------
+
+def test_block_reaches_the_belt_and_sticks_exactly_when_the_closed_form_says():
+    """The mechanism of Martins & Oden's case (b), on the rigid block with a static and a
+    kinetic friction coefficient and no flutter (μ ≤ 0.3, below the onset; normal damping on).
+
+    Released at rest from u_xG = x* + ξ0, x* = μ_k W/K_x the kinetic equilibrium, the block
+    slides (slip ≈ -U, friction μ_k W) and oscillates about x* at ω = sqrt(K_x/M): its velocity
+    u̇_xG = -ξ0 ω sin ωt. It reaches the belt speed U only if ξ0 ω ≥ U: at ξ0 ω = 0.9 U it
+    never sticks and its largest velocity is ξ0 ω; at ξ0 ω = 1.2 U it enters the stick band
+    (u̇_xG = U - ε) at ωt_1 = π + arcsin((U - ε)/(ξ0 ω)), then moves with the belt until the
+    spring force reaches the static capacity μ(ε) W (the law's μ at the band's edge), after
+    T = [(μ(ε) - μ_k) W/K_x + sqrt(ξ0² - (U/ω)²)] / U.
+
+    μ(|w|) falls linearly from μ_s = 0.3 to μ_k = 0.2 over |w| < v_c = 0.01U (PiecewiseLinear):
+    the sliding phase (|w| ≥ 0.1U) sees μ_k exactly. The closed form leaves out the ramp (the
+    block crosses v_c in v_c / (ω sqrt(ξ0²ω² - U²)) ≈ 0.1 ms, moving t_1 and T by ≲ 0.2 %),
+    the creep inside the band (|w| < ε = 0.002 U: ≤ 0.2 % of T) and the flags' resolution of
+    one step (0.1 %); implicit midpoint's phase error (ω dt)²/12 is 2e-6. Tolerances: 1e-3 on
+    the largest velocity (measured 1.3e-6), 1 % on t_1 and T (measured 1.3e-4 and 5.7e-3).
+    K_x, M, W and U are away from 1 and from the defaults.
+    """
+    mu_s, mu_k, U, eps = 0.3, 0.2, 0.5, 1e-3
+    v_c = 0.01 * U
+    law = ff.InterfaceLaw(b_n=0.381e10, eps=eps, friction_coefficient=ff.laws
+                          .PiecewiseLinearFriction(mu_s, (mu_s - mu_k) / v_c, v_c))
+    block = RigidBlock(K_x=2388.0, mass=0.3, weight=450.0, belt_speed=U, law=law)
+    omega, W, dt = np.sqrt(block.K_x / block.mass), block.weight, 5e-5
+    q_star = block.steady_state()
+    assert q_star[0] == pytest.approx(mu_k * W / block.K_x, rel=1e-9)
+
+    def release(ratio: float, t_end: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        q0 = q_star + np.array([ratio * U / omega, 0.0, 0.0])
+        solver = ReducedDynamics(model=block, q0=q0, q_dot0=np.zeros(3),
+                                 prefix=prefix("release"))
+        rows: list[tuple[float, float, float]] = []
+        solver.run(t_end=t_end, dt=dt, observe=lambda t: rows.append(
+            (t, solver.q_dot[0], solver.q_dot[0] + solver.q_dot[2] * block.H / 2 - U)) or {})
+        t, v, w = np.array(rows).T
+        return t, v, w
+
+    t, v, w = release(0.9, 0.06)  # past the velocity's peak at ωt = 3π/2
+    assert not np.any(np.abs(w) < eps)
+    assert v.max() == pytest.approx(0.9 * U, rel=1e-3)
+
+    xi0 = 1.2 * U / omega
+    t, v, w = release(1.2, 0.11)
+    stuck = np.abs(w) < eps
+    onset = t[np.argmax(stuck)]
+    assert onset == pytest.approx((np.pi + np.arcsin((U - eps) / (xi0 * omega))) / omega,
+                                  rel=1e-2)
+    assert not stuck[-1] and np.all(stuck[t > onset + 0.01][:100])  # it stuck, then slid again
+    capacity = law.friction_coefficient(eps)
+    duration = ((capacity - mu_k) * W / block.K_x + np.sqrt(xi0**2 - (U / omega) ** 2)) / U
+    assert np.sum(np.diff(t)[stuck[1:]]) == pytest.approx(duration, rel=1e-2)
+
+
+def test_rigid_observables_tell_stick_from_slip_by_the_slip_against_eps():
+    """``rigid_block_observables``: the base sticks when |w| < ε, w = u̇_xG + θ̇ H/2 - U (the
+    rotation's share included), slips otherwise, is open when lifted; the friction force is
+    the C1 law's -μ N w/ε inside the band and -μ N sgn(w) outside (N the elastic normal force;
+    no normal damping here). ε, U and μ are away from 1 and from each other."""
+    eps, U, mu = 2e-3, 0.3, 0.4
+    block = RigidBlock(belt_speed=U, law=ff.InterfaceLaw(mu=mu, eps=eps))
+    q = block.steady_state()
+    h2 = block.H / 2
+    for q_dot, ratio in (([U + 0.9 * eps, 0, 0], 0.9), ([U - 0.9 * eps, 0, 0], -0.9),
+                         ([U + 1.1 * eps, 0, 0], 1.1), ([U - 1.1 * eps, 0, 0], -1.1),
+                         ([U, 0, 0.95 * eps / h2], 0.95), ([U, 0, -1.05 * eps / h2], -1.05)):
+        seen = rigid_block_observables(block, q, np.array(q_dot, float))
+        assert seen["slip_velocity"] == pytest.approx(ratio * eps, rel=1e-9)
+        assert seen["contact"] == ("stick" if abs(ratio) < 1 else "slip")
+        coulomb = -mu * seen["normal_force_elastic"]
+        assert seen["friction_force"] == pytest.approx(
+            coulomb * (ratio if abs(ratio) < 1 else np.sign(ratio)), rel=1e-9)
+    lifted = rigid_block_observables(block, np.array([q[0], 1e-3, 0.0]), np.zeros(3))
+    assert lifted["contact"] == "open" and lifted["normal_force"] == 0.0

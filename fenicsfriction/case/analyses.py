@@ -221,6 +221,7 @@ def run_case(case: Case, out: pathlib.Path, comm: MPI.Comm = MPI.COMM_WORLD,
             outcome.interrupted, outcome.exit_code = str(err), err.exit_code
         _figures(case, outcome, out, comm)
         signum = comm.allreduce(stop.received, op=MPI.MAX)
+        stop.received = 0  # handled here, not again by the command line
         if signum and outcome.interrupted is None:  # after the last step: all is written
             outcome.interrupted = str(Interrupted(signum, "the last step"))
             outcome.exit_code = 128 + signum

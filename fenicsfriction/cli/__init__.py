@@ -22,9 +22,10 @@ computed so far written, one line, and status 130/143.
 
 from __future__ import annotations
 
-import logging
 import sys
+import typing
 
+from fenicsfriction import signals
 from fenicsfriction.cli import block, cea, contact, multicontact, oscillators, rolling, run
 from fenicsfriction.cli.arguments import Parser
 
@@ -63,11 +64,6 @@ def _old_spelling(argv: list[str]) -> str | None:
     return f"'{old} {second}' is now '{new}'"
 
 
-#: the root logger's handler while a command runs, warnings and errors only (made at the
-#: first run: its class comes with the MPI-importing results module)
-_WARNINGS_ONLY: list[logging.Handler] = []
-
-
 def _parser() -> Parser:
     parser = Parser(prog="fenicsfriction",
                     description="Friction by finite elements and reduced models: "
@@ -80,8 +76,28 @@ def _parser() -> Parser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``fenicsfriction`` console script and ``python -m fenicsfriction``."""
-    argv = sys.argv[1:] if argv is None else list(argv)
+    """Entry point of the ``fenicsfriction`` console script and ``python -m fenicsfriction``.
+
+    SIGINT and SIGTERM are caught from the first line (:func:`fenicsfriction.signals.catch`):
+    one during the start-up (flags, MPI, PETSc) waits for its end; one during the set-up
+    (mesh, just-in-time compilation, the first steady state; a command with no steps to stop
+    at) stops the command at once. Either way ``summary.json`` in ``--out`` says after which
+    stage, one line and status 130/143. During the run's steps a signal stops it at the next
+    step; after its last step the results are complete and the status is still 130/143.
+    """
+    previous = signals.catch()
+    try:
+        return _main(sys.argv[1:] if argv is None else list(argv))
+    except KeyboardInterrupt:  # a second signal inside a step: no summary, but no traceback
+        print("fenicsfriction: interrupted inside a step; the rows written so far are kept",
+              file=sys.stderr, flush=True)
+        return 130
+    finally:
+        signals.release(previous)
+
+
+def _main(argv: list[str]) -> int:
+    """:func:`main` once the signals are caught."""
     # everything after the first PETSc-style option (-prefix_name) goes to PETSc
     split = next((i for i, a in enumerate(argv) if a.startswith("-") and not a.startswith("--")
                   and len(a) > 2 and not a[1].isdigit()), len(argv))
@@ -93,35 +109,52 @@ def main(argv: list[str] | None = None) -> int:
     if split < len(argv):
         from petsc4py import PETSc
         PETSc.Options().insertString(" ".join(argv[split:]))
-    logging.getLogger("ffcx").setLevel(logging.WARNING)
-    logging.getLogger("UFL").setLevel(logging.WARNING)
-    logging.getLogger().setLevel(logging.WARNING)
-    # the just-in-time compiler's build (setuptools) configures the root logger at INFO the
-    # first time a form is compiled, unless it has a handler already: one that passes only
-    # warnings keeps its build lines off the terminal
     from mpi4py import MPI
 
-    from fenicsfriction.results import StderrHandler, blas_library, get_logger
-    if not _WARNINGS_ONLY:
-        handler = StderrHandler()
-        handler.setLevel(logging.WARNING)
-        handler.setFormatter(logging.Formatter("%(levelname)s:%(name)s:%(message)s"))
-        _WARNINGS_ONLY.append(handler)
-    if _WARNINGS_ONLY[0] not in logging.getLogger().handlers:  # once: main() runs many times
-        logging.getLogger().addHandler(_WARNINGS_ONLY[0])
-    log = get_logger(MPI.COMM_WORLD)
-    blas = blas_library()
-    if blas["optimized"] is False:
-        log.warning("fenicsfriction: the reference BLAS is in use (%s): direct solvers and "
-                    "eigensolvers run 2-3x slower; install an optimized one (Debian: "
-                    "libopenblas0-serial)", ", ".join(blas["paths"]))
+    from fenicsfriction.cli.common import stop_line
+    from fenicsfriction.results import blas_library, get_logger
+    log = get_logger(MPI.COMM_WORLD, progress="stdout")  # and quiets the JIT's build lines
+    comm = MPI.COMM_WORLD
     try:
-        return args.run(args, log)
+        signals.checkpoint("the start-up (flags read, MPI and PETSc loaded)", comm)
+        signals.raise_at_once(comm)  # the set-up's stages need not check
+        blas = blas_library()
+        if blas["optimized"] is False:
+            log.warning("fenicsfriction: the reference BLAS is in use (%s): direct solvers and "
+                        "eigensolvers run 2-3x slower; install an optimized one (Debian: "
+                        "libopenblas0-serial)", ", ".join(blas["paths"]))
+        code = args.run(args, log)
     except ValueError as err:
-        if MPI.COMM_WORLD.rank == 0:
-            print(f"fenicsfriction: error: {err}", file=sys.stderr)
+        if comm.rank == 0:
+            print(f"fenicsfriction: error: {err}", file=sys.stderr, flush=True)
         return 2
-    except KeyboardInterrupt:  # a second signal inside a step: no summary, but no traceback
-        print("fenicsfriction: interrupted inside a step; the rows written so far are kept",
-              file=sys.stderr)
-        return 130
+    except BaseException as err:  # a signal in the set-up, before the run's own steps
+        interrupted = signals.interruption(err)  # also inside an import or a PETSc callback
+        if interrupted is None:
+            raise
+        _setup_summary(args, argv, interrupted, comm)
+        stop_line(f"{interrupted}; the run had not begun its steps", comm)
+        return interrupted.exit_code
+    signum = signals.pending_on(comm)
+    if signum:  # came after the run's last check: everything is written
+        stop_line(f"{signals.Interrupted(signum, 'the run had finished')}; its results are "
+                  "complete", comm)
+        return 128 + signum
+    return code
+
+
+def _setup_summary(args: typing.Any, argv: list[str], err: Exception, comm: typing.Any) -> None:
+    """``summary.json`` in the run's ``--out`` saying the set-up was interrupted (nothing if
+    the command has no output folder or it cannot be written)."""
+    out = getattr(args, "out", None)
+    if out is None:
+        return
+    from fenicsfriction.cli.common import output_folder
+    from fenicsfriction.results import write_summary
+    try:
+        output_folder(out, comm)
+    except ValueError:
+        return
+    write_summary(out / "summary.json", {
+        "command": ["fenicsfriction", *argv], "stage": "set-up", "interrupted": str(err),
+        "failure": None}, comm)

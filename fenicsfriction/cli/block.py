@@ -128,6 +128,9 @@ def add_parser(commands: typing.Any) -> None:
     dynamics.add_argument("--perturbation", type=float, default=-0.01,
                           help="initial normal velocity added to the steady state [cm/s]")
     dynamics.add_argument("--stride", type=int, default=20, help="steps between field outputs")
+    dynamics.add_argument("--record-every", type=int, default=1, metavar="K",
+                          help="write every K-th time step (and the last) to timeseries.csv; "
+                               "the summary's statistics still see every step (1)")
     dynamics.add_argument("--probe-x", type=float,
                           help="abscissa [cm] of the contact node whose tractions are recorded "
                                "(default: L/2, the paper's node 29)")
@@ -179,12 +182,15 @@ def _build(args: argparse.Namespace) -> tuple[BlockOnBelt, BlockModel, SteadySol
     check("--mu-max", args.mu_max, np.isfinite(args.mu_max) and args.mu_max >= 0, "must be >= 0")
     check("--steps", args.steps, args.steps >= 1, "must be >= 1")
     check("--max-halvings", args.max_halvings, args.max_halvings >= 0, "must be >= 0")
+    from fenicsfriction.signals import checkpoint
+
     scene = _scene(args)
     output_folder(args.out)
     model = scene.build(MPI.COMM_WORLD, with_friction=args.mu_max > 0)
     model.initial_guess()
     solver = SteadySolver(model.residual, prefix="steady_", options=model.solver_options(),
                           search_rounds=model.search_rounds)
+    checkpoint("the set-up (model built and compiled)")
     return scene, model, solver, np.linspace(0.0, args.mu_max, args.steps + 1)
 
 
@@ -197,7 +203,12 @@ def run_steady(args: argparse.Namespace, log: logging.Logger) -> int:
     from fenicsfriction import io, plotting, results
     from fenicsfriction.laws import check
     from fenicsfriction.signals import Interrupted, StopSignals
-    from fenicsfriction.steady import ContinuationError, continuation, epsilon_sequence
+    from fenicsfriction.steady import (
+        ContinuationError,
+        SolveError,
+        continuation,
+        epsilon_sequence,
+    )
 
     comm = MPI.COMM_WORLD
     check("--snapshots", args.snapshots, args.snapshots >= 0, "must be >= 0")
@@ -238,10 +249,33 @@ def run_steady(args: argparse.Namespace, log: logging.Logger) -> int:
         except Interrupted as err:
             interrupted = err
     results.write_json(out / "steady.json", records, comm)
-    eps_records = None
+    eps_records: list[dict] | None = None
+    eps_start = float(model.eps.value)
     if args.eps_sequence and failure is None and interrupted is None:
-        eps_records = epsilon_sequence(solver, model.eps, args.eps_sequence,
-                                       observe=model.quantities)
+        eps_records = []
+        try:
+            with StopSignals(comm) as stop:
+                def on_eps(record: dict) -> None:
+                    assert eps_records is not None
+                    eps_records.append(record)
+                    results.write_json(out / "epsilon.json", eps_records, comm)
+                    stop.check(f"ε = {record['eps']:.6g} (ε step {len(eps_records)} of "
+                               f"{len(args.eps_sequence)}) at μ = {args.mu_max:.6g}")
+
+                epsilon_sequence(solver, model.eps, args.eps_sequence,
+                                 observe=model.quantities, on_step=on_eps)
+        except SolveError as err:
+            value = args.eps_sequence[len(eps_records)]
+            last = (f"ε = {float(model.eps.value):.6g}" if eps_records else
+                    f"the continuation's ε = {eps_start:.6g}")
+            failure = (f"the ε sequence at μ = {args.mu_max:.6g} failed at ε = {value:.6g} "
+                       f"(step {len(eps_records) + 1} of {len(args.eps_sequence)}): {err}; the "
+                       f"last converged state ({last}) is written to epsilon_last.xdmf, the ε "
+                       "steps done to epsilon.json")
+            with io.FieldWriter(out / "epsilon_last.xdmf", model) as last_state:
+                last_state.write(float(model.eps.value))
+        except Interrupted as err:
+            interrupted = err
         results.write_json(out / "epsilon.json", eps_records, comm)
         log.info("sequential ε process at μ = %.4g:\n%12s %12s %14s %8s", args.mu_max, "eps",
                  "change", "F_T/(μN) - 1", "Newton")
@@ -258,6 +292,9 @@ def run_steady(args: argparse.Namespace, log: logging.Logger) -> int:
         "tipping_limit": scene.tipping_limit,
         "discrete_tipping_limit": scene.discrete_tipping_limit,
         "distance_to_tipping": scene.tipping_limit - float(model.mu.value),
+        "eps_last_converged": (float(model.eps.value) if eps_records is not None else None),
+        "stage": (None if failure is None and interrupted is None else
+                  "ε sequence" if eps_records is not None else "continuation in μ"),
         "failure": failure, "interrupted": None if interrupted is None else str(interrupted)},
         comm)
     plotting.plot_deformed(snapshots, out / "deformed.png", scene.L, scene.H, comm)
@@ -289,24 +326,27 @@ def run_stability(args: argparse.Namespace, log: logging.Logger) -> int:
 
     comm = MPI.COMM_WORLD
     check("--max-frequency", args.max_frequency, args.max_frequency > 0, "must be > 0")
-    check("--onset-tol", args.onset_tol, args.onset_tol > 0, "must be > 0")
+    check("--onset-tol", args.onset_tol, args.onset_tol >= 1e-12 * max(args.mu_max, 1.0),
+          "must be >= 1e-12 max(μ-max, 1) (a narrower interval is below round-off: the "
+          "bisection would not end)")
     check("--growth-tol", args.growth_tol, args.growth_tol > 0, "must be > 0")
     t_start = time.perf_counter()
     scene, model, solver, targets = _build(args)
     out: pathlib.Path = args.out
     loci = Loci(solver, StabilitySolver(model.residual, prefix="stability_"), model.mu,
-                args.max_frequency, args.growth_tol)
+                args.max_frequency, args.growth_tol, max_halvings=args.max_halvings)
     transitions: list[tuple[float, float, list[Mode]]] = []
     previous: dict[str, typing.Any] = {}
     records: list[dict] = []
 
-    def write(fe: dict, rigid: typing.Any, failure: str | None, interrupted: str | None) -> None:
+    def write(fe: dict, rigid: typing.Any, failure: str | None, interrupted: str | None,
+              stage: str | None = None) -> None:
         results.write_summary(out / "stability.json", {
             "scene": args.scene, "parameters": dataclasses.asdict(scene), "ranks": comm.size,
             "mu_crit": {"fe": fe["mu_crit"], "rigid": rigid.mu_crit if rigid else None},
             "fe": fe, "rigid": rigid, "max_frequency": args.max_frequency,
             "growth_tol": args.growth_tol, "wall_time_s": time.perf_counter() - t_start,
-            "failure": failure, "interrupted": interrupted}, comm)
+            "stage": stage, "failure": failure, "interrupted": interrupted}, comm)
 
     failure, interrupted = None, None
     with StopSignals(comm) as stop, io.ModeWriter(out / "unstable_modes.xdmf", model) as shapes:
@@ -332,16 +372,32 @@ def run_stability(args: argparse.Namespace, log: logging.Logger) -> int:
             failure = f"at μ = {float(model.mu.value):.6g}: {err}"
         except Interrupted as err:
             interrupted = err
-    finished = failure is None and interrupted is None
-    onsets = [loci.onset(a, b, args.onset_tol, reference=ref)
-              for a, b, ref in transitions] if finished else []
+    onsets = []
+    stage = "continuation in μ" if failure is not None or interrupted is not None else None
+    if failure is None and interrupted is None:
+        with StopSignals(comm) as stop:
+            for k, (a, b, ref) in enumerate(transitions):
+                try:
+                    onsets.append(loci.onset(a, b, args.onset_tol, reference=ref))
+                    stop.check(f"the onset bisection in [{a:.6g}, {b:.6g}] ({k + 1} of "
+                               f"{len(transitions)})")
+                except (ContinuationError, EigenSolveError, ValueError) as err:
+                    stage = "onset bisection"
+                    failure = (f"the onset bisection in μ ∈ [{a:.6g}, {b:.6g}] failed at μ = "
+                               f"{float(model.mu.value):.6g}: {err}; the loci of every grid "
+                               f"step and the {len(onsets)} onset(s) found before are written "
+                               "to stability.json")
+                    break
+                except Interrupted as err:
+                    stage, interrupted = "onset bisection", err
+                    break
     rigid = rigid_loci(scene, targets, args.max_frequency, args.growth_tol,
                        args.onset_tol) if interrupted is None else None
     fe = {"steps": records, "onsets": onsets,
           "mu_crit": onsets[0].mu_crit if onsets else None,
           "unstable_intervals": {str(k): v for k, v in
                                  unstable_intervals(records, args.growth_tol).items()}}
-    write(fe, rigid, failure, None if interrupted is None else str(interrupted))
+    write(fe, rigid, failure, None if interrupted is None else str(interrupted), stage)
     plotting.plot_loci(records, rigid.steps if rigid else [], out / "loci.png", comm)
     plotting.plot_growth(records, rigid.steps if rigid else [], out / "growth.png", comm)
     comm.Barrier()
@@ -360,13 +416,13 @@ def run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
     import numpy as np
 
     from fenicsfriction import io, plotting, results
-    from fenicsfriction.cli.common import output_folder
+    from fenicsfriction.cli.common import output_folder, stopped
     from fenicsfriction.dynamics import CentralDifference, DynamicsSolver
     from fenicsfriction.laws import check
-    from fenicsfriction.results import CsvRows
-    from fenicsfriction.signals import Interrupted, StopSignals
+    from fenicsfriction.results import CsvRows, RunningStatistics, SampledRecords
+    from fenicsfriction.signals import Interrupted, StopSignals, checkpoint
     from fenicsfriction.statistics import stick_slip_statistics
-    from fenicsfriction.steady import SteadySolver
+    from fenicsfriction.steady import ContinuationError, SteadySolver
     from fenicsfriction.timestepping import DynamicsError
 
     comm = MPI.COMM_WORLD
@@ -374,16 +430,45 @@ def run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
     check("--t-end", args.t_end, args.t_end > 0, "must be > 0")
     check("--dt", args.dt, 0 < args.dt <= args.t_end, "must lie in (0, t-end]")
     check("--stride", args.stride, args.stride >= 1, "must be >= 1")
+    check("--record-every", args.record_every, args.record_every >= 1, "must be >= 1")
     scene = _scene(args, mu=args.mu)
+    # beyond the tipping limit no steady sliding exists to start from: refuse before meshing
+    check("--mu", args.mu, args.mu < scene.discrete_tipping_limit,
+          f"must be < {scene.discrete_tipping_limit:.6g}, the tipping limit of this block "
+          f"(L/(2 h_s) = {scene.tipping_limit:.6g}, less the outermost contact point's inset): "
+          "beyond it no steady sliding exists to start the dynamics from")
     check("--scheme", args.scheme, args.scheme == "alpha2" or args.scene == "block",
           f"the scene {args.scene} needs alpha2 (central differences have no contact "
           "couplings)")
     out = output_folder(args.out)
+    t_start = time.perf_counter()
     model = scene.build(comm)
     model.initial_guess()
     steady = SteadySolver(model.residual, prefix="steady_", options=model.solver_options(),
                           search_rounds=model.search_rounds)
-    model.slide_to(args.mu, steady)
+    checkpoint("the set-up (model built and compiled)")
+
+    def summary(**fields: typing.Any) -> None:
+        results.write_summary(out / "summary.json", {
+            "scene": args.scene, "parameters": dataclasses.asdict(scene), "scheme": args.scheme,
+            "dt": args.dt, "record_every": args.record_every,
+            "wall_time_s": time.perf_counter() - t_start, **fields}, comm)
+
+    try:
+        model.slide_to(args.mu, steady)
+    except ContinuationError as err:
+        reached = float(err.records[-1]["value"]) if err.records else None
+        with io.FieldWriter(out / "slide.xdmf", model) as last_state:
+            last_state.write(float(model.mu.value))
+        kept = ("no steady state converged (the initial guess is written to slide.xdmf)"
+                if reached is None else
+                f"the last converged steady state (μ = {reached:.6g}) is written to slide.xdmf")
+        halt = (f"the slide to μ = {args.mu:.6g} (the steady state the run starts from) "
+                f"failed: {err}; no time step taken, {kept}")
+        summary(stage="slide to μ", mu_last_converged=reached, steps=0, failure=halt,
+                interrupted=None, statistics=None, running_statistics=None)
+        return stopped(halt, None)
+    checkpoint(f"the set-up (steady sliding at μ = {args.mu:.6g})")
     model.perturb_normal_velocity(args.perturbation)
     dynamics: CentralDifference | DynamicsSolver
     if args.scheme == "central":
@@ -396,14 +481,23 @@ def run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
                                   atol=1e-10 * model.force_scale)
     observe = model.dynamics_observer(args.probe_x)
 
-    records: list[dict] = []
+    # every step feeds the running statistics; a bounded sample is kept for the figures and
+    # the stick-slip statistics; every K-th step goes to the table: memory stays flat
+    whole, window = RunningStatistics(), RunningStatistics(t_from=0.5 * args.t_end)
+    sampled = SampledRecords()
+    steps = [0]
+    last: dict[str, typing.Any] = {}
     failure, interrupted = None, None
     with StopSignals(comm) as stop, CsvRows(out / "timeseries.csv", comm) as table, \
             io.FieldWriter(out / "dynamics.xdmf", model) as fields:
         def on_step(record: dict) -> None:
-            k = len(records)
-            records.append(record)
-            table.write(record)
+            k = steps[0]
+            steps[0] += 1
+            for accumulator in (whole, window, sampled):
+                accumulator.add(record)
+            last.update(record=record, written=k % args.record_every == 0)
+            if last["written"]:
+                table.write(record)
             if k % args.stride == 0:
                 fields.write(record["time"])
                 log.info(f"step {k:6d}  t={record['time']:.4e} s  dt={record['dt']:.2e}  "
@@ -413,26 +507,45 @@ def run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
             stop.check(f"t = {record['time']:.6g} s (step {k})")
 
         try:
-            dynamics.run(args.t_end, args.dt, observe=observe, on_step=on_step)
+            dynamics.run(args.t_end, args.dt, observe=observe, on_step=on_step,
+                         keep_records=False)
         except DynamicsError as err:
             failure = str(err)
         except Interrupted as err:
             interrupted = err
+        if last and not last["written"]:  # the last step is always in the table
+            table.write(last["record"])
     statistics = None
+    records = sampled.records()
     if len(records) > 2:  # over the second half of what was integrated
         statistics = stick_slip_statistics(records, args.mu, float(model.eps.value),
                                            t_from=0.5 * records[-1]["time"])
+        # the run's totals from every step, not the sample
+        exact: dict[str, typing.Any] = {
+            "steps": whole.count - 1, "newton_iterations": whole.totals["newton_iterations"],
+            "rejected_steps": whole.totals["rejected_steps"]}
+        if "energy_error" in whole:
+            exact["max_energy_error"] = whole["energy_error"]["max_abs"]
+        if failure is None and interrupted is None and window.count > 2:
+            # the second half of the run as asked: its means from every step
+            mean_n, mean_f = window.mean("normal_force"), window.mean("friction_force")
+            exact.update(
+                t_from=window.t_first, mean_normal_force=mean_n, mean_friction_force=mean_f,
+                normal_force_range=[window["normal_force"]["min"],
+                                    window["normal_force"]["max"]],
+                apparent_coefficient=abs(mean_f) / mean_n,
+                ratio_to_mu=abs(mean_f) / mean_n / args.mu if args.mu > 0 else float("nan"))
+        statistics = dataclasses.replace(statistics, **exact)
         if comm.rank == 0:
             plotting.plot_stick_slip({f"U = {scene.belt_speed} cm/s": records},
                                      out / "stick_slip.png", args.mu, float(model.eps.value))
         log.info(f"apparent friction coefficient {statistics.apparent_coefficient:.4f} "
                  f"(μ = {args.mu}), probe node sticks {statistics.probe_stick_fraction:.1%} "
                  f"of the time (second half of the run)")
-    results.write_summary(out / "summary.json", {
-        "scene": args.scene, "parameters": dataclasses.asdict(scene), "scheme": args.scheme,
-        "dt": args.dt, "steps": len(records) - 1, "failure": failure,
-        "interrupted": None if interrupted is None else str(interrupted),
-        "statistics": statistics}, comm)
+    summary(steps=whole.count - 1, failure=failure,
+            interrupted=None if interrupted is None else str(interrupted),
+            stage=None if failure is None and interrupted is None else "time integration",
+            statistics=statistics, sampled_every=sampled.stride,
+            running_statistics=whole.to_json())
     log.info(f"results in {out}/: timeseries.csv, summary.json, dynamics.xdmf, stick_slip.png")
-    from fenicsfriction.cli.common import stopped
     return stopped(failure, interrupted)

@@ -125,7 +125,10 @@ def add_parser(commands: typing.Any) -> None:
             ("--spread", float, "relative spread of the thresholds (0.5)"),
             ("--delay", float, "time a broken contact stays off [s] (0)"),
             ("--push-speed", float, "speed of the pushing stage [m/s] (0.01)"),
-            ("--seed", int, "seed of the thresholds (0)")):
+            ("--seed", int, "seed of the thresholds (0)"),
+            ("--patches", int, "patches of the base sharing a threshold, dividing nx (0: one "
+                               "per node)"),
+            ("--viscosity", float, "Kelvin-Voigt relaxation time of the slider [s] (0)")):
         slider.add_argument(name, type=kind, help=text)
     slider.add_argument("--t-end", type=float, default=5e-3, help="final time [s] (5e-3)")
     slider.add_argument("--dt", type=float, default=1e-6, help="time step [s] (1e-6)")
@@ -185,7 +188,8 @@ def _run_eq(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> in
     me = MasterEquation(model, args.h).solve(X_max)
     summary = {"command": "eq", **_record(run), "K_star": me.K_star,
                "master_equation": {"kinetic_force": me.kinetic_force,
-                                   "static_force": me.static_force, "h": me.h}}
+                                   "static_force": me.static_force, "X_max": me.X_max,
+                                   "force_at_X_max": me.force_at_X_max, "h": me.h}}
     results.write_summary(out / "multicontact.json", summary, comm)
     write_rows(out / "force.csv", ({"X": x, "F": f, "F_std": e}
                              for x, f, e in zip(run.X, run.F, run.F_std, strict=True)), comm)
@@ -221,7 +225,9 @@ def _run_master_equation(args: argparse.Namespace, log: logging.Logger, comm: MP
     write_rows(out / "force.csv", ({"X": x, "F": f} for x, f in zip(me.X, me.F, strict=True)), comm)
     if comm.rank == 0:
         figures.master_equation_figure(me, out / "master_equation.png")
-    log.info(f"static force {me.static_force:.6g}, kinetic {me.kinetic_force:.6g}, "
+    log.info(f"static force {me.static_force:.6g}, kinetic (steady state) "
+             f"{me.kinetic_force:.6g}, force at X_max = {me.X_max:g} {me.force_at_X_max:.6g} "
+             f"({me.force_at_X_max / me.kinetic_force - 1:+.2%} from kinetic), "
              f"K* = {me.K_star:.6g}, mass error {me.mass_error:.1e}; results in {out}/: "
              "multicontact.json, force.csv, master_equation.png")
     return 0
@@ -411,15 +417,13 @@ def _run_fk(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> in
 # --- the elastic slider on an EQ interface ------------------------------------------------------
 
 def _run_slider(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
-    import numpy as np
-
     from fenicsfriction import results
     from fenicsfriction.cli.common import output_folder
     from fenicsfriction.io import FieldWriter
     from fenicsfriction.studies.multicontact import ElasticSlider, ElasticSliderModel, figures
 
     names = ("L", "H", "nx", "ny", "E", "nu", "rho", "k", "threshold", "spread", "delay",
-             "push_speed", "seed")
+             "push_speed", "seed", "patches", "viscosity")
     scene = ElasticSlider(**{n: getattr(args, n) for n in names if getattr(args, n) is not None})
     out = output_folder(args.out, comm)
     model = ElasticSliderModel(scene, comm)
@@ -438,8 +442,8 @@ def _run_slider(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -
     summary = {"command": "slider", "parameters": {**scene.__dict__, "t_end": args.t_end,
                                                    "dt": args.dt},
                "breaks": len(history.breaks), "fronts": [f.to_json() for f in history.fronts],
-               "slip_force": history.slip_force,
-               "peak_push_force": float(np.max(history.push_force))}
+               "slip_force": history.slip_force, "peak_push_force": history.peak_force,
+               "wave_speeds": {"c_p": scene.wave_speeds[0], "c_s": scene.wave_speeds[1]}}
     results.write_summary(out / "multicontact.json", summary, comm)
     with FieldWriter(out / "slider.xdmf", model) as writer:
         writer.write(float(model.time.value))

@@ -183,14 +183,16 @@ def _flat(box: list[float], axis: int, value: float, tol: float) -> bool:
 
 
 def _refine_near_origin(gmsh: typing.Any, h_contact: float, h_far: float, half_width: float,
-                        grading: float) -> None:
-    """Mesh size ``h_contact`` in the box |x|, |y|, |z| <= ``half_width``, growing linearly with
-    the distance from it (by ``grading`` per unit length) up to ``h_far``."""
+                        grading: float, depth: float | None = None) -> None:
+    """Mesh size ``h_contact`` in the box |x|, |y| <= ``half_width``, |z| <= ``depth``
+    (default ``half_width``), growing linearly with the distance from it (by ``grading`` per
+    unit length) up to ``h_far``."""
+    depth = half_width if depth is None else depth
     field = gmsh.model.mesh.field
     box = field.add("Box")
     for key, value in (("VIn", h_contact), ("VOut", h_far), ("XMin", -half_width),
                        ("XMax", half_width), ("YMin", -half_width), ("YMax", half_width),
-                       ("ZMin", -half_width), ("ZMax", half_width),
+                       ("ZMin", -depth), ("ZMax", depth),
                        ("Thickness", (h_far - h_contact) / grading)):
         field.setNumber(box, key, value)
     field.setAsBackgroundMesh(box)
@@ -286,7 +288,7 @@ def hertz_3d(comm: MPI.Comm, R: float = 1.0, block_half_width: float | None = No
              block_height: float | None = None, h_contact: float | None = None,
              h_far: float | None = None, refine_half_width: float | None = None,
              refine: int = 0, grading: float = 0.3, msh_file: str | None = None,
-             partition: str = "graph") -> TwoBodyMesh:
+             partition: str = "graph", refine_depth: float | None = None) -> TwoBodyMesh:
     """A quarter of a hemisphere on a quarter block (x >= 0, y >= 0; tetrahedra).
 
     Body 1 is the quarter (x, y >= 0) of the lower hemisphere of radius ``R`` centred at
@@ -305,6 +307,9 @@ def hertz_3d(comm: MPI.Comm, R: float = 1.0, block_half_width: float | None = No
         h_far: Largest mesh size, away from the contact (default 0.5R), before ``refine``.
         refine_half_width: Half-width of the cube |x|, |y|, |z| <= it where the size is
             ``h_contact`` (default 0.25R); in [h_contact, R].
+        refine_depth: If given, the refined zone is the slab |x|, |y| <= ``refine_half_width``,
+            |z| <= ``refine_depth`` instead (in [h_contact, refine_half_width]): a thin layer
+            along the contact plane, for a small ``h_contact`` at a sane cost.
         refine: Halve ``h_contact`` and ``h_far`` this many times (about 8 times the cells).
         grading: Growth of the mesh size per unit distance from that cube, up to ``h_far``.
         msh_file: If given, rank 0 writes the gmsh mesh there (``.msh``).
@@ -320,6 +325,9 @@ def hertz_3d(comm: MPI.Comm, R: float = 1.0, block_half_width: float | None = No
     """
     W, H, h_c, h_f, w = _hertz_sizes(R, block_half_width, block_height, h_contact, h_far,
                                      refine_half_width, refine, grading, (0.02, 0.25))
+    if refine_depth is not None:
+        laws.check("refine_depth", refine_depth, h_c <= refine_depth <= w,
+                   f"must lie in [h_contact, refine_half_width] = [{h_c}, {w}]")
 
     def construct(gmsh: typing.Any) -> None:
         occ = gmsh.model.occ
@@ -346,10 +354,11 @@ def hertz_3d(comm: MPI.Comm, R: float = 1.0, block_half_width: float | None = No
                     groups[tag].append(face)
         _add_groups(gmsh, 3, {BODY1: [ball], BODY2: [block]})
         _add_groups(gmsh, 2, groups)
-        _refine_near_origin(gmsh, h_c, h_f, w, grading)
+        _refine_near_origin(gmsh, h_c, h_f, w, grading, refine_depth)
 
     parameters = {"R": R, "block_half_width": W, "block_height": H, "h_contact": h_c,
-                  "h_far": h_f, "refine_half_width": w, "refine": refine, "grading": grading}
+                  "h_far": h_f, "refine_half_width": w, "refine": refine, "grading": grading,
+                  "refine_depth": refine_depth}
     return _build(comm, "hertz_3d", 3, construct, msh_file, parameters, partition, _around_z)
 
 

@@ -44,6 +44,7 @@ Modelling choices the papers leave open (Braun, Barel & Urbakh 2009 describe a 1
 from __future__ import annotations
 
 import dataclasses
+import math
 import pathlib
 import typing
 
@@ -82,6 +83,11 @@ class ElasticSlider:
         k_push: stiffness of the pusher springs per unit length of the left face [Pa/m].
         push_speed: speed V of the pusher stage [m/s].
         seed: seed of the thresholds.
+        patches: number of equal patches of the base that share a threshold (0: one per node);
+            with ``nx`` a multiple of ``patches`` the realisation of the thresholds is a
+            function of x alone, the same on every mesh.
+        viscosity: Kelvin-Voigt relaxation time τ of the slider [s]: σ = C : (ε(u) + τ ε(u̇))
+            damps the waves the breaks radiate (a mode of frequency ω by ωτ/2 of critical).
     """
 
     L: float = 0.1
@@ -99,6 +105,8 @@ class ElasticSlider:
     k_push: float = 1e11
     push_speed: float = 0.01
     seed: int = 0
+    patches: int = 0
+    viscosity: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("L", "H", "E", "rho", "k"):
@@ -108,21 +116,37 @@ class ElasticSlider:
             check(name, getattr(self, name), int(getattr(self, name)) >= 1, "must be >= 1")
         check("nu", self.nu, -1 < self.nu < 0.5, "must lie in (-1, 0.5)")
         check("spread", self.spread, 0 <= self.spread < 1, "must lie in [0, 1)")
-        for name in ("delay", "k_push", "push_speed"):
+        for name in ("delay", "k_push", "push_speed", "viscosity"):
             check_positive(name, getattr(self, name), strict=False)
+        check("patches", self.patches, self.patches >= 0 and (
+            self.patches == 0 or self.nx % self.patches == 0),
+            f"must be 0 or divide nx = {self.nx}")
 
     @property
     def h(self) -> float:
         """Spacing of the base nodes [m]."""
         return self.L / self.nx
 
+    @property
+    def wave_speeds(self) -> tuple[float, float]:
+        r"""The slider's P- and S-wave speeds :math:`(c_p, c_s)` [m/s]: :math:`c_s^2 = \mu/\rho`;
+        :math:`c_p^2 = (\lambda + 2\mu)/\rho` in plane strain, :math:`E/(\rho(1 - \nu^2))`
+        (the plate's) in plane stress."""
+        mu = self.E / (2 * (1 + self.nu))
+        if self.plane_stress:
+            return math.sqrt(self.E / (self.rho * (1 - self.nu**2))), math.sqrt(mu / self.rho)
+        lam = self.E * self.nu / ((1 + self.nu) * (1 - 2 * self.nu))
+        return math.sqrt((lam + 2 * mu) / self.rho), math.sqrt(mu / self.rho)
+
     def draw_threshold(self, node: np.ndarray, count: np.ndarray) -> np.ndarray:
         """Thresholds x_s [m] of base nodes ``node`` (numbers j = x/h) formed ``count`` times
         before: the same numbers on any partition of the mesh."""
         if not np.isfinite(self.threshold):
             return np.full(len(node), np.inf)
+        where = node if self.patches == 0 else np.minimum(
+            np.asarray(node) * self.patches // self.nx, self.patches - 1)
         uniform = np.array([np.random.default_rng((self.seed, int(j), int(c))).random()
-                            for j, c in zip(node, count, strict=True)])
+                            for j, c in zip(where, count, strict=True)])
         return self.threshold * (1.0 + self.spread * (2.0 * uniform - 1.0))
 
 
@@ -147,6 +171,7 @@ class Front(Record):
             (``nan`` for a single break).
         arrested: it stopped before the far (leading) edge: a precursor.
         push_force: pusher force per unit breadth when it started [N/m].
+        size: how many breaks it grouped.
     """
 
     start_time: float
@@ -156,26 +181,56 @@ class Front(Record):
     speed: float
     arrested: bool
     push_force: float
+    size: int = 1
 
 
 def fronts(breaks: typing.Sequence[Break], push_force: typing.Callable[[float], float],
-           gap: float, far_edge: float) -> list[Front]:
-    """Group breaks into fronts: a front is a run of breaks none farther than ``gap`` [s] in
-    time from the previous one; it is arrested when its tip stays short of ``far_edge`` [m]."""
+           gap: float, far_edge: float, wave_speed: float = math.inf) -> list[Front]:
+    r"""Group breaks into fronts by causality: a break joins a front only if a signal at the
+    wave speed c could have carried it from one of the front's breaks at most ``gap`` [s]
+    before it,
+
+    .. math::
+        |x_e - x_f| \le c\,(t_e - t_f), \qquad 0 \le t_e - t_f \le \text{gap};
+
+    otherwise it starts a front of its own. Where several fronts could have caused it, it
+    joins the one whose reachable break is the latest (then the nearest). A front's breaks
+    lie in the light cone of its first break (the bound holds link by link along the
+    causal chain and adds up), so its speed never exceeds c: the rule of causality that
+    bounds rupture fronts by the material's limiting wave speed (Freund 1990, *Dynamic
+    Fracture Mechanics*; Rosakis 2002, "Intersonic shear cracks and fault ruptures"), and the
+    largest c (the P-wave speed) lets supershear fronts through, as Rubinstein, Cohen &
+    Fineberg (2004) saw them. Breaks at different places in the same step are never one
+    front's: nothing travels in no time. ``wave_speed = inf`` is the grouping by the time
+    gap alone. A front is arrested when its tip stays short of ``far_edge`` [m]."""
+    check("wave_speed", wave_speed, wave_speed > 0, "must be > 0 (inf: the time gap alone)")
+    check_positive("gap", gap, strict=False)
     groups: list[list[Break]] = []
     for b in sorted(breaks, key=lambda b: (b.time, b.x)):
-        if groups and b.time - groups[-1][-1].time <= gap:
-            groups[-1].append(b)
-        else:
+        best: tuple[float, float] | None = None  # (time, -distance) of the best cause so far
+        joins = -1
+        for g, group in enumerate(groups):
+            for f in reversed(group):  # the front's breaks, latest first
+                lag = b.time - f.time
+                if lag > gap:
+                    break
+                # the times are sums of steps: a relative 1e-9 absorbs their round-off
+                reachable = lag >= 0 if math.isinf(wave_speed) else \
+                    abs(b.x - f.x) <= wave_speed * lag * (1.0 + 1e-9)
+                if reachable and (best is None or (f.time, -abs(b.x - f.x)) > best):
+                    best, joins = (f.time, -abs(b.x - f.x)), g
+        if joins < 0:
             groups.append([b])
+        else:
+            groups[joins].append(b)
     result = []
-    for group in groups:
+    for group in sorted(groups, key=lambda group: (group[0].time, group[0].x)):
         first, tip = group[0], max(group, key=lambda b: (b.x, -b.time))
         duration = tip.time - first.time
         speed = (tip.x - first.x) / duration if duration > 0 else float("nan")
         result.append(Front(start_time=first.time, end_time=group[-1].time, start_x=first.x,
                             tip_x=tip.x, speed=speed, arrested=tip.x < far_edge,
-                            push_force=push_force(first.time)))
+                            push_force=push_force(first.time), size=len(group)))
     return result
 
 
@@ -191,8 +246,9 @@ class SliderHistory(Record):
         attached: number of attached contacts, per step.
         breaks: every break since the model was built, in order.
         fronts: the breaks grouped into fronts (:func:`fronts`).
-        slip_force: the pusher force when the first front reached the far edge (the whole
-            interface slipped) [N/m]; ``nan`` if none did.
+        slip_force: the pusher force at the step the far-edge contact first broke (the
+            detachment had spanned the interface) [N/m]; ``nan`` if it never did.
+        peak_force: the largest pusher force [N/m] (the static friction force).
     """
 
     time: list[float]
@@ -202,6 +258,7 @@ class SliderHistory(Record):
     breaks: list[Break]
     fronts: list[Front]
     slip_force: float
+    peak_force: float
 
     def write_csv(self, path: str | pathlib.Path, comm: MPI.Comm = MPI.COMM_WORLD) -> None:
         """The front history as a CSV table (on rank 0)."""
@@ -269,7 +326,8 @@ class ElasticSliderModel:
         u, u_dot, u_ddot = fem.Function(V, name="displacement"), fem.Function(V), fem.Function(V)
         v = ufl.TestFunction(V)
         form = inertia(s.rho, u_ddot, v, ufl.dx(domain=msh)) \
-            + elasticity(u, v, s.E, s.nu, ufl.dx(domain=msh), s.plane_stress) \
+            + elasticity(u + s.viscosity * u_dot if s.viscosity > 0 else u, v, s.E, s.nu,
+                         ufl.dx(domain=msh), s.plane_stress) \
             + s.k * self.attached * (u[0] - self.anchor) * v[0] * self.ds_base
         if s.k_push > 0:
             form += s.k_push * (u[0] - s.push_speed * self.time) * v[0] * self.ds_left
@@ -375,14 +433,17 @@ class ElasticSliderModel:
 
     def run(self, t_end: float, dt: float, solver: DynamicsSolver | None = None,
             on_step: typing.Callable[[dict], None] | None = None,
-            front_gap: float | None = None) -> SliderHistory:
+            front_gap: float | None = None, wave_speed: float | None = None) -> SliderHistory:
         """Push for ``t_end`` with steps ``dt``, breaking contacts between steps.
 
         Args:
             t_end, dt: duration and (fixed) step [s].
             solver: default :meth:`solver`.
             on_step: called with each step's record (e.g. field output).
-            front_gap: breaks closer in time than this belong to one front [s]; default 5 dt.
+            front_gap: breaks closer in time than this can belong to one front [s]; default
+                5 dt.
+            wave_speed: the speed that bounds the fronts (:func:`fronts`) [m/s]; default the
+                P-wave speed.
 
         Returns:
             The history of the run.
@@ -405,9 +466,12 @@ class ElasticSliderModel:
             return float(np.interp(t, times, force))
 
         far_edge = self.scene.L - 0.5 * self.scene.h
-        found = fronts(self.breaks, force_at, front_gap or 5 * dt, far_edge)
-        spanning = [f for f in found if not f.arrested]
-        return SliderHistory(time=times, front_position=[r["front_position"] for r in records],
+        found = fronts(self.breaks, force_at, front_gap or 5 * dt, far_edge,
+                       wave_speed or self.scene.wave_speeds[0])
+        position = np.array([r["front_position"] for r in records])
+        spanned = np.flatnonzero(position >= far_edge)
+        return SliderHistory(time=times, front_position=[float(p) for p in position],
                              push_force=force, attached=[r["attached"] for r in records],
                              breaks=list(self.breaks), fronts=found,
-                             slip_force=spanning[0].push_force if spanning else float("nan"))
+                             slip_force=float(force[spanned[0]]) if len(spanned) else float("nan"),
+                             peak_force=float(np.max(force)))
