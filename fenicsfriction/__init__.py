@@ -28,6 +28,7 @@ _EXPORTS: dict[str, str] = {
     # solvers on the finite element residual
     "SteadySolver": "steady", "SolveError": "steady", "SolveReport": "steady",
     "ContinuationError": "steady", "continuation": "steady", "epsilon_sequence": "steady",
+    "solve_continued": "steady",
     "StabilitySolver": "stability", "Loci": "stability", "Mode": "stability",
     "EigenSolveError": "stability", "unstable_intervals": "stability", "Onset": "stability",
     "DynamicsSolver": "dynamics", "CentralDifference": "dynamics",
@@ -158,6 +159,7 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers and IDEs
         SteadySolver,
         continuation,
         epsilon_sequence,
+        solve_continued,
     )
     from fenicsfriction.studies.block import (
         BlockData,

@@ -22,11 +22,16 @@ Drivers on top of one solve (Martins & Oden 1986, "NINCT increments"):
   :class:`ContinuationError` with the last converged state kept in ``u``.
 * :func:`epsilon_sequence` — Kalker's *sequential process* (Kalker 1986, section 6): ε_k → 0,
   each solve starting from the previous one, recording how much the solution still changes.
+* :func:`solve_continued` — a solve at a parameter value that falls back, when the direct
+  solve fails, on continuation from an easy value: natural steps halved on failure, then,
+  where the branch folds back (a limit point: halving cannot pass it), pseudo-arclength
+  steps round the fold (Keller 1977) until the branch reaches the value again.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import logging
 import time
 import typing
 
@@ -63,7 +68,9 @@ from fenicsfriction.petsc_options import RoundoffConvergence, options_with_defau
 from fenicsfriction.reused_lu import ReusedFactorisation
 
 __all__ = ["ContinuationError", "SolveError", "SolveReport", "SteadySolver", "continuation",
-           "epsilon_sequence"]
+           "epsilon_sequence", "solve_continued"]
+
+log = logging.getLogger(__name__)
 
 DEFAULT_OPTIONS = {
     "snes_type": "newtonls",
@@ -131,6 +138,9 @@ class SolveReport:
     atol: float
     rounds: int = 1
     krylov_iterations: int = 0
+    #: :func:`solve_continued`: how the value was reached (``None``: a direct solve), with
+    #: ``start``, ``steps``, ``cutbacks``, ``arclength_steps`` and ``turning_points``
+    continuation: dict | None = None
 
 
 _REASONS = {v: k for k, v in vars(PETSc.SNES.ConvergedReason).items() if not k.startswith("_")}
@@ -534,3 +544,268 @@ def epsilon_sequence(solver: SteadySolver, eps: fem.Constant, values: typing.Ite
         previous.destroy()
     return records
 
+
+
+def solve_continued(solver: SteadySolver, parameter: fem.Constant, target: float,
+                    start: float = 0.0, max_cutbacks: int = 8, max_arclength_steps: int = 100
+                    ) -> SolveReport:
+    r"""Solve at ``parameter = target`` from the current ``u``; if Newton fails, reach
+    ``target`` by continuation from ``start`` (a value where the same guess converges, e.g.
+    μ = 0) instead of giving up.
+
+    The continuation first takes natural steps in the parameter, each from the last
+    converged state, halving a step that fails (steps are never lengthened again). When a
+    step halved ``max_cutbacks`` times still fails, the branch is taken to fold back there
+    (a limit point, where the Jacobian turns singular), and pseudo-arclength continuation
+    (Keller 1977) follows it round the fold: the state and the parameter are solved
+    together, each step of length ds along the tangent t of the branch,
+
+    .. math::
+
+        R(u, p) = 0, \qquad \langle t, (u - u_k, p - p_k) \rangle = \Delta s,
+
+    with the inner product :math:`\langle a, b \rangle = \frac1n \sum_i a_i b_i / U_i^2
+    + a_p b_p`, U_i the mean change of the i-th component of u per unit parameter over the
+    natural steps (so that a rigid slide held by a soft spring, 1e6 times a penetration,
+    does not hide the penetrations' turn at the fold); each Newton correction is
+    found by bordering (two solves with the Jacobian; Keller 1977), t is the solution of
+    :math:`J t_u = -\partial_p R\,t_p` (∂_p R by a forward difference), oriented along the
+    previous one. Once the branch crosses ``target`` again, Newton solves at ``target`` from
+    the state interpolated between the two steps that bracket it. The state reached is
+    therefore on the branch connected to ``start``; where the problem has several solutions
+    at ``target`` (beyond a fold) it is that branch's, not the one a direct solve might
+    find.
+
+    Args:
+        solver: the steady solver (its ``u`` holds the guess and the result).
+        parameter: the ``fem.Constant`` continued (e.g. the friction coefficient).
+        target: the value to solve at.
+        start: the easy value the continuation starts from (solved from the same guess).
+        max_cutbacks: how many times the natural step may be halved before the steps turn
+            to arclength, and how many halvings in a row an arclength step may take before
+            giving up.
+        max_arclength_steps: a bound on the arclength steps.
+
+    Returns:
+        The report of the last solve; its ``continuation`` is ``None`` for a direct solve,
+        else a dict with ``start``, ``steps`` (natural steps converged), ``cutbacks`` (all
+        halvings), ``arclength_steps`` and ``turning_points`` (the parameter values where the
+        branch turned back), also logged.
+
+    Raises:
+        ContinuationError: the start did not converge, the arclength steps could not be
+            halved further or exceeded ``max_arclength_steps`` (``u`` and ``parameter`` keep
+            the last converged state; ``records`` is empty).
+    """
+    check("max_cutbacks", max_cutbacks, isinstance(max_cutbacks, int) and max_cutbacks >= 0,
+          "an integer >= 0")
+    solve = solver.solve_searched
+    parameter.value = target
+    try:
+        return solve()
+    except SolveError as err:
+        log.info("direct solve at %.6g failed (%s); continuing from %.6g", target,
+                 err.report.reason, start)
+    info: dict[str, typing.Any] = {"start": float(start), "steps": 0, "cutbacks": 0,
+                                   "arclength_steps": 0, "turning_points": []}
+    parameter.value = start
+    try:
+        report = solve()
+    except SolveError as err:
+        parameter.value = start
+        raise ContinuationError(f"continuation to {target:.6g}: the start {start:.6g} did not "
+                                f"converge either: {err}", []) from err
+    u_vec = _compat.petsc_vec(solver.u)
+    states = [(float(start), u_vec.copy())]  # the converged natural steps, the last two kept
+    origin = u_vec.copy()
+    step = target - start
+    try:
+        while True:  # natural steps, each from the last converged state
+            current, converged = states[-1]
+            trial = target if abs(target - current) <= abs(step) else current + step
+            parameter.value = trial
+            try:
+                report = solve()
+            except SolveError:
+                converged.copy(u_vec)
+                solver.u.x.scatter_forward()
+                parameter.value = current
+                if abs(step) <= abs(target - start) / 2**max_cutbacks:
+                    break
+                info["cutbacks"] += 1
+                step /= 2
+                continue
+            info["steps"] += 1
+            if trial == target:
+                report.continuation = info
+                log.info("reached %.6g by continuation from %.6g: %d steps, %d cut-backs",
+                         target, start, info["steps"], info["cutbacks"])
+                return report
+            if len(states) == 2:
+                states.pop(0)[1].destroy()
+            states.append((trial, u_vec.copy()))
+        log.info("continuation to %.6g: natural steps cannot pass %.6g (a fold?); arclength",
+                 target, states[-1][0])
+        report = _arclength(solver, parameter, target, states, origin, info, max_cutbacks,
+                            max_arclength_steps)
+    finally:
+        for _, vec in states:
+            vec.destroy()
+        origin.destroy()
+    report.continuation = info
+    log.info("reached %.6g by continuation from %.6g: %d steps, %d arclength steps, "
+             "%d cut-backs, turning points %s", target, start, info["steps"],
+             info["arclength_steps"], info["cutbacks"], info["turning_points"])
+    return report
+
+
+def _arclength(solver: SteadySolver, parameter: fem.Constant, target: float,
+               states: list[tuple[float, PETSc.Vec]], origin: PETSc.Vec, info: dict,
+               max_cutbacks: int, max_steps: int) -> SolveReport:
+    """Pseudo-arclength steps from the last of ``states`` (the natural steps' last two)
+    until the branch crosses ``target``, then Newton at ``target`` (see
+    :func:`solve_continued`; ``origin``: the state at ``info["start"]``)."""
+    u_vec = _compat.petsc_vec(solver.u)
+    comm = solver.u.function_space.mesh.comm
+    p_k, u_k = states[-1][0], states[-1][1].copy()
+    # U_i: the mean change of each component of u per unit parameter from the start, so
+    # that every component counts alike (a rigid slide held by a soft spring can be 1e6
+    # times a penetration, whose change near a fold is what the steps must follow); nearly
+    # still components are floored at 1e-6 of the largest
+    weights = u_k.copy()
+    weights.axpy(-1.0, origin)
+    travelled = abs(p_k - info["start"]) or 1.0
+    weights.abs()
+    weights.scale(1.0 / travelled)
+    floor = max(weights.max()[1], 1e-300) * 1e-6
+    with weights.localForm() as local:
+        local.array[:] = 1.0 / np.maximum(local.array, floor) ** 2 / weights.getSize()
+    work = u_k.duplicate()
+    diff = u_k.copy()
+    # the first step: as long as the last natural step, in the arclength metric
+    if len(states) > 1:
+        u_k.copy(diff)
+        diff.axpy(-1.0, states[0][1])
+        work.pointwiseMult(weights, diff)
+        ds = float(np.sqrt(work.dot(diff) + (p_k - states[0][0]) ** 2))
+    else:
+        ds = abs(target - p_k) / 8
+    diff.destroy()
+    ksp = PETSc.KSP().create(comm)
+    ksp.setType("preonly")
+    ksp.getPC().setType("lu")
+    ksp.getPC().setFactorSolverType("mumps")
+    F, F_p, z1, z2 = (u_vec.duplicate() for _ in range(4))
+    t_u, t_p = u_vec.duplicate(), 0.0
+    atol = max(solver.convergence.atol_used, solver.snes.getTolerances()[1])
+
+    def residual(p: float, out: PETSc.Vec) -> None:
+        parameter.value = p
+        solver._F(solver.snes, u_vec, out)
+
+    def jacobian_solves(p: float, tangent_only: bool = False) -> None:
+        """z2 = -J⁻¹ ∂_p R at (u, p); z1 = -J⁻¹ R too unless ``tangent_only``."""
+        h = 1e-7 * max(1.0, abs(p))
+        residual(p + h, F_p)
+        residual(p, F)
+        F_p.axpy(-1.0, F)
+        F_p.scale(-1.0 / h)
+        solver._J(solver.snes, u_vec, solver.A, solver.A)
+        ksp.setOperators(solver.A)
+        ksp.setUp()
+        ksp.solve(F_p, z2)
+        if not tangent_only:
+            F.scale(-1.0)
+            ksp.solve(F, z1)
+            F.scale(-1.0)
+
+    def dot(a_u: PETSc.Vec, a_p: float, b_u: PETSc.Vec, b_p: float) -> float:
+        work.pointwiseMult(weights, a_u)
+        return work.dot(b_u) + a_p * b_p
+
+    def tangent(previous: tuple[PETSc.Vec, float] | None) -> None:
+        nonlocal t_p
+        u_k.copy(u_vec)
+        solver.u.x.scatter_forward()
+        jacobian_solves(p_k, tangent_only=True)
+        z2.copy(t_u)
+        t_p = 1.0
+        norm = np.sqrt(dot(t_u, t_p, t_u, t_p))
+        sign = (np.sign(dot(t_u, t_p, *previous)) if previous is not None
+                else np.sign(target - p_k))
+        t_u.scale(sign / norm)
+        t_p = sign / norm
+
+    previous: tuple[PETSc.Vec, float] | None = None
+    halvings = 0
+    try:
+        tangent(None)
+        for _ in range(max_steps):
+            # predictor along the tangent, corrector: Newton on (R, arclength) by bordering
+            u_k.copy(u_vec)
+            u_vec.axpy(ds, t_u)
+            p = p_k + ds * t_p
+            converged = False
+            for _ in range(25):
+                solver.u.x.scatter_forward()
+                jacobian_solves(p)
+                d_u = u_vec.copy()
+                d_u.axpy(-1.0, u_k)
+                N = dot(t_u, t_p, d_u, p - p_k) - ds
+                d_u.destroy()
+                log.debug("arclength p %.8g ds %.3g t_p %.3g |F| %.3e (atol %.3e) N %.3e",
+                          p, ds, t_p, F.norm(), atol, N)
+                if F.norm() <= 10 * atol and abs(N) <= 1e-8 * ds:
+                    converged = True
+                    break
+                dp = (-N - dot(t_u, 0.0, z1, 0.0)) / (t_p + dot(t_u, 0.0, z2, 0.0))
+                u_vec.axpy(1.0, z1)
+                u_vec.axpy(dp, z2)
+                p += dp
+                if not np.isfinite(p) or not np.isfinite(u_vec.norm()):
+                    break
+            if not converged:
+                if halvings == max_cutbacks:
+                    raise ContinuationError(
+                        f"arclength continuation to {target:.6g} stalled at {p_k:.6g} after "
+                        f"{halvings} halvings of its step", [])
+                halvings += 1
+                info["cutbacks"] += 1
+                ds /= 2
+                continue
+            halvings = 0
+            info["arclength_steps"] += 1
+            if (p - target) * (p_k - target) <= 0:  # crossed: Newton at target from between
+                weight = (target - p_k) / (p - p_k)
+                u_vec.scale(weight)
+                u_vec.axpy(1.0 - weight, u_k)
+                solver.u.x.scatter_forward()
+                parameter.value = target
+                try:
+                    return solver.solve_searched()
+                except SolveError as err:
+                    raise ContinuationError(f"arclength continuation crossed {target:.6g} "
+                                            f"but Newton there failed: {err}", []) from err
+            u_vec.copy(u_k)
+            p_k = p
+            t_old = (t_u.copy(), t_p)
+            if previous is not None:
+                previous[0].destroy()
+            previous = t_old
+            tangent(previous)
+            if np.sign(t_p) != np.sign(previous[1]):
+                info["turning_points"].append(float(p_k))
+            ds *= 1.5
+        raise ContinuationError(f"arclength continuation did not reach {target:.6g} within "
+                                f"{max_steps} steps (max_arclength_steps)", [])
+    except ContinuationError:
+        u_k.copy(u_vec)
+        solver.u.x.scatter_forward()
+        parameter.value = p_k
+        raise
+    finally:
+        for vec in (F, F_p, z1, z2, t_u, u_k, weights, work):
+            vec.destroy()
+        if previous is not None:
+            previous[0].destroy()
+        ksp.destroy()

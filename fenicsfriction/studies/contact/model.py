@@ -34,7 +34,7 @@ from fenicsfriction.contact import FORMULATIONS, make_contact, solve_with_search
 from fenicsfriction.contact.node_to_segment import ENFORCEMENTS
 from fenicsfriction.laws import check
 from fenicsfriction.numerics import power_law_secant
-from fenicsfriction.steady import SteadySolver
+from fenicsfriction.steady import SolveError, SteadySolver
 from fenicsfriction.studies.contact.geometry import (
     BODY1,
     BODY2,
@@ -288,21 +288,54 @@ class TwoBodyModel:
         return self.comm.allreduce(float(self._contact_force()[self._body1_rows, -1].sum()))
 
     def solve_for_load(self, load: float, guess: float, rtol: float = 1e-6,
-                       max_solves: int = 30) -> dict:
+                       max_solves: int = 30, max_cutbacks: int = 6) -> dict:
         """The approach whose contact force is ``load`` (total in 3D, per unit length in 2D).
 
         The force grows like a power of the approach (δ^{3/2} for Hertz in 3D, about δ in 2D),
         so the approach is found by secant steps on log force against log approach, from
-        ``guess`` (any approach that makes contact). Returns ``approach``, ``load`` (reached),
-        ``newton_iterations`` (all solves) and ``solves``.
+        ``guess`` (any approach that makes contact). A solve that fails is cut back: the
+        state and the approach return to the last converged ones (at first the start) and
+        the step of the approach is halved, at most ``max_cutbacks`` times in all; the steps
+        that follow are no longer than the last one halved (load stepping where the step is
+        too long for Newton: each deeper approach starts from body 1 moved rigidly, whose
+        overlap, the wider the deeper, Newton must shrink to the elastic contact zone by
+        about one node per iteration; with two passes both surfaces' overlaps). Returns
+        ``approach``, ``load`` (reached), ``newton_iterations`` (all solves, failed ones
+        included), ``solves`` and ``cutbacks``.
+
+        Raises:
+            SolveError: a solve still failed after ``max_cutbacks`` cut-backs (the state is
+                the last converged one).
         """
         check("load", load, load > 0, "the load must be > 0")
         check("guess", guess, guess > 0, "the first approach must be > 0")
         history: list[tuple[float, float]] = []
-        iterations, delta = 0, guess
+        iterations, delta, cutbacks, force = 0, guess, 0, float("nan")
+        converged = (float(self.approach.value), self.u.x.array.copy())
+        longest = np.inf  # the longest step of the approach since the last cut-back
         for solves in range(1, max_solves + 1):
-            report = self.solve_at(delta)
+            delta = float(np.clip(delta, converged[0] - longest, converged[0] + longest))
+            try:
+                report = self.solve_at(delta)
+            except SolveError as err:
+                iterations += err.report.iterations
+                last, state = converged
+                self.approach.value, self._platen.value = last, -last
+                self.u.x.array[:] = state
+                self.u.x.scatter_forward()
+                if cutbacks == max_cutbacks:
+                    err.report.iterations = iterations
+                    raise SolveError(f"solve_for_load: the approach {delta:.6g} failed after "
+                                     f"{cutbacks} cut-backs (max_cutbacks): {err}",
+                                     err.report) from err
+                cutbacks += 1
+                longest = abs(delta - last) / 2
+                log.info("approach %.6g: Newton failed (%s); cut back to steps of %.6g", delta,
+                         err.report.reason, longest)
+                delta = (last + delta) / 2
+                continue
             iterations += report.iterations
+            converged = (delta, self.u.x.array.copy())
             force = self.normal_force()
             log.debug("approach %.6g: contact force %.6g (load %.6g), %d Newton iterations",
                       delta, force, load, report.iterations)
@@ -310,7 +343,7 @@ class TwoBodyModel:
                 history.append((np.log(delta), np.log(force)))
             if abs(force / load - 1) < rtol:
                 return {"approach": delta, "load": force, "newton_iterations": iterations,
-                        "solves": solves}
+                        "solves": solves, "cutbacks": cutbacks}
             if len(history) < 2:
                 delta *= 2.0 if force <= 0 else (load / force) ** 0.7
                 continue

@@ -17,6 +17,7 @@ giving a contact half-width (radius) of R/10.
 from __future__ import annotations
 
 import dataclasses
+import logging
 import time
 import typing
 
@@ -26,6 +27,7 @@ import numpy as np
 
 from fenicsfriction import laws
 from fenicsfriction.laws import check
+from fenicsfriction.steady import SolveError
 from fenicsfriction.studies.contact import closed_forms, geometry
 from fenicsfriction.studies.contact.model import (
     Material,
@@ -38,6 +40,12 @@ __all__ = ["Cattaneo", "Hertz", "Patch", "surface_comparison"]
 
 #: the regularisation during Cattaneo's normal loading, relative to the contact half-width
 NORMAL_LOADING_EPS = 1e-2
+
+#: the Newton iterations allowed when an increment of Cattaneo's perturbed Lagrangian is
+#: repeated after failing within the solver's default 50
+PENALTY_MAX_IT = 400
+
+log = logging.getLogger(__name__)
 
 
 @dataclasses.dataclass
@@ -197,7 +205,8 @@ class Hertz(_Bodies):
             f"fitted_{width}_error": None if fitted[0] is None else fitted[0] / a - 1,
             "fitted_max_pressure_error": None if fitted[1] is None else fitted[1] / p0 - 1,
             "approach": solved["approach"], "newton_iterations": solved["newton_iterations"],
-            "solves": solved["solves"], "wall_time_s": time.perf_counter() - t0,
+            "solves": solved["solves"], "cutbacks": solved["cutbacks"],
+            "wall_time_s": time.perf_counter() - t0,
         }
         return summary, model
 
@@ -344,25 +353,66 @@ class Cattaneo(Hertz):
             model.commit()
             q = self.q_ratio * k / self.increments
             model.shear.value = np.array([q * self.law.mu * self.load / (2 * self.radius), 0.0])
-            report = model.solve_at(float(model.approach.value))
+            iterations, repeated = self._solve_increment(model)
             values = model.surface_values()
             stick, _ = self.stick_zone(values)
             row = {"q_ratio": q, "stick_half_width": stick,
                    "cattaneo_stick_half_width": closed_forms.cattaneo_stick_half_width(a, q),
-                   "newton_iterations": report.iterations}
+                   "newton_iterations": iterations}
+            if repeated is not None:
+                row["newton_limit_raised_to"] = repeated
             rows.append(row)
             if on_increment is not None:
                 on_increment(row)
         values = model.surface_values()
         exact = closed_forms.cattaneo_traction(values.x[:, 0], a, p0, self.law.mu, self.q_ratio)
-        # the traction on the cylinder opposes Q: its x component is -q(x)
-        error = float(np.sqrt(np.sum(values.weight * (-values.traction[:, 0] - exact) ** 2)
+        # the traction on the cylinder opposes Q: its x component is -q(x). One pass: the
+        # law's nodal traction; two: what both passes transmit, each node's force over its
+        # load weight (the first pass's law, weighted 1/2, carries only its share)
+        traction = values.traction if self.passes == 1 else values.force
+        error = float(np.sqrt(np.sum(values.weight * (-traction[:, 0] - exact) ** 2)
                               / np.sum(values.weight * exact**2)))
         return {"eps": eps, "stick_half_width": rows[-1]["stick_half_width"],
                 "cattaneo_stick_half_width": rows[-1]["cattaneo_stick_half_width"],
                 "traction_error_l2": error,
                 "newton_iterations": sum(r["newton_iterations"] for r in rows),
                 "increments": rows}
+
+    def _solve_increment(self, model: TwoBodyModel) -> tuple[int, int | None]:
+        """One increment of Q; under the perturbed Lagrangian a failed solve is repeated from
+        the increment's start with :data:`PENALTY_MAX_IT` Newton iterations allowed: a stiff
+        stick spring κ_T makes Newton move the stick-slip boundary by about a node per
+        iteration (the residual falls slowly but steadily: at κ_T = 1e5 E*/R, h = a/20 and
+        Q = μP/10 the first increment needs 80, against the 50 allowed; continuation in κ_T,
+        tenfold steps up from a softer spring's solution, needs as many at each step).
+        Returns the Newton
+        iterations (the failed solve's included) and the iteration limit of the repeated
+        solve (``None``: solved directly)."""
+        approach = float(model.approach.value)
+        start = model.u.x.array.copy()
+        try:
+            return model.solve_at(approach).iterations, None
+        except SolveError as err:
+            if self.enforcement != "perturbed-lagrangian":
+                raise
+            iterations = err.report.iterations
+        log.info("the increment did not converge at penalty_T=%.3g; repeated with %d Newton "
+                 "iterations allowed", self.penalty_T, PENALTY_MAX_IT)
+        model.u.x.array[:] = start
+        model.u.x.scatter_forward()
+        snes = model.solver.snes
+        tolerances = snes.getTolerances()
+        snes.setTolerances(max_it=PENALTY_MAX_IT)
+        try:
+            iterations += model.solve_at(approach).iterations
+        except SolveError as err:
+            raise SolveError(f"penalty_T={self.penalty_T:g}: the increment did not converge "
+                             f"within {PENALTY_MAX_IT} Newton iterations either (a stiffer "
+                             f"stick spring needs more; soften penalty_T): {err}",
+                             err.report) from err
+        finally:
+            snes.setTolerances(max_it=tolerances[3])
+        return iterations, PENALTY_MAX_IT
 
     def _summary(self, normal: dict, tangential: dict, t0: float) -> dict:
         summary = dict(normal)
