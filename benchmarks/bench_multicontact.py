@@ -10,14 +10,32 @@ friction force per contact of one realisation of N contacts (exact quasistatic d
 master equation (h = 0.002 x_c), over 8 seeds, for N = 100 … 25600: the exponent of its fall
 with N (the law of large numbers says −1/2) and the wall time of a realisation.
 
-**Instability map**: the spring-driven model (N = 300, v = 1, ζ = 0.1) over K/(N k) and
-σ/x_c, each run classified by the fraction of its late window spent stuck, with the master
-equation's K* = −max F'(X) per σ: stick-slip should lie below K*, smooth sliding above.
+**Instability map**: the model (N = 300) over K/(N k) and σ/x_c, each run classified by the
+slip events of the slider pulled infinitely slowly (a jump at the static peak: one event drops
+the spring force by more than 5 % of it), beside the former speed classification of the
+spring-driven runs with inertia (v = 1, ζ = 0.1; max Ẋ > 10 v), with the master equation's
+K* = −max F'(X) per σ: stick-slip should lie below K*, smooth sliding above.
+
+**Events against N and run length**: the slow spring drive at K/K* = 0.5 … 2, σ/x_c = 0.1,
+0.3, N = 100 … 3000, run 3 or 12 x_c past the static peak: the onset's drop (the largest
+event over the peak force), the late window's largest drop over its mean force, the late
+advance carried by jumps, the mean breaks per late event; and the spring-driven runs' speed
+classification for the same N (3 x_c): which classification converges with N to K < K*.
 
 **Interacting contacts, cost against N**: the EQ model on an n × n lattice between two identical
 bodies (coupling k/(E a) = 0.1, σ = 0.3 x_c) moved quasistatically over four contact lives,
-n = 8 … 24: the set-up (the dense stiffness matrix, O(N³)), the run, the time per break, and
-the ratio of the run to the plain model's over the same lives (the baseline, same process).
+n = 8 … 32, dense (the stiffness matrix, O(N³)) and matrix-free (FFT and conjugate gradients):
+the set-up, the run, the time per break, the events compared (sizes equal, positions to
+tolerance) and the time ratio; then the matrix-free model alone at n = 64 and 128 (16,384
+contacts) over its first breaks: the time per break and the iterations per solve.
+
+**Interacting contacts, events**: the slow spring drive of matrix-free lattices (n = 8 … 32)
+at couplings 0, 0.1, 0.3, σ = 0.3 x_c, K = S/2 (S the interface's stiffness): onset and late
+drops against N.
+
+``--sections`` picks some of: convergence, noise, map, events, interacting, interacting-events;
+``--sizes`` the N of the events study, ``--sides`` the lattices compared dense against
+matrix-free (a busy machine may want fewer).
 
 Writes ``bench_multicontact.json`` and ``bench_multicontact.png`` to ``--out`` and prints markdown
 tables. Serial (vectorised NumPy and a two-unknown TS).
@@ -35,7 +53,9 @@ from fenicsfriction.studies.multicontact import (
     EQModel,
     InstabilityMap,
     InteractingEQModel,
+    LatticeEQModel,
     MasterEquation,
+    critical_stiffness,
     instability_map,
 )
 
@@ -43,7 +63,13 @@ STEPS = [0.04, 0.02, 0.01, 0.005, 0.0025]
 SIZES = [100, 400, 1600, 6400, 25600]
 SPREADS = [0.05, 0.1, 0.2, 0.3, 0.5]
 STIFFNESS = list(np.logspace(-1.5, 1.5, 7))  # × N k
-SIDES = [8, 12, 16, 24]
+SIDES = [8, 12, 16, 24, 32]
+LARGE_SIDES = {64: 500, 128: 200}  # side: breaks timed
+EVENT_SIZES = [100, 300, 1000, 3000]
+EVENT_FACTORS = [0.5, 0.8, 0.9, 1.1, 1.25, 2.0]  # K/K*
+EVENT_SPREADS = [0.1, 0.3]
+RUN_LENGTHS = [3.0, 12.0]  # x_c past the static peak
+COUPLINGS = [0.0, 0.1, 0.3]
 
 
 def _convergence(out: dict) -> None:
@@ -94,78 +120,259 @@ def _map(out: dict) -> InstabilityMap:
     out["instability_map"] = {**result.to_json(), "wall_time_s": time.perf_counter() - start}
     below = result.K[None, :] < result.K_star[:, None]
     agree = float(np.mean(below == result.stick_slip))
+    agree_speed = float(np.mean(below == result.fast_slip))
     out["instability_map"]["agreement_with_K_star"] = agree
-    print(f"\ninstability map: classification agrees with K > K* in {100 * agree:.0f} % of runs")
+    out["instability_map"]["speed_agreement_with_K_star"] = agree_speed
+    print(f"\ninstability map: the events agree with K > K* in {100 * agree:.0f} % of runs, "
+          f"max Ẋ > 10 v in {100 * agree_speed:.0f} %")
     print("| σ/x_c | K*/(N k) | " + " | ".join(f"{s:.3g}" for s in STIFFNESS) + " |")
     print("|---|---|" + "---|" * len(STIFFNESS))
     for i, spread in enumerate(SPREADS):
-        cells = ["S" if ss else "." for ss in result.stick_slip[i]]
+        cells = [("S" if ss else ".") + ("v" if fs else "") for ss, fs in
+                 zip(result.stick_slip[i], result.fast_slip[i], strict=True)]
         print(f"| {spread} | {result.K_star[i] / n:.3g} | " + " | ".join(cells) + " |")
     return result
 
 
+def _events(out: dict) -> None:
+    rows = []
+    print("\nevents against N and run length (slow spring drive; onset drop / peak force, "
+          "late largest drop / mean force):")
+    print("| σ/x_c | N | run (x_c) | " + " | ".join(f"K/K* = {f}" for f in EVENT_FACTORS)
+          + " |")
+    print("|---|---|---|" + "---|" * len(EVENT_FACTORS))
+    for spread in EVENT_SPREADS:
+        for n in EVENT_SIZES:
+            model = EQModel(n_contacts=n, x_s_std=spread)
+            K_star = critical_stiffness(model)
+            master = MasterEquation(model, h=spread / 50).solve(2.0 + 10 * spread)
+            for length in RUN_LENGTHS:
+                cells = []
+                for factor in EVENT_FACTORS:
+                    K = factor * K_star
+                    start = time.perf_counter()
+                    run = model.spring_quasistatic(K=K, D_max=master.static_force / K + length)
+                    rows.append({"relative_spread": spread, "N": n, "run_length": length,
+                                 "K_over_K_star": factor, "K_star": K_star,
+                                 "onset_drop": run.onset_drop, "onset_jump": run.onset_jump,
+                                 "late_drop": run.largest_drop, "late_stick_slip": run.stick_slip,
+                                 "jump_fraction": run.jump_fraction,
+                                 "mean_breaks": run.mean_breaks, "events": int(run.D.size),
+                                 "wall_time_s": time.perf_counter() - start})
+                    cells.append(f"{run.onset_drop:.3f} / {run.largest_drop:.3f}")
+                print(f"| {spread} | {n} | {length:g} | " + " | ".join(cells) + " |")
+    speed = []
+    for spread in EVENT_SPREADS:
+        for n in EVENT_SIZES:
+            model = EQModel(n_contacts=n, x_s_std=spread)
+            K_star = critical_stiffness(model)
+            master = MasterEquation(model, h=spread / 50).solve(2.0 + 10 * spread)
+            mass = 1e-5 * n
+            for factor in EVENT_FACTORS:
+                K = factor * K_star
+                period = 2 * np.pi * np.sqrt(mass / (n + K))
+                run = model.spring_driven(K=K, v=1.0, mass=mass,
+                                          damping=0.2 * np.sqrt(mass * (n + K)),
+                                          t_end=master.static_force / K + RUN_LENGTHS[0],
+                                          dt=period / 20)
+                speed.append({"relative_spread": spread, "N": n, "K_over_K_star": factor,
+                              "max_speed": run.max_speed, "fast_slip": run.fast_slip,
+                              "largest_dynamic_drop": run.largest_drop})
+    out["events_study"] = {"rows": rows, "speed": speed, "drop_threshold": 0.05}
+    print("\nspring-driven runs with inertia (v = 1, ζ = 0.1, 3 x_c): max Ẋ/v")
+    print("| σ/x_c | N | " + " | ".join(f"K/K* = {f}" for f in EVENT_FACTORS) + " |")
+    print("|---|---|" + "---|" * len(EVENT_FACTORS))
+    for spread in EVENT_SPREADS:
+        for n in EVENT_SIZES:
+            cells = [f"{r['max_speed']:.1f}" for r in speed
+                     if r["relative_spread"] == spread and r["N"] == n]
+            print(f"| {spread} | {n} | " + " | ".join(cells) + " |")
+
+
 def _interacting(out: dict) -> None:
     rows = []
-    print("\ninteracting contacts (k/(E a) = 0.1, σ = 0.3 x_c, four lives):")
-    print("| N | set-up (s) | run (s) | breaks | µs per break | run / plain model's |")
-    print("|---|---|---|---|---|---|")
+    print("\ninteracting contacts (k/(E a) = 0.1, σ = 0.3 x_c, four lives), dense against "
+          "matrix-free:")
+    print("| N | set-up dense (s) | set-up free (s) | run dense (s) | run free (s) | breaks | "
+          "µs per break dense | µs per break free | free / dense | same events |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for n in SIDES:
         model = EQModel(n_contacts=n * n, x_s_std=0.3)
         start = time.perf_counter()
         coupled = InteractingEQModel.lattice(model, 0.1)
         setup = time.perf_counter() - start
+        start = time.perf_counter()
+        free = LatticeEQModel(model, 0.1)
+        setup_free = time.perf_counter() - start
         lives = 4.0 * n * n / coupled.interface_stiffness
         start = time.perf_counter()
         run = coupled.quasistatic(lives)
         wall = time.perf_counter() - start
         start = time.perf_counter()
-        model.quasistatic(4.0)  # the same four lives without interaction
-        plain = time.perf_counter() - start
-        rows.append({"N": n * n, "setup_s": setup, "run_s": wall, "breaks": run.breaks,
-                     "largest_avalanche": run.largest_avalanche, "plain_run_s": plain,
-                     "ratio_to_plain": wall / plain})
-        print(f"| {n * n} | {setup:.3f} | {wall:.2f} | {run.breaks} | "
-              f"{1e6 * wall / run.breaks:.0f} | {wall / plain:.0f} |")
+        run_free = free.quasistatic(lives)
+        wall_free = time.perf_counter() - start
+        same = bool(np.array_equal(run.avalanche_size, run_free.avalanche_size))
+        position = float(np.max(np.abs(run.avalanche_X - run_free.avalanche_X)) / lives) \
+            if same else float("nan")
+        rows.append({"N": n * n, "setup_s": setup, "setup_free_s": setup_free, "run_s": wall,
+                     "run_free_s": wall_free, "breaks": run.breaks,
+                     "largest_avalanche": run.largest_avalanche, "same_events": same,
+                     "largest_position_difference_over_X_max": position,
+                     "force_difference": float(np.max(np.abs(run.F - run_free.F))
+                                               / np.max(np.abs(run.F))),
+                     "ratio_free_to_dense": wall_free / wall,
+                     "iterations_per_solve": free.stiffness.iterations / free.stiffness.solves
+                     if free.stiffness is not None else 0.0})
+        print(f"| {n * n} | {setup:.3f} | {setup_free:.3f} | {wall:.2f} | {wall_free:.2f} | "
+              f"{run.breaks} | {1e6 * wall / run.breaks:.0f} | "
+              f"{1e6 * wall_free / run.breaks:.0f} | {wall_free / wall:.1f} | {same} "
+              f"({position:.1e}) |")
+    large = []
+    print("\nmatrix-free alone, its first breaks from all contacts relaxed:")
+    print("| N | set-up (s) | breaks | ms per break | iterations per solve |")
+    print("|---|---|---|---|---|")
+    for n, count in LARGE_SIDES.items():
+        model = EQModel(n_contacts=n * n, x_s_std=0.3)
+        start = time.perf_counter()
+        free = LatticeEQModel(model, 0.1)
+        setup = time.perf_counter() - start
+        assert free.stiffness is not None
+        contacts = free.contacts(np.random.default_rng(0))
+        solves, iterations = free.stiffness.solves, free.stiffness.iterations
+        broken, start = 0, time.perf_counter()
+        while broken < count:
+            broken += contacts.relax(*contacts.next_break())
+        wall = time.perf_counter() - start
+        per_solve = (free.stiffness.iterations - iterations) / (free.stiffness.solves - solves)
+        large.append({"N": n * n, "setup_s": setup, "breaks": broken, "run_s": wall,
+                      "ms_per_break": 1e3 * wall / broken, "iterations_per_solve": per_solve,
+                      "interface_stiffness_over_N_k": free.interface_stiffness / (n * n)})
+        print(f"| {n * n} | {setup:.2f} | {broken} | {1e3 * wall / broken:.1f} | "
+              f"{per_solve:.1f} |")
     out["interacting_cost"] = {"coupling": 0.1, "relative_spread": 0.3, "lives": 4,
-                               "rows": rows}
+                               "rows": rows, "matrix_free_large": large}
+
+
+def _interacting_events(out: dict) -> None:
+    rows = []
+    print("\ninteracting contacts, slow spring drive K = S/2 (σ = 0.3 x_c, 6 lives): "
+          "onset drop / late drop")
+    print("| N | " + " | ".join(f"k/(E a) = {c}" for c in COUPLINGS) + " |")
+    print("|---|" + "---|" * len(COUPLINGS))
+    for n in SIDES:
+        model = EQModel(n_contacts=n * n, x_s_std=0.3)
+        cells = []
+        for coupling in COUPLINGS:
+            interface = LatticeEQModel(model, coupling)
+            S = interface.interface_stiffness
+            K = 0.5 * S
+            start = time.perf_counter()
+            run = interface.spring_quasistatic(K=K, D_max=n * n / K + 6.0 * n * n / S)
+            rows.append({"N": n * n, "coupling": coupling, "K": K, "interface_stiffness": S,
+                         "onset_drop": run.onset_drop, "late_drop": run.largest_drop,
+                         "jump_fraction": run.jump_fraction, "mean_breaks": run.mean_breaks,
+                         "largest_event_breaks": int(np.max(run.events.breaks, initial=0)),
+                         "wall_time_s": time.perf_counter() - start})
+            cells.append(f"{run.onset_drop:.3f} / {run.largest_drop:.3f}")
+        print(f"| {n * n} | " + " | ".join(cells) + " |")
+    out["interacting_events"] = rows
+
+
+SECTIONS = ("convergence", "noise", "map", "events", "interacting", "interacting-events")
 
 
 def main() -> None:
     flags = benchmark_parser(__doc__)
+    flags.add_argument("--sections", default=",".join(SECTIONS),
+                       help=f"comma-separated, of {', '.join(SECTIONS)} (all)")
+    flags.add_argument("--sizes", default=",".join(map(str, EVENT_SIZES)),
+                       help="N of the events study (100,300,1000,3000)")
+    flags.add_argument("--sides", default=",".join(map(str, SIDES)),
+                       help="lattice sides, dense against matrix-free (8,12,16,24,32)")
+    flags.add_argument("--large-sides", default="64:500,128:200",
+                       help="matrix-free alone, side:breaks (64:500,128:200)")
     args = flags.parse_args()
+    EVENT_SIZES[:] = [int(v) for v in args.sizes.split(",")]
+    SIDES[:] = [int(v) for v in args.sides.split(",")]
+    LARGE_SIDES.clear()
+    LARGE_SIDES.update({int(a): int(b) for a, b in
+                        (item.split(":") for item in args.large_sides.split(","))})
+    chosen = [name.strip() for name in args.sections.split(",") if name.strip()]
+    unknown = sorted(set(chosen) - set(SECTIONS))
+    if unknown:
+        flags.error(f"--sections {','.join(unknown)} is invalid: choose among "
+                    f"{', '.join(SECTIONS)}")
     args.out.mkdir(parents=True, exist_ok=True)
-    out: dict = {}
-    _convergence(out)
-    _noise(out)
-    result = _map(out)
-    _interacting(out)
-    write_summary(args.out / "bench_multicontact.json", out)
+    out: dict = {"sections": chosen}
+    result = None
+    steps = {"convergence": _convergence, "noise": _noise, "events": _events,
+             "interacting": _interacting, "interacting-events": _interacting_events}
+    for name in SECTIONS:
+        if name not in chosen:
+            continue
+        if name == "map":
+            result = _map(out)
+        else:
+            steps[name](out)
+        # written after each section: a long run keeps what it measured
+        write_summary(args.out / "bench_multicontact.json", out)
+    _figure(out, result, args.out / "bench_multicontact.png")
 
+
+def _figure(out: dict, result: InstabilityMap | None, path) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
-    rows = out["model_against_equation"]["rows"]
-    ax1.loglog([r["N"] for r in rows], [r["rms_difference"] for r in rows], "o-",
-               label="EQ model − master equation")
-    ax1.loglog(SIZES, rows[0]["rms_difference"] * np.sqrt(SIZES[0] / np.array(SIZES)), "k--",
-               label="N^(−1/2)")
-    ax1.set_xlabel("N")
-    ax1.set_ylabel("rms difference of F/N (k x_c)")
-    ax1.legend()
-    n = result.parameters["N"]
-    K_grid, spread_grid = np.meshgrid(result.K / n, result.relative_spread)
-    ax2.scatter(K_grid[result.stick_slip], spread_grid[result.stick_slip], marker="x",
-                color="C3", label="stick-slip")
-    ax2.scatter(K_grid[~result.stick_slip], spread_grid[~result.stick_slip], marker="o",
-                facecolors="none", edgecolors="C0", label="smooth")
-    ax2.plot(result.K_star / n, result.relative_spread, "k-", label="K* (master equation)")
-    ax2.set_xscale("log")
-    ax2.set_xlabel("K / (N k)")
-    ax2.set_ylabel("σ / x_c")
-    ax2.legend()
-    save(fig, args.out / "bench_multicontact.png", dpi=120)
+    fig, axes = plt.subplots(2, 2, figsize=(11, 8))
+    ax1, ax2, ax3, ax4 = axes.ravel()
+    if "model_against_equation" in out:
+        rows = out["model_against_equation"]["rows"]
+        ax1.loglog([r["N"] for r in rows], [r["rms_difference"] for r in rows], "o-",
+                   label="EQ model − master equation")
+        ax1.loglog(SIZES, rows[0]["rms_difference"] * np.sqrt(SIZES[0] / np.array(SIZES)),
+                   "k--", label="N^(−1/2)")
+        ax1.set_xlabel("N")
+        ax1.set_ylabel("rms difference of F/N (k x_c)")
+        ax1.legend()
+    else:
+        ax1.set_visible(False)
+    if result is None:
+        ax2.set_visible(False)
+    else:
+        n = result.parameters["N"]
+        K_grid, spread_grid = np.meshgrid(result.K / n, result.relative_spread)
+        ax2.scatter(K_grid[result.stick_slip], spread_grid[result.stick_slip], marker="x",
+                    color="C3", label="jump at the peak (events)")
+        ax2.scatter(K_grid[~result.stick_slip], spread_grid[~result.stick_slip], marker="o",
+                    facecolors="none", edgecolors="C0", label="smooth (events)")
+        ax2.scatter(K_grid[result.fast_slip], spread_grid[result.fast_slip], marker="+",
+                    s=120, color="k", label="max Ẋ > 10 v")
+        ax2.plot(result.K_star / n, result.relative_spread, "k-", label="K* (master equation)")
+        ax2.set_xscale("log")
+        ax2.set_xlabel("K / (N k)")
+        ax2.set_ylabel("σ / x_c")
+        ax2.legend(fontsize=7)
+    if "events_study" in out:
+        rows = out["events_study"]["rows"]
+        for i, factor in enumerate(EVENT_FACTORS):
+            for key, ax, style in (("onset_drop", ax3, "-"), ("late_drop", ax4, "-")):
+                picked = [r for r in rows if r["K_over_K_star"] == factor
+                          and r["relative_spread"] == EVENT_SPREADS[0]
+                          and r["run_length"] == RUN_LENGTHS[-1]]
+                ax.loglog([r["N"] for r in picked], [r[key] for r in picked], "o" + style,
+                          color=f"C{i}", label=f"K/K* = {factor}")
+        for ax, name in ((ax3, "onset: largest drop / peak force"),
+                         (ax4, "late window: largest drop / mean force")):
+            ax.axhline(0.05, color="k", ls=":", label="threshold")
+            ax.set_xlabel("N")
+            ax.set_ylabel(name)
+            ax.set_title(f"slow spring drive, σ = {EVENT_SPREADS[0]} x_c", fontsize=9)
+        ax3.legend(fontsize=7)
+    else:
+        ax3.set_visible(False)
+        ax4.set_visible(False)
+    save(fig, path, dpi=120)
 
 
 if __name__ == "__main__":

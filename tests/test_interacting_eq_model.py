@@ -10,6 +10,8 @@ from scipy import stats
 from fenicsfriction.studies.multicontact import (
     EQModel,
     InteractingEQModel,
+    LatticeCompliance,
+    LatticeEQModel,
     coupling_map,
     interaction_matrix,
     lattice_compliance,
@@ -50,17 +52,25 @@ def test_the_compliance_is_twice_the_half_space_tangential_block():
     assert np.all(G > 0) and np.all(np.linalg.eigvalsh(G) > 0)
 
 
-def test_forces_stay_those_of_the_tracked_stretchings_through_the_avalanches():
+@pytest.mark.parametrize("matrix_free", [False, True])
+def test_forces_stay_those_of_the_tracked_stretchings_through_the_avalanches(matrix_free):
     model = EQModel(n_contacts=64, x_s_std=0.2)
-    interface = InteractingEQModel.lattice(model, coupling=0.3)
+    if matrix_free:
+        interface = LatticeEQModel(model, coupling=0.3)
+        # M from the dense inverse of 1/k + G, G assembled column by column: independent of
+        # the conjugate gradients that update the forces
+        M = np.linalg.inv(np.eye(64) / model.k + interface.compliance.dense())
+    else:
+        interface = InteractingEQModel.lattice(model, coupling=0.3)
+        M = interface.stiffness_matrix
     contacts = interface.contacts(np.random.default_rng(3))
     X = 0.0
-    for _ in range(300):
+    for _ in range(150):
         X, trigger = contacts.next_break()
         contacts.relax(X, trigger)
-    assert sum(a[1] for a in contacts.avalanches) > 300  # some avalanches broke several
+    assert sum(a[1] for a in contacts.avalanches) > 150  # some avalanches broke several
     # f = M (X − b) for the offsets b of the re-formed contacts (the update's invariant)
-    np.testing.assert_allclose(contacts.forces, interface.stiffness_matrix @ (X - contacts.offsets),
+    np.testing.assert_allclose(contacts.forces, M @ (X - contacts.offsets),
                                rtol=1e-9, atol=1e-9 * np.max(np.abs(contacts.forces)))
     assert np.all(contacts.forces <= model.k * contacts.thresholds)  # none left over
     assert contacts.friction(X) == pytest.approx(np.sum(contacts.forces), rel=1e-12)
@@ -143,3 +153,50 @@ def test_a_runaway_avalanche_stops_with_an_error_and_keeps_the_state_before_it()
     assert contacts.X_ref == 0.0 and np.all(contacts.offsets == 0.0)
     contacts.max_rounds = 10
     assert contacts.relax(1.0) > 1  # an avalanche
+
+
+def test_the_fft_compliance_is_the_dense_lattice_compliance():
+    # an independent construction: the dense matrix of the half-space's Green tensor
+    positions, G = lattice_compliance(5, 1.3, E=2.0, nu=0.27, contact_radius=0.4)
+    fft = LatticeCompliance(5, 1.3, E=2.0, nu=0.27, contact_radius=0.4)
+    np.testing.assert_allclose(fft.dense(), G, rtol=1e-12, atol=1e-14 * np.max(G))
+
+
+def test_the_matrix_free_model_has_the_dense_models_events():
+    # k, x_c, σ, ν and the coupling away from 0 and 1: the two solve the same interface, the
+    # one by Cholesky, the other by conjugate gradients to 1e-10: the same draws, in order
+    model = EQModel(n_contacts=100, k=1.7, x_s_mean=0.9, x_s_std=0.25)
+    dense = InteractingEQModel.lattice(model, 0.2, nu=0.27)
+    free = LatticeEQModel(model, 0.2, nu=0.27)
+    assert free.interface_stiffness == pytest.approx(dense.interface_stiffness, rel=1e-9)
+    np.testing.assert_allclose(free.stiffness.rate, dense.stiffness_matrix.sum(axis=1),
+                               rtol=1e-9)
+    X_max = 2.0 * 0.9 * 100 * 1.7 / dense.interface_stiffness
+    a, b = dense.quasistatic(X_max, seed=4), free.quasistatic(X_max, seed=4)
+    assert a.breaks > 150 and a.largest_avalanche > 5 / 100  # avalanches, not single breaks
+    np.testing.assert_array_equal(b.avalanche_size, a.avalanche_size)
+    # an event's position is a threshold over a rate, each to the solves' 1e-10
+    np.testing.assert_allclose(b.avalanche_X, a.avalanche_X, rtol=1e-8)
+    np.testing.assert_allclose(b.force_drop, a.force_drop, rtol=1e-6,
+                               atol=1e-8 * a.kinetic_force)
+    np.testing.assert_allclose(b.F, a.F, rtol=1e-8)
+
+
+def test_slow_spring_drive_events_of_interacting_contacts():
+    model = EQModel(n_contacts=64, k=1.3, x_s_mean=1.1, x_s_std=0.2)
+    K, D_max = 20.0, 64 * 1.3 * 1.1 / 20.0 + 3.0
+    plain = model.spring_quasistatic(K=K, D_max=D_max, seed=2)
+    # without interaction, the lattice's contacts (dense or matrix-free) are the plain ones
+    for uncoupled in (InteractingEQModel.lattice(model, 0.0), LatticeEQModel(model, 0.0)):
+        run = uncoupled.spring_quasistatic(K=K, D_max=D_max, seed=2)
+        np.testing.assert_array_equal(run.events.breaks, plain.events.breaks)
+        np.testing.assert_allclose(run.events.drop, plain.events.drop, rtol=1e-9,
+                                   atol=1e-12 * plain.peak_force)
+    # coupled, the dense and the matrix-free interfaces have the same events
+    dense = InteractingEQModel.lattice(model, 0.3).spring_quasistatic(K=K, D_max=D_max, seed=2)
+    free = LatticeEQModel(model, 0.3).spring_quasistatic(K=K, D_max=D_max, seed=2)
+    np.testing.assert_array_equal(free.events.breaks, dense.events.breaks)
+    np.testing.assert_allclose(free.D, dense.D, rtol=1e-8)
+    # every event's drop is K times the slider's slip at fixed drive
+    np.testing.assert_allclose(dense.events.drop, K * dense.events.slip, rtol=1e-9)
+    assert dense.events.breaks.size > 5 and dense.events.breaks.max() > 1  # avalanches

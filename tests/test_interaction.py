@@ -118,3 +118,33 @@ def test_break_response_decays_as_inverse_cube_beyond_the_correlation_length():
 def test_bad_input_names_the_parameter(call, name):
     with pytest.raises(ValueError, match=name):
         call()
+
+
+def _cerruti(Q_x: float, x: float, y: float, z: float, nu: float, shear_modulus: float):
+    """Cerruti's displacements at depth z below a tangential point load Q_x on the surface of
+    a half-space, (u_x, u_y) (Johnson 1985, *Contact mechanics*, §3.2, eq. 3.86a-b; z into
+    the solid, ρ the distance from the load)."""
+    rho = math.sqrt(x * x + y * y + z * z)
+    c = Q_x / (4 * math.pi * shear_modulus)
+    u_x = c * (1 / rho + x * x / rho**3
+               + (1 - 2 * nu) * (1 / (rho + z) - x * x / (rho * (rho + z) ** 2)))
+    u_y = c * (x * y / rho**3 - (1 - 2 * nu) * x * y / (rho * (rho + z) ** 2))
+    return u_x, u_y
+
+
+@pytest.mark.parametrize("angle", [30.0, 125.0])
+def test_in_plane_green_tensor_off_the_axes_is_cerrutis_solution(angle):
+    """Off the axes the xy coupling 2g σ x y/r² does not vanish; Johnson's closed form at the
+    surface (z → 0) gives both the xx and the xy components, and by symmetry of G the yx."""
+    r, nu, E_ = 1.3, 0.27, 3.1
+    x, y = r * math.cos(math.radians(angle)), r * math.sin(math.radians(angle))
+    G = green_tensor([x, y], E_, nu)
+    u_x, u_y = _cerruti(1.0, x, y, 0.0, nu, E_ / (2 * (1 + nu)))
+    assert abs(u_y) > 0.05 * abs(u_x)  # a case where the coupling matters
+    assert G[0, 0] == pytest.approx(u_x, rel=1e-12)
+    assert G[1, 0] == pytest.approx(u_y, rel=1e-12)
+    assert G[0, 1] == pytest.approx(u_y, rel=1e-12)
+    # a load along y: Cerruti's solution with x and y exchanged
+    u_y_from_y, u_x_from_y = _cerruti(1.0, y, x, 0.0, nu, E_ / (2 * (1 + nu)))
+    assert G[1, 1] == pytest.approx(u_y_from_y, rel=1e-12)
+    assert G[0, 1] == pytest.approx(u_x_from_y, rel=1e-12)

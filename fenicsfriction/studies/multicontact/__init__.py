@@ -19,11 +19,13 @@ from fenicsfriction._lazy import attach
 __getattr__, __dir__, __all__ = attach(__name__, {
     "EQModel": "eq_model", "QuasistaticResult": "eq_model",
     "SpringDrivenResult": "eq_model", "describe_distribution": "eq_model",
+    "SpringQuasistaticResult": "eq_model", "SlipEvents": "eq_model", "slip_events": "eq_model",
     "MasterEquation": "master_equation", "MasterEquationResult": "master_equation",
     "InstabilityMap": "instability", "instability_map": "instability",
     "critical_stiffness": "instability", "CouplingMap": "instability",
     "coupling_map": "instability", "InteractingEQModel": "interacting",
     "InteractingQuasistaticResult": "interacting", "lattice_compliance": "interacting",
+    "LatticeEQModel": "interacting", "LatticeCompliance": "interacting",
     "FKChain": "frenkel_kontorova",
     "FKResult": "frenkel_kontorova", "FrontSpeeds": "frenkel_kontorova",
     "TriangleRamp": "frenkel_kontorova", "front_speeds": "frenkel_kontorova",
@@ -38,8 +40,11 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers
     from fenicsfriction.studies.multicontact.eq_model import (
         EQModel,
         QuasistaticResult,
+        SlipEvents,
         SpringDrivenResult,
+        SpringQuasistaticResult,
         describe_distribution,
+        slip_events,
     )
     from fenicsfriction.studies.multicontact.frenkel_kontorova import (
         FKChain,
@@ -58,6 +63,8 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers
     from fenicsfriction.studies.multicontact.interacting import (
         InteractingEQModel,
         InteractingQuasistaticResult,
+        LatticeCompliance,
+        LatticeEQModel,
         lattice_compliance,
     )
     from fenicsfriction.studies.multicontact.interaction import (

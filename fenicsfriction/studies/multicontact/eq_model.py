@@ -41,7 +41,8 @@ from fenicsfriction.laws import check, check_positive
 from fenicsfriction.results import Record
 
 __all__ = ["Contacts", "Distribution", "EQModel", "IndependentContacts", "QuasistaticResult",
-           "SpringDrivenResult", "check_quasistatic", "describe_distribution", "drive"]
+           "SlipEvents", "SpringDrivenResult", "SpringQuasistaticResult", "check_quasistatic",
+           "describe_distribution", "drive", "drive_quasistatic", "slip_events"]
 
 
 class Distribution(typing.Protocol):
@@ -116,6 +117,58 @@ class QuasistaticResult(Record):
 
 
 @dataclasses.dataclass
+class SlipEvents(Record):
+    """The slip events of a spring-driven run (:func:`slip_events`), in order.
+
+    Attributes:
+        start, end: the times where each event's spring force starts and stops falling.
+        drop: the fall of the spring force K (v t − X) over the event (force units).
+        slip: the slider's advance over the event (length).
+        breaks: the contacts broken in the event (those of its first step included), >= 1.
+    """
+
+    start: np.ndarray
+    end: np.ndarray
+    drop: np.ndarray
+    slip: np.ndarray
+    breaks: np.ndarray
+
+    def after(self, t: float) -> SlipEvents:
+        """The events that start at or after t."""
+        keep = self.start >= t
+        return SlipEvents(self.start[keep], self.end[keep], self.drop[keep], self.slip[keep],
+                          self.breaks[keep])
+
+
+def slip_events(t: np.ndarray, X: np.ndarray, spring_force: np.ndarray,
+                breaks: np.ndarray) -> SlipEvents:
+    r"""The slip events of a run: every maximal interval over which the spring force
+    :math:`K (v t - X)` falls (the slider outruns the drive, :math:`\dot X > v`) and in which
+    contacts break.
+
+    A break's loss of force reaches the spring through the slider's motion, so an event is
+    seen from its cause (the breaks at the step that starts it) to the spring force's first
+    minimum: an underdamped slider's overshoot beyond its new equilibrium belongs to the
+    event, and the later swings of its ring-down (falls without breaks, as is the start from
+    rest) are not events.
+
+    Args:
+        t: the recorded times, increasing.
+        X: the slider's position at t.
+        spring_force: K (v t − X) at t.
+        breaks: the contacts broken at the end of each step (after t).
+    """
+    falling = np.diff(spring_force) < 0
+    edges = np.diff(falling.astype(np.int8), prepend=0, append=0)
+    first, last = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)  # steps [first, last)
+    counted = np.concatenate([[0], np.cumsum(breaks)])
+    broken = (counted[last] - counted[first]).astype(int)
+    first, last = first[broken > 0], last[broken > 0]
+    return SlipEvents(start=t[first], end=t[last], drop=spring_force[first] - spring_force[last],
+                      slip=X[last] - X[first], breaks=broken[broken > 0])
+
+
+@dataclasses.dataclass
 class SpringDrivenResult(Record):
     """A run of the slider pulled through a spring (:meth:`EQModel.spring_driven`).
 
@@ -130,15 +183,24 @@ class SpringDrivenResult(Record):
         force_spread: std/mean of the spring force over the late window.
         velocity_spread: std(Ẋ)/v over the late window.
         stuck_fraction: the fraction of late steps with Ẋ < v/10.
+        events: the slip events of the whole run (:func:`slip_events`).
+        mean_force: the mean spring force over the late window.
+        largest_drop: the largest spring-force drop of a late event over ``mean_force``.
+        jump_fraction: the share of the slider's late displacement made in events whose
+            drop exceeds ``drop_threshold`` (the drive carried by jumps).
+        drop_threshold: the drop, over ``mean_force``, that makes an event a jump.
+
+        At a finite drive speed the events are ambiguous: a slider that follows a falling
+        F(X) (K > K*) outruns the drive too, and the whole decline after the static peak is one
+        falling interval, as large as a jump. The regimes are told apart in the limit v → 0
+        (:func:`drive_quasistatic`, :meth:`EQModel.spring_quasistatic`), which classifies.
         max_speed: max Ẋ/v over the run.
-        stick_slip: ``max_speed > slip_speed`` (the classification): the slider jumped. A
-            slider that follows its equilibrium F(X) = K (v t − X) moves at
-            Ẋ = v K/(K + F'(X)), at most v K/(K − K*) when K > K*; below K* it jumps at the
-            speed of its free oscillation. The late-window measures do not separate the
-            regimes: contacts re-formed together after the first collective break stay partly
-            in phase for ~(x_c/σ)² lives, so F(X) oscillates by several per cent even when the
-            slider follows the drive; single breaks make micro-slips of ~x_c/N at the
-            oscillation's speed; and a soft drive (K < N k/9) creeps at Ẋ < v/10 while loading.
+        fast_slip: ``max_speed > slip_speed``, the former speed classification, kept under its
+            own name. It does not separate the regimes: a slider that follows its
+            equilibrium moves at Ẋ = v K/(K + F'(X)), which exceeds any multiple of v as K
+            approaches K* from above; single breaks make micro-slips of ~x_c/N at the
+            oscillation's speed, above 10 v for small N; and a soft drive (K < N k/9) creeps
+            at Ẋ < v/10 while loading, so the late-window spreads do not separate them either.
         parameters: the model's :meth:`EQModel.parameters`.
     """
 
@@ -156,8 +218,13 @@ class SpringDrivenResult(Record):
     force_spread: float
     velocity_spread: float
     stuck_fraction: float
+    events: SlipEvents
+    mean_force: float
+    largest_drop: float
+    jump_fraction: float
+    drop_threshold: float
     max_speed: float
-    stick_slip: bool
+    fast_slip: bool
     parameters: dict
 
 
@@ -288,8 +355,8 @@ class EQModel:
 
     def spring_driven(self, K: float, v: float, mass: float, damping: float, t_end: float,
                       dt: float, seed: int | None = 0, late_from: float | None = None,
-                      slip_speed: float = 10.0, prefix: str = "eq_",
-                      options: dict | None = None) -> SpringDrivenResult:
+                      drop_threshold: float = 0.05, slip_speed: float = 10.0,
+                      prefix: str = "eq_", options: dict | None = None) -> SpringDrivenResult:
         """Pull the slider, from rest with every contact relaxed, through a spring K whose end
         moves at speed v: m Ẍ + η Ẋ + F(X) = K (v t − X), by PETSc TS (generalized-α), the
         contacts breaking at step resolution.
@@ -305,16 +372,29 @@ class EQModel:
             t_end: the duration.
             dt: the time step; a contact overshoots its threshold by at most |Ẋ| dt.
             seed: seeds the random generator.
-            late_from: start of the late-time window classified; None: t_end/2.
-            slip_speed: the slider speed, in units of v, above which it has jumped (the run
-                is stick-slip). The run must reach the static peak: v t_end > F_s/K + x_c.
+            late_from: start of the late-time window classified; None: t_end/2. The run
+                must reach the static peak: v t_end > F_s/K + x_c.
+            drop_threshold: the spring-force drop of one event, over the late mean force,
+                above which the event is a jump (:class:`SpringDrivenResult`).
+            slip_speed: the speed, in units of v, of ``fast_slip`` (the former classification).
             prefix, options: the TS's options prefix and defaults
                 (see :class:`~fenicsfriction.timestepping.ReducedDynamics`).
         """
         contacts = IndependentContacts(self, np.random.default_rng(seed))
         return drive(contacts, self.parameters(), K=K, v=v, mass=mass, damping=damping,
-                     t_end=t_end, dt=dt, late_from=late_from, slip_speed=slip_speed,
-                     prefix=prefix, options=options)
+                     t_end=t_end, dt=dt, late_from=late_from, drop_threshold=drop_threshold,
+                     slip_speed=slip_speed, prefix=prefix, options=options)
+
+
+    def spring_quasistatic(self, K: float, D_max: float, seed: int | None = 0,
+                           late_from: float | None = None,
+                           drop_threshold: float = 0.05) -> SpringQuasistaticResult:
+        """Pull the slider through a spring K infinitely slowly, event by event
+        (:func:`drive_quasistatic`, whose arguments these are), every contact relaxed at
+        D = 0."""
+        contacts = IndependentContacts(self, np.random.default_rng(seed))
+        return drive_quasistatic(contacts, self.parameters(), K=K, D_max=D_max,
+                                 late_from=late_from, drop_threshold=drop_threshold)
 
 
 class Contacts(typing.Protocol):
@@ -329,9 +409,12 @@ class Contacts(typing.Protocol):
     def friction(self, X: float) -> float:
         """The contacts' force on the slider at X, before the breaks at X."""
 
-    def relax(self, X: float) -> int:
-        """Break every contact over its threshold at X and re-form it (and any it overloads);
-        return the number of breaks."""
+    def relax(self, X: float, trigger: int | None = None) -> int:
+        """Break every contact over its threshold at X and re-form it (and any it overloads),
+        ``trigger`` whatever the round-off; return the number of breaks."""
+
+    def next_break(self) -> tuple[float, int]:
+        """The slider position of the next break under further loading and its contact."""
 
 
 class IndependentContacts:
@@ -348,8 +431,16 @@ class IndependentContacts:
     def friction(self, X: float) -> float:
         return self.model.k * (self.model.n_contacts * X - self.sum_anchors)
 
-    def relax(self, X: float) -> int:
-        broken = np.flatnonzero(X - self.anchors > self.thresholds)
+    def next_break(self) -> tuple[float, int]:
+        reach = self.anchors + self.thresholds
+        first = int(np.argmin(reach))
+        return float(reach[first]), first
+
+    def relax(self, X: float, trigger: int | None = None) -> int:
+        over = X - self.anchors > self.thresholds
+        if trigger is not None:
+            over[trigger] = True
+        broken = np.flatnonzero(over)
         if broken.size:
             x0 = self.model.draw_newborn(self.rng, broken.size)
             self.anchors[broken] = X - x0
@@ -360,7 +451,7 @@ class IndependentContacts:
 
 def drive(contacts: Contacts, parameters: dict, K: float, v: float, mass: float,
           damping: float, t_end: float, dt: float, late_from: float | None = None,
-          slip_speed: float = 10.0, prefix: str = "eq_",
+          drop_threshold: float = 0.05, slip_speed: float = 10.0, prefix: str = "eq_",
           options: dict | None = None) -> SpringDrivenResult:
     """Pull a slider held by ``contacts`` through a spring K (see :meth:`EQModel.spring_driven`,
     whose arguments these are; ``parameters`` go into the result)."""
@@ -370,6 +461,7 @@ def drive(contacts: Contacts, parameters: dict, K: float, v: float, mass: float,
                         ("slip_speed", slip_speed)):
         check_positive(name, value)
     check_positive("damping", damping, strict=False)
+    check("drop_threshold", drop_threshold, 0 < drop_threshold < 1, "must lie in (0, 1)")
     late_from = 0.5 * t_end if late_from is None else late_from
     check("late_from", late_from, 0 <= late_from < t_end, f"must lie in [0, {t_end})")
     slider = _SpringDrivenSlider(contacts, K, mass, damping)
@@ -381,15 +473,159 @@ def drive(contacts: Contacts, parameters: dict, K: float, v: float, mass: float,
                                         ("time", "X", "X_dot", "D", "friction", "breaks"))
     spring = K * (D - X)
     late = t >= late_from
+    events = slip_events(t, X, spring, broken)
+    late_events = events.after(late_from)
+    mean_force = float(np.mean(spring[late]))
+    drops = late_events.drop / abs(mean_force)
+    advance = float(X[-1] - X[late][0])
+    jumps = float(np.sum(late_events.slip[drops > drop_threshold]))
+    largest = float(np.max(drops, initial=0.0))
     max_speed = float(np.max(X_dot) / v)
     return SpringDrivenResult(
         t=t, X=X, X_dot=X_dot, spring_force=spring, friction_force=friction,
         breaks=broken.astype(int), K=float(K), v=float(v), mass=float(mass),
         damping=float(damping), late_from=float(late_from),
-        force_spread=float(np.std(spring[late]) / abs(np.mean(spring[late]))),
+        force_spread=float(np.std(spring[late]) / abs(mean_force)),
         velocity_spread=float(np.std(X_dot[late]) / v),
-        stuck_fraction=float(np.mean(X_dot[late] < 0.1 * v)), max_speed=max_speed,
-        stick_slip=max_speed > slip_speed, parameters=parameters)
+        stuck_fraction=float(np.mean(X_dot[late] < 0.1 * v)), events=events,
+        mean_force=mean_force, largest_drop=largest,
+        jump_fraction=jumps / advance if advance > 0 else 0.0,
+        drop_threshold=float(drop_threshold), max_speed=max_speed,
+        fast_slip=max_speed > slip_speed, parameters=parameters)
+
+
+@dataclasses.dataclass
+class SpringQuasistaticResult(Record):
+    """The slider pulled through a spring K infinitely slowly (:func:`drive_quasistatic`).
+
+    Attributes:
+        D: the drive's positions at the events.
+        events: the events (``start`` = ``end`` = the drive's position D there): a break and
+            the slip and further breaks it causes at fixed D, until the slider rests.
+        K: the drive's stiffness.
+        late_from: where the late window starts (a drive position).
+        mean_force: the mean spring force over the late window (exact: it is linear in D
+            between events).
+        largest_drop: the largest drop of a late event over ``mean_force``.
+        jump_fraction: the share of the slider's late advance made in events whose drop
+            exceeds ``drop_threshold``.
+        mean_breaks: the mean breaks per late event.
+        peak_force: the largest spring force of the run (the static peak).
+        onset_drop: the largest drop of any event over ``peak_force``: the first collective
+            break, from all contacts relaxed, where F(X) falls fastest.
+        drop_threshold: the drop that makes an event a jump.
+        onset_jump: ``onset_drop > drop_threshold``: the slider jumps at the static peak,
+            which the elastic instability predicts for K < K* as N → ∞
+            (:func:`~fenicsfriction.studies.multicontact.instability.critical_stiffness`).
+        stick_slip: ``largest_drop > drop_threshold``: the jumps go on in the late window.
+        parameters: the model's parameters.
+    """
+
+    D: np.ndarray
+    events: SlipEvents
+    K: float
+    late_from: float
+    mean_force: float
+    largest_drop: float
+    jump_fraction: float
+    mean_breaks: float
+    peak_force: float
+    onset_drop: float
+    drop_threshold: float
+    onset_jump: bool
+    stick_slip: bool
+    parameters: dict
+
+
+def drive_quasistatic(contacts: Contacts, parameters: dict, K: float, D_max: float,
+                      late_from: float | None = None,
+                      drop_threshold: float = 0.05) -> SpringQuasistaticResult:
+    r"""Pull a slider held by ``contacts`` through a spring K whose end D moves infinitely
+    slowly, from D = 0, event by event and exactly.
+
+    Between events the slider rests on its equilibrium :math:`K (D - X) = F(X)`, F linear in X
+    (slope S), so X reaches the next break at :math:`D = X + F(X)/K`. There the contact breaks
+    at fixed D; F falls, and the slider slips to its new equilibrium,
+    :math:`X' = X + (K (D - X) - F(X))/(K + S)`, breaking in their order every contact it
+    takes past its threshold on the way (each re-formed where it broke), until it rests: one
+    event, whose spring-force drop is :math:`K (X_{end} - X_{start})`. This is the limit
+    v → 0 of :func:`drive` for an overdamped slider (no overshoot), where time scales
+    separate and the events are unambiguous: a stiff drive (K > K*) loses single breaks,
+    each :math:`k x_s K/(K + S)`, and a soft one (K < K*) loses a finite fraction of its force
+    in one event of O(N) breaks.
+
+    Args:
+        contacts: the contacts (:class:`Contacts`), from X = 0.
+        parameters: go into the result.
+        K: the drive's stiffness (force / length).
+        D_max: the drive's last position (length).
+        late_from: where the late window starts; None: D_max/2.
+        drop_threshold: the drop, over the late mean force, that makes an event a jump.
+    """
+    check_positive("K", K)
+    check_positive("D_max", D_max)
+    check("drop_threshold", drop_threshold, 0 < drop_threshold < 1, "must lie in (0, 1)")
+    late_from = 0.5 * D_max if late_from is None else late_from
+    check("late_from", late_from, 0 <= late_from < D_max, f"must lie in [0, {D_max})")
+    S = contacts.stiffness
+    X = 0.0
+    at, before, after, start, slips, counts = [], [], [], [], [], []
+    while True:
+        X_break, trigger = contacts.next_break()
+        if X_break < X:  # round-off: a contact left at its threshold by the last slip
+            X_break = X
+        D = X_break + contacts.friction(X_break) / K
+        if D_max < D:
+            break
+        X, X_start, force_before = X_break, X_break, K * (D - X_break)
+        broken = contacts.relax(X, trigger)
+        while True:  # the slip at fixed D, break by break
+            target = X + (K * (D - X) - contacts.friction(X)) / (K + S)
+            X_next, trigger = contacts.next_break()
+            if X_next > target:
+                X = target
+                break
+            X = max(X, X_next)
+            broken += contacts.relax(X, trigger)
+        at.append(D)
+        before.append(force_before)
+        after.append(K * (D - X))
+        start.append(X_start)
+        slips.append(X - X_start)
+        counts.append(broken)
+    D_events = np.asarray(at)
+    events = SlipEvents(start=D_events, end=D_events.copy(),
+                        drop=np.asarray(before) - np.asarray(after), slip=np.asarray(slips),
+                        breaks=np.asarray(counts, dtype=int))
+    # between events X and the spring force are linear in D, of slopes K/(K + S), K S/(K + S)
+    knots = np.concatenate([[0.0], D_events])
+    force_after = np.concatenate([[0.0], after])  # just after each event (and at D = 0)
+    slider_after = np.concatenate([[0.0], np.asarray(start) + np.asarray(slips)])
+
+    def slider(d: float) -> float:
+        i = int(np.searchsorted(knots, d, side="right")) - 1
+        return float(slider_after[i] + (d - knots[i]) * K / (K + S))
+
+    ends = np.concatenate([knots[1:], [D_max]])
+    left, right = np.clip(knots, late_from, D_max), np.clip(ends, late_from, D_max)
+    slope = K * S / (K + S)
+    midpoint_force = force_after + slope * (0.5 * (left + right) - knots)
+    mean_force = float(np.sum(midpoint_force * (right - left)) / (D_max - late_from))
+    late = events.after(late_from)
+    drops = late.drop / abs(mean_force)
+    advance = slider(D_max) - slider(late_from)
+    jumps = float(np.sum(late.slip[drops > drop_threshold]))
+    largest = float(np.max(drops, initial=0.0))
+    peak = float(np.max(before, initial=float(force_after[-1] + slope * (D_max - knots[-1]))))
+    onset = float(np.max(events.drop, initial=0.0)) / peak
+    return SpringQuasistaticResult(
+        D=D_events, events=events, K=float(K), late_from=float(late_from),
+        mean_force=mean_force, largest_drop=largest,
+        jump_fraction=jumps / advance if advance > 0 else 0.0,
+        mean_breaks=float(np.mean(late.breaks)) if late.breaks.size else 0.0,
+        peak_force=peak, onset_drop=onset, drop_threshold=float(drop_threshold),
+        onset_jump=onset > drop_threshold, stick_slip=largest > drop_threshold,
+        parameters=parameters)
 
 
 class _SpringDrivenSlider:

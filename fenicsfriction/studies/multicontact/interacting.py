@@ -40,8 +40,19 @@ stronger it is, the more of a break's force goes to the neighbours, and avalanch
 slides' "the stronger is the interaction, the wider is the range of model parameters where
 stick-slip occurs" (:func:`~fenicsfriction.studies.multicontact.instability.coupling_map`).
 
-Cost: :math:`M` is dense, one :math:`O(N^3)` Cholesky inversion; a break costs :math:`O(N)`
-per broken contact.
+Cost: :class:`InteractingEQModel` holds :math:`M` dense, one :math:`O(N^3)` Cholesky
+inversion (N ≲ 2000); a break costs :math:`O(N)` per broken contact.
+:class:`LatticeEQModel` is matrix-free: on a square lattice :math:`G` depends on the offset
+only, so :math:`(k^{-1} + G) f` is a convolution, done by FFT on a :math:`2n \times 2n`
+circulant embedding (as
+:class:`~fenicsfriction.studies.multicontact.interaction.LatticeInteraction`); the rate
+:math:`M\mathbf 1` is one conjugate-gradient solve, and an avalanche's round one more, on the
+contacts that keep their offsets: with :math:`\delta f_S = k x_0 - f_S` prescribed on
+the broken set S, :math:`(k^{-1} + G)_{\bar S \bar S}\,\delta f_{\bar S} =
+-G_{\bar S S}\,\delta f_S` (the same update as the dense one, which solves with
+:math:`M_{SS}`), preconditioned by the circulant of the periodic lattice, each offset at its
+nearest image (Strang 1986, "A proposal for Toeplitz matrix calculations"). Set-up
+:math:`O(N \log N)`, memory :math:`O(N)`, a round :math:`O(N \log N)` per iteration.
 """
 
 from __future__ import annotations
@@ -52,6 +63,7 @@ import typing
 
 import numpy as np
 import numpy.typing as npt
+import scipy.fft
 import scipy.linalg
 
 from fenicsfriction.laws import check, check_positive
@@ -59,13 +71,20 @@ from fenicsfriction.studies.multicontact.eq_model import (
     EQModel,
     QuasistaticResult,
     SpringDrivenResult,
+    SpringQuasistaticResult,
     check_quasistatic,
     drive,
+    drive_quasistatic,
 )
-from fenicsfriction.studies.multicontact.interaction import interaction_matrix
+from fenicsfriction.studies.multicontact.interaction import (
+    green_tensor,
+    interaction_matrix,
+    self_compliance,
+)
 
-__all__ = ["CoupledContacts", "InteractingEQModel", "InteractingQuasistaticResult",
-           "lattice_compliance"]
+__all__ = ["CoupledContacts", "DenseStiffness", "InteractingEQModel",
+           "InteractingQuasistaticResult", "LatticeCompliance", "LatticeEQModel",
+           "LatticeStiffness", "StiffnessOperator", "lattice_compliance"]
 
 Array: typing.TypeAlias = npt.NDArray[np.float64]
 
@@ -97,6 +116,153 @@ def lattice_compliance(n: int, spacing: float, E: float, nu: float,
     return positions, np.ascontiguousarray(2.0 * G[0::3, 0::3])
 
 
+class LatticeCompliance:
+    """:func:`lattice_compliance` applied matrix-free: ``G f`` by FFT on the ``2n × 2n``
+    circulant embedding of the lattice's offsets, O(N log N), no N × N array.
+
+    Args: as :func:`lattice_compliance` (``E`` finite).
+
+    Attributes:
+        n, size: contacts per side and N = n².
+        diagonal: G_ii, the self term (all equal).
+    """
+
+    def __init__(self, n: int, spacing: float, E: float, nu: float,
+                 contact_radius: float | None = None) -> None:
+        check("n", n, isinstance(n, (int, np.integer)) and n >= 1, "must be an integer >= 1")
+        check_positive("spacing", spacing)
+        self.n, self.size = int(n), int(n) ** 2
+        radius = 0.5 * spacing if contact_radius is None else contact_radius
+        offsets = np.fft.fftfreq(2 * self.n, d=1.0 / (2 * self.n))  # 0, 1, .., n, -(n-1), .., -1
+        dx, dy = np.meshgrid(offsets * spacing, offsets * spacing, indexing="ij")
+        kernel = np.zeros((2 * self.n, 2 * self.n))
+        nonzero = np.hypot(dx, dy) > 0
+        kernel[nonzero] = 2.0 * green_tensor(np.stack([dx[nonzero], dy[nonzero]], axis=-1),
+                                             E, nu)[:, 0, 0]
+        self.diagonal = 2.0 * float(self_compliance(radius, E, nu)[0, 0])
+        kernel[0, 0] = self.diagonal
+        self._spectrum = scipy.fft.rfft2(kernel)
+        # the periodic lattice's circulant (each offset taken at its nearest image, Strang
+        # 1986): the preconditioner's spectrum, O(N log N)
+        near = np.fft.fftfreq(self.n, d=1.0 / self.n)
+        px, py = np.meshgrid(near * spacing, near * spacing, indexing="ij")
+        periodic = np.zeros((self.n, self.n))
+        inner = np.hypot(px, py) > 0
+        periodic[inner] = 2.0 * green_tensor(np.stack([px[inner], py[inner]], axis=-1),
+                                             E, nu)[:, 0, 0]
+        periodic[0, 0] = self.diagonal
+        self.periodic_spectrum = scipy.fft.rfft2(periodic)
+
+    def apply(self, forces: Array) -> Array:
+        """G f for ``(N,)`` forces: the relative displacements ``(N,)``."""
+        n = self.n
+        padded = np.zeros((2 * n, 2 * n))
+        padded[:n, :n] = forces.reshape(n, n)
+        full = scipy.fft.irfft2(self._spectrum * scipy.fft.rfft2(padded), s=(2 * n, 2 * n))
+        return full[:n, :n].ravel()
+
+    def dense(self) -> Array:
+        """G as an ``(N, N)`` array, column by column (for checks at small N)."""
+        return np.stack([self.apply(e) for e in np.eye(self.size)], axis=1)
+
+
+class StiffnessOperator(typing.Protocol):
+    """What :class:`CoupledContacts` needs of M = (1/k + G)⁻¹."""
+
+    #: M 1, the contacts' force per unit slider displacement.
+    rate: Array
+
+    def update(self, over: npt.NDArray[np.intp], change: Array) -> tuple[Array, Array]:
+        """The forces' change when the contacts ``over`` change theirs by ``change`` and the
+        others keep their offsets, and the offsets' change on ``over``."""
+
+
+class DenseStiffness:
+    """M = (1/k + G)⁻¹ held dense: the update of :class:`CoupledContacts` by :math:`M_{SS}`."""
+
+    def __init__(self, M: Array) -> None:
+        self.M = M
+        self.rate: Array = M.sum(axis=1)
+
+    def update(self, over: npt.NDArray[np.intp], change: Array) -> tuple[Array, Array]:
+        """The forces' change when the contacts ``over`` change theirs by ``change`` and the
+        others keep their offsets, and the offsets' change on ``over``."""
+        jump = change / self.M[over[0], over[0]] if over.size == 1 else \
+            scipy.linalg.solve(self.M[np.ix_(over, over)], change, assume_a="pos")
+        return self.M[:, over] @ jump, -jump
+
+
+class LatticeStiffness:
+    """M = (1/k + G)⁻¹ applied by conjugate gradients on the FFT compliance, matrix-free.
+
+    Args:
+        k: the contacts' stiffness.
+        compliance: G (:class:`LatticeCompliance`).
+        rtol: the relative residual of each solve.
+        max_iterations: per solve; beyond, the run stops with an error naming ``rtol``.
+
+    Attributes:
+        rate: M 1.
+        iterations: conjugate-gradient iterations so far, all solves.
+        solves: the solves so far.
+    """
+
+    def __init__(self, k: float, compliance: LatticeCompliance, rtol: float = 1e-10,
+                 max_iterations: int = 2000) -> None:
+        check_positive("rtol", rtol)
+        self.k, self.G, self.rtol, self.max_iterations = k, compliance, rtol, max_iterations
+        n = compliance.n
+        self._preconditioner = 1.0 / (1.0 / k + compliance.periodic_spectrum.real)
+        self._shape = (n, n)
+        self.iterations = self.solves = 0
+        everyone = np.ones(compliance.size, dtype=bool)
+        self.rate = self.solve(np.ones(compliance.size), everyone)
+
+    def operator(self, f: Array) -> Array:
+        """(1/k + G) f."""
+        return f / self.k + self.G.apply(f)
+
+    def _precondition(self, r: Array) -> Array:
+        return scipy.fft.irfft2(self._preconditioner * scipy.fft.rfft2(r.reshape(self._shape)),
+                                s=self._shape).ravel()
+
+    def solve(self, rhs: Array, free: npt.NDArray[np.bool_]) -> Array:
+        """x with ``(1/k + G)_{FF} x_F = rhs_F`` on the contacts ``free`` (F) and x = 0 off
+        them, by preconditioned conjugate gradients (the operator restricted to F is
+        symmetric positive definite, and so is the preconditioner restricted likewise)."""
+        x = np.zeros_like(rhs)
+        r = np.where(free, rhs, 0.0)
+        target = self.rtol * float(np.linalg.norm(r))
+        z = np.where(free, self._precondition(r), 0.0)
+        d, rz = z.copy(), float(r @ z)
+        for _ in range(self.max_iterations):
+            if float(np.linalg.norm(r)) <= target:
+                break
+            q = np.where(free, self.operator(d), 0.0)
+            alpha = rz / float(d @ q)
+            x += alpha * d
+            r -= alpha * q
+            z = np.where(free, self._precondition(r), 0.0)
+            rz, previous = float(r @ z), rz
+            d = z + (rz / previous) * d
+            self.iterations += 1
+        else:
+            check("rtol", self.rtol, False, f"conjugate gradients did not reach it in "
+                  f"{self.max_iterations} iterations")
+        self.solves += 1
+        return x
+
+    def update(self, over: npt.NDArray[np.intp], change: Array) -> tuple[Array, Array]:
+        """As :meth:`DenseStiffness.update`: one solve on the contacts that keep their
+        offsets, loaded by the broken ones' change through G."""
+        delta = np.zeros(self.G.size)
+        delta[over] = change
+        free = np.ones(self.G.size, dtype=bool)
+        free[over] = False
+        delta += self.solve(-self.G.apply(delta), free)
+        return delta, -self.operator(delta)[over]
+
+
 class CoupledContacts:
     """The contacts of an :class:`InteractingEQModel` in one realisation: their forces at a
     reference position, their thresholds, the breaks and avalanches (the module docstring).
@@ -112,15 +278,17 @@ class CoupledContacts:
         avalanches: ``(X, breaks, force drop)`` of every :meth:`relax` that broke contacts.
     """
 
-    def __init__(self, model: EQModel, stiffness_matrix: Array, rng: np.random.Generator,
-                 max_rounds: int) -> None:
-        self.model, self.M, self.rng, self.max_rounds = model, stiffness_matrix, rng, max_rounds
+    def __init__(self, model: EQModel, stiffness: Array | StiffnessOperator,
+                 rng: np.random.Generator, max_rounds: int) -> None:
+        self.stiffness_operator: StiffnessOperator = DenseStiffness(stiffness) if isinstance(
+            stiffness, np.ndarray) else stiffness
+        self.model, self.rng, self.max_rounds = model, rng, max_rounds
         n = model.n_contacts
         self.forces: Array = np.zeros(n)
         self.offsets: Array = np.zeros(n)
         self.X_ref = 0.0
         self.thresholds = model.draw_thresholds(rng, np.zeros(n))
-        self.rate = stiffness_matrix.sum(axis=1)
+        self.rate = self.stiffness_operator.rate
         self._loaded = np.flatnonzero(self.rate > 0)  # the contacts X loads (rate is fixed)
         self.stiffness = float(self.rate.sum())
         self.weight = n * model.k * model.x_s_mean
@@ -162,11 +330,10 @@ class CoupledContacts:
                                    f"max_rounds = {self.max_rounds} rounds ({broken} breaks); "
                                    "the contacts are left as they were before it")
             x0 = self.model.draw_newborn(self.rng, over.size)
-            jump = (k * x0 - f[over]) / self.M[over[0], over[0]] if over.size == 1 else \
-                scipy.linalg.solve(self.M[np.ix_(over, over)], k * x0 - f[over], assume_a="pos")
-            f += self.M[:, over] @ jump
+            change, offset_change = self.stiffness_operator.update(over, k * x0 - f[over])
+            f += change
             f[over] = k * x0
-            self.offsets[over] -= jump
+            self.offsets[over] += offset_change
             self.thresholds[over] = self.model.draw_thresholds(self.rng, x0)
             broken += over.size
             rounds += 1
@@ -197,8 +364,84 @@ class InteractingQuasistaticResult(QuasistaticResult):
     interface_stiffness: float
 
 
+class _Interface:
+    """The drives of interacting contacts, whatever holds their stiffness."""
+
+    model: EQModel
+
+    @property
+    def interface_stiffness(self) -> float:
+        raise NotImplementedError
+
+    def parameters(self) -> dict[str, typing.Any]:
+        raise NotImplementedError
+
+    def contacts(self, rng: np.random.Generator) -> CoupledContacts:
+        raise NotImplementedError
+
+    def quasistatic(self, X_max: float, n_points: int = 401, realisations: int = 1,
+                    seed: int | None = 0, kinetic_from: float | None = None,
+                    bins: int = 50) -> InteractingQuasistaticResult:
+        """Move the slider from X = 0, every contact relaxed, to ``X_max``, break by break.
+
+        Event-driven and exact: F is linear in X between breaks, the next break is found in
+        closed form, and each avalanche is resolved at its X (arguments as
+        :meth:`EQModel.quasistatic`).
+        """
+        kinetic_from = check_quasistatic(X_max, n_points, realisations, kinetic_from)
+        rng = np.random.default_rng(seed)
+        X = np.linspace(0.0, X_max, n_points)
+        F = np.empty((realisations, n_points))
+        stretch, avalanches = [], []
+        for r in range(realisations):
+            contacts = self.contacts(rng)
+            at, after = [0.0], [0.0]  # F just after each avalanche, and where
+            while (event := contacts.next_break())[0] <= X_max:
+                X_next = event[0]
+                contacts.relax(*event)
+                at.append(X_next)
+                after.append(contacts.friction(X_next))
+            last = np.searchsorted(at, X, side="right") - 1
+            F[r] = np.asarray(after)[last] + (X - np.asarray(at)[last]) * contacts.stiffness
+            stretch.append(contacts.forces_at(X_max) / self.model.k)
+            avalanches.extend(contacts.avalanches)
+        density, edges = np.histogram(np.concatenate(stretch), bins=bins, density=True)
+        where, size, drop = (np.array([a[i] for a in avalanches]) for i in range(3))
+        mean_F = F.mean(axis=0)
+        return InteractingQuasistaticResult(
+            X=X, F=mean_F, F_std=F.std(axis=0), histogram_edges=edges, histogram=density,
+            kinetic_force=float(np.mean(mean_F[kinetic_from <= X])),
+            static_force=float(np.max(mean_F)), kinetic_from=float(kinetic_from),
+            realisations=realisations, breaks=int(np.sum(size)), parameters=self.parameters(),
+            avalanche_X=where, avalanche_size=size.astype(int), force_drop=drop,
+            largest_avalanche=float(np.max(size, initial=0) / self.model.n_contacts),
+            interface_stiffness=self.interface_stiffness)
+
+    def spring_driven(self, K: float, v: float, mass: float, damping: float, t_end: float,
+                      dt: float, seed: int | None = 0, late_from: float | None = None,
+                      drop_threshold: float = 0.05, slip_speed: float = 10.0,
+                      prefix: str = "eq_", options: dict | None = None) -> SpringDrivenResult:
+        """The slider pulled through a spring K (arguments and result as
+        :meth:`EQModel.spring_driven`); an avalanche is resolved within the step whose end
+        puts a contact over its threshold."""
+        contacts = self.contacts(np.random.default_rng(seed))
+        return drive(contacts, self.parameters(), K=K, v=v, mass=mass, damping=damping,
+                     t_end=t_end, dt=dt, late_from=late_from, drop_threshold=drop_threshold,
+                     slip_speed=slip_speed, prefix=prefix, options=options)
+
+    def spring_quasistatic(self, K: float, D_max: float, seed: int | None = 0,
+                           late_from: float | None = None,
+                           drop_threshold: float = 0.05) -> SpringQuasistaticResult:
+        """The slider pulled through a spring K infinitely slowly, event by event (arguments
+        and result as :meth:`EQModel.spring_quasistatic`); an event's breaks include the
+        avalanches through the bodies."""
+        contacts = self.contacts(np.random.default_rng(seed))
+        return drive_quasistatic(contacts, self.parameters(), K=K, D_max=D_max,
+                                 late_from=late_from, drop_threshold=drop_threshold)
+
+
 @dataclasses.dataclass
-class InteractingEQModel:
+class InteractingEQModel(_Interface):
     """EQ contacts coupled through the elastic bodies by the compliance G (module docstring).
 
     Args:
@@ -266,52 +509,74 @@ class InteractingEQModel:
         """A fresh realisation, every contact relaxed at X = 0."""
         return CoupledContacts(self.model, self.stiffness_matrix, rng, self.max_rounds)
 
-    def quasistatic(self, X_max: float, n_points: int = 401, realisations: int = 1,
-                    seed: int | None = 0, kinetic_from: float | None = None,
-                    bins: int = 50) -> InteractingQuasistaticResult:
-        """Move the slider from X = 0, every contact relaxed, to ``X_max``, break by break.
 
-        Event-driven and exact: F is linear in X between breaks, the next break is found in
-        closed form, and each avalanche is resolved at its X (arguments as
-        :meth:`EQModel.quasistatic`).
-        """
-        kinetic_from = check_quasistatic(X_max, n_points, realisations, kinetic_from)
-        rng = np.random.default_rng(seed)
-        X = np.linspace(0.0, X_max, n_points)
-        F = np.empty((realisations, n_points))
-        stretch, avalanches = [], []
-        for r in range(realisations):
-            contacts = self.contacts(rng)
-            at, after = [0.0], [0.0]  # F just after each avalanche, and where
-            while (event := contacts.next_break())[0] <= X_max:
-                X_next = event[0]
-                contacts.relax(*event)
-                at.append(X_next)
-                after.append(contacts.friction(X_next))
-            last = np.searchsorted(at, X, side="right") - 1
-            F[r] = np.asarray(after)[last] + (X - np.asarray(at)[last]) * contacts.stiffness
-            stretch.append(contacts.forces_at(X_max) / self.model.k)
-            avalanches.extend(contacts.avalanches)
-        density, edges = np.histogram(np.concatenate(stretch), bins=bins, density=True)
-        where, size, drop = (np.array([a[i] for a in avalanches]) for i in range(3))
-        mean_F = F.mean(axis=0)
-        return InteractingQuasistaticResult(
-            X=X, F=mean_F, F_std=F.std(axis=0), histogram_edges=edges, histogram=density,
-            kinetic_force=float(np.mean(mean_F[kinetic_from <= X])),
-            static_force=float(np.max(mean_F)), kinetic_from=float(kinetic_from),
-            realisations=realisations, breaks=int(np.sum(size)), parameters=self.parameters(),
-            avalanche_X=where, avalanche_size=size.astype(int), force_drop=drop,
-            largest_avalanche=float(np.max(size, initial=0) / self.model.n_contacts),
-            interface_stiffness=self.interface_stiffness)
+@dataclasses.dataclass
+class LatticeEQModel(_Interface):
+    """:class:`InteractingEQModel` on an ``n × n`` lattice between two identical bodies,
+    matrix-free (module docstring): the same contacts, draws and events, for N = n² far
+    beyond a dense M (16,384 contacts and more).
 
-    def spring_driven(self, K: float, v: float, mass: float, damping: float, t_end: float,
-                      dt: float, seed: int | None = 0, late_from: float | None = None,
-                      slip_speed: float = 10.0, prefix: str = "eq_",
-                      options: dict | None = None) -> SpringDrivenResult:
-        """The slider pulled through a spring K (arguments and result as
-        :meth:`EQModel.spring_driven`); an avalanche is resolved within the step whose end
-        puts a contact over its threshold."""
-        contacts = self.contacts(np.random.default_rng(seed))
-        return drive(contacts, self.parameters(), K=K, v=v, mass=mass, damping=damping,
-                     t_end=t_end, dt=dt, late_from=late_from, slip_speed=slip_speed,
-                     prefix=prefix, options=options)
+    Args:
+        model: the contacts; N must be a square n².
+        coupling: k/(E a), the interaction's strength (0: none, E = ∞).
+        nu: Poisson's ratio of the bodies.
+        spacing: the lattice spacing a (length).
+        contact_radius: the contacts' radius for the self term; None: a/2.
+        rtol: the relative residual of each conjugate-gradient solve.
+        max_rounds: the rounds an avalanche may take before the run stops with an error.
+    """
+
+    model: EQModel
+    coupling: float
+    nu: float = 0.3
+    spacing: float = 1.0
+    contact_radius: float | None = None
+    rtol: float = 1e-10
+    max_rounds: int = 10_000
+    compliance: LatticeCompliance | None = dataclasses.field(init=False, repr=False)
+    stiffness: LatticeStiffness | None = dataclasses.field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        n = math.isqrt(self.model.n_contacts)
+        check("n_contacts", self.model.n_contacts, n * n == self.model.n_contacts,
+              "must be a square n² for a lattice")
+        check_positive("coupling", self.coupling, strict=False)
+        check("max_rounds", self.max_rounds,
+              isinstance(self.max_rounds, int) and self.max_rounds >= 1, "must be an integer >= 1")
+        if self.coupling > 0:
+            E = self.model.k / (self.coupling * self.spacing)
+            self.compliance = LatticeCompliance(n, self.spacing, E, self.nu, self.contact_radius)
+            self.stiffness = LatticeStiffness(self.model.k, self.compliance, self.rtol)
+        else:
+            self.compliance = self.stiffness = None
+
+    @property
+    def interface_stiffness(self) -> float:
+        """S = 1ᵀ M 1: the friction force's slope dF/dX between breaks (≤ N k)."""
+        if self.stiffness is None:
+            return float(self.model.n_contacts * self.model.k)
+        return float(self.stiffness.rate.sum())
+
+    def parameters(self) -> dict[str, typing.Any]:
+        """The contacts' parameters, the coupling and the interface stiffness."""
+        return {**self.model.parameters(), "coupling": float(self.coupling),
+                "interface_stiffness": self.interface_stiffness, "matrix_free": True}
+
+    def contacts(self, rng: np.random.Generator) -> CoupledContacts:
+        """A fresh realisation, every contact relaxed at X = 0."""
+        stiffness: StiffnessOperator = self.stiffness if self.stiffness is not None else \
+            _Diagonal(self.model.k, self.model.n_contacts)  # no interaction: M = k
+        return CoupledContacts(self.model, stiffness, rng, self.max_rounds)
+
+
+class _Diagonal:
+    """M = k (no interaction), as a stiffness operator."""
+
+    def __init__(self, k: float, n: int) -> None:
+        self.k = k
+        self.rate: Array = np.full(n, k)
+
+    def update(self, over: npt.NDArray[np.intp], change: Array) -> tuple[Array, Array]:
+        delta = np.zeros(self.rate.size)
+        delta[over] = change
+        return delta, -change / self.k
