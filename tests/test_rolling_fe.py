@@ -172,3 +172,59 @@ def test_xdmf_holds_the_displacement_and_the_traction(shared_tmp_path):
     write_xdmf(path, model)
     text = path.read_text()
     assert 'Name="displacement"' in text and 'Name="contact_traction"' in text
+
+
+#: (ξ, η, φa) of the zero patterns: each creepage zero or 1e-6 (linear theory, 1/3000 of
+#: the saturation creepage μ p0/G)
+PATTERNS = [(x, y, z) for x in (0.0, 1e-6) for y in (0.0, 1e-6) for z in (0.0, 1e-6)]
+
+
+@pytest.fixture(scope="module")
+def coarse_circle():
+    """The circle on the coarsest mesh (h = a/2, a node at the spin's centre), solved at every
+    zero pattern from the unloaded state."""
+    scene = RollingContact(dim=3, nu=0.0, law=LAW, p0=0.01, cells_per_a=2, block_size=4.0,
+                           growth=1.5)
+    model = scene.build()
+    results = {}
+    for xi, eta, spin in PATTERNS:
+        model.u.x.array[:] = 0.0  # each solve from rest: the slip vanishes at the centre
+        results[xi, eta, spin] = model.solve((xi, eta, spin / scene.a))
+    return scene, model, results
+
+
+@pytest.mark.parametrize("pattern", PATTERNS, ids=lambda p: "xi{:g}-eta{:g}-phi{:g}".format(*p))
+def test_every_zero_pattern_of_the_creepages_solves_and_superposes(coarse_circle, pattern):
+    """Every combination of ξ, η, φ with any of them zero solves from rest (pure spin and zero
+    creepage failed: the smooth law's Jacobian was NaN where the slip vanishes), and in the
+    linear theory's range the forces are the sums of those of each creepage alone. The ε
+    sequence is relative to each solve's slip scale, so the stick stiffness μ p_n/ε differs
+    between the patterns; its stick slip ε |p_τ|/(μ p_n) is 1e-3 of the rigid slip or less
+    (|p_τ| ~ G φa against μ p0 = 3e-3 G, ε = 0.01 of the scale): superposition holds to
+    1e-3 of the largest force, and zero creepage gives zero force."""
+    _, _, results = coarse_circle
+    result = results[pattern]
+    alone = [results[tuple(c if i == k else 0.0 for i, c in enumerate(pattern))]
+             for k in range(3)]
+    scale = max(abs(r.Fy) + abs(r.Fx) for r in results.values())
+    for name in ("Fx", "Fy"):
+        assert getattr(result, name) == pytest.approx(
+            sum(getattr(r, name) for r in alone), abs=1e-3 * scale)
+    moment = max(abs(r.Mz) for r in results.values())
+    assert result.Mz == pytest.approx(sum(r.Mz for r in alone), abs=1e-3 * moment)
+    if not any(pattern):
+        assert max(abs(result.Fx), abs(result.Fy), abs(result.Mz)) < 1e-12 * scale
+    assert result.adhesion_fraction > 0.9
+
+
+def test_pure_spin_far_past_saturation_solves_with_the_full_slip_moment(coarse_circle):
+    """Pure spin at φ a = 10 μ p0/G from rest (the issue's failure at φ = 1, μ = 100): the
+    moment approaches the full-slip μ ∫ p_n r dA = (3π/16) μ Fn a from below (the nodal
+    rule's Fn and r on this mesh), the lateral force stays below it."""
+    scene, model, _ = coarse_circle
+    model.u.x.array[:] = 0.0
+    result = model.solve((0.0, 0.0, 10 * scene.creepage_scale / scene.a))
+    full_slip = 3 * np.pi / 16 * scene.law.mu * result.Fn * scene.a
+    assert -result.Mz < full_slip
+    assert -result.Mz > 0.5 * full_slip
+    assert abs(result.Fy) < 0.5 * scene.law.mu * result.Fn

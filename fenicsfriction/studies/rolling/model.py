@@ -331,7 +331,12 @@ class RollingModel:
             self._contact_pressure()
         xi, eta, phi = self.creepage[0], self.creepage[1], self.creepage[2]
         if kinematics == "rolling":
-            w = xi if dim == 2 else ufl.as_vector([xi - phi * self.x[1], eta + phi * self.x[0]])
+            self.midpoint_x = _cell_midpoint_x(self.msh)
+            # the rigid slip where the upwind difference is centred: the facet's midpoint in x
+            # (at the node, the spin's φx would lag the difference by h/2: a lateral creepage
+            # -φh/2, -1.3 h/a of the spin's Fy on the circle, docs/rolling-fe.md)
+            w = xi if dim == 2 else ufl.as_vector([xi - phi * self.x[1],
+                                                   eta + phi * self.midpoint_x])
             self.slip = rolling_slip(self.u, w, dim)
         else:
             self.slip = shift_slip(self.u, self.u_old, self.increment, dim)
@@ -417,9 +422,7 @@ class RollingModel:
         the rolling direction; the Galerkin (central) rule is blind to it, and at small
         creepage, where no slip zone is resolved, it returned an antisymmetric traction of
         nearly no net force (docs/rolling-fe.md)."""
-        midpoint = fem.Function(_compat.scalar_function_space(self.msh, "DG", 0))
-        midpoint.interpolate(lambda x: x[0])  # DG0: at the cell's midpoint
-        return ufl.conditional(ufl.gt(midpoint, self.x[0]), 2.0, 0.0)
+        return ufl.conditional(ufl.gt(self.midpoint_x, self.x[0]), 2.0, 0.0)
 
     # --- observables ------------------------------------------------------------------------
 
@@ -543,6 +546,13 @@ class RollingModel:
     def dofs(self) -> int:
         """Number of displacement unknowns."""
         return self.V.dofmap.index_map.size_global * self.V.dofmap.index_map_bs
+
+
+def _cell_midpoint_x(msh: typing.Any) -> fem.Function:
+    """x of each cell's midpoint (DG0); on a surface facet, the facet's midpoint in x."""
+    midpoint = fem.Function(_compat.scalar_function_space(msh, "DG", 0))
+    midpoint.interpolate(lambda x: x[0])  # DG0: at the cell's midpoint
+    return midpoint
 
 
 def _magnitude(w: typing.Any) -> typing.Any:
