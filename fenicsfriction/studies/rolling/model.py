@@ -436,7 +436,11 @@ class RollingModel:
         values = {"Fx": t[0] * ds, "Fn": self.weight * self.p_n * ds, "contact": in_contact * ds,
                   "stick": stick * ds}
         if self.dim == 3:
-            values.update(Fy=t[1] * ds, Mz=(self.x[0] * t[1] - self.x[1] * t[0]) * ds)
+            # rolling: a node's traction is that of the slip at its facet's midpoint in x,
+            # the moment's arm too (at the node, the arm is h/2 short: -0.55 h/a of the
+            # spin's Mz on the circle, docs/rolling-fe.md)
+            arm = self.midpoint_x if self.kinematics == "rolling" else self.x[0]
+            values.update(Fy=t[1] * ds, Mz=(arm * t[1] - self.x[1] * t[0]) * ds)
         return {k: _compat.form(f) for k, f in values.items()}
 
     def _scalar(self, name: str) -> float:
