@@ -9,7 +9,7 @@ LINTERS := ruff==0.17.6 mypy==2.4.1
 OUT ?= results
 APT_PACKAGES := python3-dolfinx python3-petsc4py python3-slepc4py python3-mpi4py python3-ufl \
     python3-basix python3-ffcx python3-numpy python3-scipy python3-matplotlib python3-pytest \
-    python3-pytest-mpi python3-pytest-timeout python3-venv python3-pip python3-setuptools \
+    python3-pytest-mpi python3-pytest-timeout python3-pytest-xdist python3-venv python3-pip python3-setuptools \
     python3-wheel python3-dev openmpi-bin build-essential pkg-config libopenblas0-serial \
     python3-gmsh python3-sphinx python3-myst-parser python3-sphinxcontrib.bibtex
 # the peer library of benchmarks/bench_getfem.py, installed by `make benchmark` only
@@ -21,7 +21,7 @@ export PYTHONDONTWRITEBYTECODE := 1
 
 .PHONY: setup demo lint docs test test-serial test-mpi test-debian13 benchmark clean
 
-$(VENV)/.installed: pyproject.toml
+$(VENV)/.installed: pyproject.toml Makefile
 	@missing=$$(for p in $(APT_PACKAGES); do dpkg-query -W -f='$${Status}' $$p 2>/dev/null \
 	    | grep -q "install ok installed" || echo $$p; done); \
 	if [ -n "$$missing" ]; then \
@@ -51,8 +51,10 @@ lint: setup
 	$(PY) -m ruff check .
 	$(PY) -m mypy
 
+# the serial pass on every core (pytest-xdist), one test file per worker so that a module's
+# fixtures are built once; the MPI pass cannot share its ranks' cores and runs as one job
 test-serial: setup
-	$(PY) -m pytest -q --durations=25 tests
+	$(PY) -m pytest -q --durations=25 -n $(NP) --dist loadfile tests
 
 test-mpi: setup
 	$(MPIRUN) $(PY) -m mpi4py -m pytest -q --durations=25 --with-mpi tests

@@ -9,7 +9,6 @@ alternatives, which docs/cli.md spells out as runnable examples) and a line pref
 own tests on 2 ranks); PETSc options after the flags pass through as documented.
 """
 
-import concurrent.futures
 import os
 import pathlib
 import re
@@ -73,28 +72,16 @@ def test_the_documentation_shows_commands_of_every_family():
     assert {"block", "oscillators", "contact", "rolling", "multicontact"} <= families, families
 
 
-@pytest.fixture(scope="module")
-def runs(tmp_path_factory) -> dict[str, tuple[subprocess.CompletedProcess, pathlib.Path]]:
-    """Every documented command run once, two at a time (each runs serially, and the suite's
-    serial pass leaves the second core idle): line -> (the finished process, its --out)."""
-    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_"))}
-
-    def run(line: str) -> tuple[subprocess.CompletedProcess, pathlib.Path]:
-        folder = tmp_path_factory.mktemp("command")
-        result = subprocess.run(_argv(line, folder / "out"), capture_output=True, text=True,
-                                timeout=600, env=env, cwd=folder)
-        return result, folder / "out"
-
-    lines = [line for _, line in COMMANDS]
-    with concurrent.futures.ThreadPoolExecutor(max_workers=2) as pool:
-        return dict(zip(lines, pool.map(run, lines), strict=True))
-
-
 @pytest.mark.skipif(MPI.COMM_WORLD.size > 1,
                     reason="starts its own interpreter; runs in the serial pass")
 @pytest.mark.parametrize(("page", "line"), COMMANDS,
                          ids=[f"{page}: {line[:90]}" for page, line in COMMANDS])
-def test_documented_command_runs(runs, page, line):
-    result, out = runs[line]
+def test_documented_command_runs(tmp_path, page, line):
+    """One documented line as a user types it, in a temporary folder. The suite's serial pass
+    runs test files on every core (pytest-xdist), so the commands run one after another here."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_"))}
+    out = tmp_path / "out"
+    result = subprocess.run(_argv(line, out), capture_output=True, text=True, timeout=600,
+                            env=env, cwd=tmp_path)
     assert result.returncode == 0, f"{page}: {line}\n{result.stderr[-2000:]}"
     assert any(out.iterdir()), f"{page}: {line} wrote nothing"

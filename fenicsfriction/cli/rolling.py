@@ -44,8 +44,8 @@ def _rolling_flags() -> argparse.ArgumentParser:
     fastsim = flags.add_argument_group("fastsim (Kalker's simplified theory)")
     fastsim.add_argument("--nx", type=int, help="elements per strip along x")
     fastsim.add_argument("--ny", type=int, help="strips across the contact")
-    fastsim.add_argument("--pressure", choices=["ellipsoidal", "parabolic"],
-                         help="the traction bound's pressure profile")
+    fastsim.add_argument("--pressure", choices=["parabolic", "ellipsoidal"],
+                         help="the traction bound's pressure profile (parabolic: Kalker's)")
     fe = flags.add_argument_group("fe (Kalker's complete theory by finite elements)")
     fe.add_argument("--dim", type=int, choices=[2, 3], default=3,
                     help="2: Carter's cylinders (plane strain); 3: the Hertzian ellipse (3)")

@@ -6,7 +6,7 @@ One module per question:
 * :mod:`~fenicsfriction.studies.rolling.hertz` — where do the bodies touch? The Hertz ellipse
   (:func:`hertz_from_curvatures`, :func:`hertz_from_radii`, :class:`HertzEllipse`);
 * :mod:`~fenicsfriction.studies.rolling.kalker` — how stiff is the contact against creep?
-  Kalker's coefficients C11, C22, C23 (:func:`creep_coefficients`);
+  Kalker's coefficients C11, C22, C23, C33 (:func:`creep_coefficients`);
 * :mod:`~fenicsfriction.studies.rolling.fastsim` — what are the tractions and forces? Kalker's
   simplified theory by FASTSIM (:func:`~fenicsfriction.studies.rolling.fastsim.fastsim`,
   :func:`creep_curve`) and the linear theory (:func:`linear_theory`).
@@ -30,7 +30,8 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "HertzEllipse": "hertz", "hertz_from_curvatures": "hertz",
     "hertz_from_radii": "hertz", "quasi_identical_modulus": "hertz",
     "KalkerCoefficients": "kalker", "creep_coefficients": "kalker",
-    "FastsimResult": "fastsim", "LinearForces": "fastsim", "creep_curve": "fastsim",
+    "FastsimResult": "fastsim", "Flexibilities": "fastsim", "LinearForces": "fastsim",
+    "creep_curve": "fastsim",
     "flexibilities": "fastsim", "linear_theory": "fastsim",
     "RollingContact": "model", "RollingModel": "model", "RollingResult": "model",
     "write_xdmf": "model"}, ("closed_forms", "fastsim", "geometry", "hertz", "kalker"))
@@ -39,6 +40,7 @@ if typing.TYPE_CHECKING:  # the same names, eagerly, for type checkers
     from fenicsfriction.studies.rolling import closed_forms, fastsim, geometry, hertz, kalker
     from fenicsfriction.studies.rolling.fastsim import (
         FastsimResult,
+        Flexibilities,
         LinearForces,
         creep_curve,
         flexibilities,

@@ -15,16 +15,26 @@ a brush of independent springs of flexibility :math:`L`. In steady rolling the s
 zero at the leading edge as :math:`\partial p/\partial x = w/L`. Kalker (1982, "A fast
 algorithm for the simplified theory of rolling contact", Vehicle System Dynamics 11, 1-13)
 gives each creepage its own flexibility, chosen so that the simplified theory reproduces the
-linear theory's :math:`C_{11}, C_{22}, C_{23}` exactly:
+linear theory's coefficients exactly; here four, one per linear coefficient
+(:class:`Flexibilities`):
 
 .. math::
 
     L_1 = \frac{8a}{3 C_{11} G}, \qquad L_2 = \frac{8a}{3 C_{22} G}, \qquad
-    L_3 = \frac{\pi a \sqrt{a/b}}{4 C_{23} G}
+    L_3 = \frac{\pi a \sqrt{a/b}}{4 C_{23} G}, \qquad L_4 = \frac{8b}{15 C_{33} G}.
 
-(as computed in subroutine ``simpflex`` of CONTACT, Vollebregt & Kalker, Vtech CMCC,
-Apache-2.0; the coefficients are :mod:`~fenicsfriction.studies.rolling.kalker`'s). The spin
-terms of both components use :math:`L_3`.
+:math:`L_1, L_2, L_3` are Kalker's (1982; computed the same way in subroutine ``simpflex`` of
+CONTACT, Vollebregt & Kalker, Vtech CMCC, Apache-2.0). Kalker uses :math:`L_3` for both
+components of the spin slip, :math:`(-\phi y,\ \phi x)`; fitted to :math:`C_{23}` it makes the
+lateral force of spin right and the spin moment of spin wrong by the factor
+:math:`32 C_{23} (b/a)^{3/2} / (15 \pi C_{33})` (0.85 for a circle at :math:`\nu = 0.28`,
+0.93 at :math:`a/b = 1/2`). In full adhesion the lateral component :math:`\phi x` gives only
+:math:`F_y` (:math:`-\pi a^3 b \phi/(4 L_3)`) and the longitudinal one :math:`-\phi y` only
+:math:`M_z` (:math:`-8 a^2 b^3 \phi/(15 L_4)`), so the default gives the latter its own
+flexibility :math:`L_4`, fitted to :math:`C_{33}`: the simplified theory then reproduces all
+four of Kalker's coefficients.
+Kalker's original is ``flexibility=Flexibilities(L1, L2, L3, L3)``
+(:meth:`Flexibilities.kalker1982`).
 
 **FASTSIM** (Kalker 1982; Kalker 1986, eqs. 28-30): the contact is cut into ``ny`` strips
 along :math:`x`, each into ``nx`` equal elements; the traction is marched from the leading
@@ -37,16 +47,20 @@ opposite to the slip). Forces are midpoint sums over the elements. In full adhes
 traction is exact at the centres, so the force errors are the midpoint rule's,
 :math:`O(n^{-2})`.
 
-**Traction bound**: ``pressure="ellipsoidal"`` (the default) is the Hertz pressure
-:math:`p_0\sqrt{1-x^2/a^2-y^2/b^2}`, :math:`p_0 = 3F_n/(2\pi ab)`, the pressure the normal
-problem actually has (and the one the finite element model computes); Vollebregt's CONTACT
-user guide advises it over the parabolic one, which raises the tractions at the centre by a
-third. ``pressure="parabolic"`` is :math:`(2F_n/(\pi ab))(1-x^2/a^2-y^2/b^2)`, the bound of
-Kalker's classical FASTSIM (the normal pressure of the simplified theory itself), kept for
-comparison with the literature. Both carry :math:`F_n`, so that full sliding gives
-:math:`|F| = \mu F_n` up to the quadrature of the pressure.
+**Traction bound**: ``pressure="parabolic"`` (the default) is
+:math:`(2F_n/(\pi ab))(1-x^2/a^2-y^2/b^2)`, the bound of Kalker's FASTSIM (1982; the normal
+pressure of the simplified theory itself), and of the implementations users compare with.
+``pressure="ellipsoidal"`` is the Hertz pressure :math:`p_0\sqrt{1-x^2/a^2-y^2/b^2}`,
+:math:`p_0 = 3F_n/(2\pi ab)`, the pressure the normal problem actually has (and the one the
+finite element model computes), which Vollebregt's CONTACT user guide advises: the parabola
+raises the bound at the centre by a third and lowers it near the edges. On the wheel-rail case
+of ``docs/rolling-fastsim.md`` (:math:`\mu = 0.33`) at :math:`\xi = 1.2\cdot 10^{-3}` the
+parabolic bound gives :math:`|F_x| = 0.615\,\mu F_n`, the ellipsoidal :math:`0.660\,\mu F_n`.
+Both carry
+:math:`F_n`, so that full sliding gives :math:`|F| = \mu F_n` up to the quadrature of the
+pressure.
 
-With three flexibilities the directions of the trial increments are those of
+With several flexibilities the directions of the trial increments are those of
 :math:`(\xi/L_1, \eta/L_2)`, not :math:`(\xi, \eta)`: at full sliding under combined
 creepage the force points along the former.
 """
@@ -65,11 +79,11 @@ import numpy.typing as npt
 from fenicsfriction.laws import check, check_positive
 from fenicsfriction.studies.rolling.kalker import creep_coefficients
 
-__all__ = ["FastsimResult", "LinearForces", "PRESSURES", "creep_curve", "fastsim",
-           "flexibilities", "linear_theory"]
+__all__ = ["Flexibilities", "FastsimResult", "LinearForces", "PRESSURES", "creep_curve",
+           "fastsim", "flexibilities", "linear_theory"]
 
-#: the traction bounds :func:`fastsim` offers
-PRESSURES = ("ellipsoidal", "parabolic")
+#: the traction bounds :func:`fastsim` offers, the default first
+PRESSURES = ("parabolic", "ellipsoidal")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -117,15 +131,29 @@ class FastsimResult:
 
 
 class LinearForces(typing.NamedTuple):
-    """Kalker's linear theory: forces on body 1 [force] and spin moment [force·length].
-
-    ``Mz`` is None when the spin creepage is not zero: it needs C33, which is not tabulated
-    (see :mod:`~fenicsfriction.studies.rolling.kalker`).
-    """
+    """Kalker's linear theory: forces on body 1 [force] and spin moment [force·length]."""
 
     Fx: float
     Fy: float
-    Mz: float | None
+    Mz: float
+
+
+class Flexibilities(typing.NamedTuple):
+    r"""The simplified theory's flexibilities [length/(force/length²)], one per component of the
+    rigid slip: in adhesion the traction grows from the leading edge as
+    :math:`\partial p/\partial x = w/L`. ``L1`` for the longitudinal creepage ξ, ``L2`` for
+    the lateral creepage η, ``L3`` for the spin's lateral slip φx (Kalker 1982: fitted to
+    C23), ``L4`` for the spin's longitudinal slip -φy (fitted to C33; Kalker 1982 uses L3).
+    """
+
+    L1: float
+    L2: float
+    L3: float
+    L4: float
+
+    def kalker1982(self) -> Flexibilities:
+        """Kalker's (1982) choice: L3 for both components of the spin slip."""
+        return self._replace(L4=self.L3)
 
 
 def _check_material(a: float, b: float, G: float, nu: float) -> None:
@@ -136,8 +164,9 @@ def _check_material(a: float, b: float, G: float, nu: float) -> None:
           "Poisson's ratio must be in [0, 0.5]")
 
 
-def flexibilities(a: float, b: float, G: float, nu: float) -> tuple[float, float, float]:
-    """Kalker's flexibilities (L1, L2, L3) [length/(force/length²)] of the simplified theory.
+def flexibilities(a: float, b: float, G: float, nu: float) -> Flexibilities:
+    """The flexibilities (L1, L2, L3, L4) [length/(force/length²)] that make the simplified
+    theory reproduce Kalker's C11, C22, C23, C33 (module docstring).
 
     Args:
         a: semi-axis along the rolling direction x [length], > 0.
@@ -147,15 +176,16 @@ def flexibilities(a: float, b: float, G: float, nu: float) -> tuple[float, float
     """
     _check_material(a, b, G, nu)
     c = creep_coefficients(a, b, nu)
-    return (8.0 * a / (3.0 * c.C11 * G), 8.0 * a / (3.0 * c.C22 * G),
-            math.pi * a * math.sqrt(a / b) / (4.0 * c.C23 * G))
+    return Flexibilities(L1=8.0 * a / (3.0 * c.C11 * G), L2=8.0 * a / (3.0 * c.C22 * G),
+                         L3=math.pi * a * math.sqrt(a / b) / (4.0 * c.C23 * G),
+                         L4=8.0 * b / (15.0 * c.C33 * G))
 
 
 def linear_theory(a: float, b: float, G: float, nu: float, xi: float = 0.0, eta: float = 0.0,
                   phi: float = 0.0) -> LinearForces:
     r"""Kalker's linear theory (see :mod:`~fenicsfriction.studies.rolling.kalker`):
-    :math:`F_x = -G ab C_{11}\xi`, :math:`F_y = -G ab (C_{22}\eta + \sqrt{ab} C_{23}\phi)`,
-    :math:`M_z = G (ab)^{3/2} C_{23}\eta` (without spin; None with spin).
+    :math:`F_x = -G c^2 C_{11}\xi`, :math:`F_y = -G c^2 (C_{22}\eta + c\, C_{23}\phi)`,
+    :math:`M_z = -G c^3 (-C_{23}\eta + c\, C_{33}\phi)`, :math:`c = \sqrt{ab}`.
 
     Args:
         a: semi-axis along the rolling direction x [length], > 0.
@@ -174,7 +204,7 @@ def linear_theory(a: float, b: float, G: float, nu: float, xi: float = 0.0, eta:
     c2 = a * b
     c = math.sqrt(c2)
     return LinearForces(Fx=-G * c2 * k.C11 * xi, Fy=-G * c2 * (k.C22 * eta + c * k.C23 * phi),
-                        Mz=G * c2 * c * k.C23 * eta if phi == 0.0 else None)
+                        Mz=-G * c2 * c * (-k.C23 * eta + c * k.C33 * phi))
 
 
 def _creepages(**values: npt.ArrayLike) -> list[np.ndarray]:
@@ -196,8 +226,8 @@ def _creepages(**values: npt.ArrayLike) -> list[np.ndarray]:
 
 def creep_curve(a: float, b: float, G: float, nu: float, mu: float, Fn: float,
                 xi: npt.ArrayLike = 0.0, eta: npt.ArrayLike = 0.0, phi: npt.ArrayLike = 0.0,
-                nx: int = 40, ny: int = 40, pressure: str = "ellipsoidal"
-                ) -> list[FastsimResult]:
+                nx: int = 40, ny: int = 40, pressure: str = "parabolic",
+                flexibility: Flexibilities | None = None) -> list[FastsimResult]:
     """FASTSIM at many creepages at once (one march, vectorised over the points and strips).
 
     ``xi``, ``eta`` and ``phi`` are numbers or 1-D arrays broadcast together; one result per
@@ -211,7 +241,12 @@ def creep_curve(a: float, b: float, G: float, nu: float, mu: float, Fn: float,
               and value >= 1, "must be an integer >= 1")
     check("pressure", pressure, pressure in PRESSURES, f"one of {PRESSURES}")
     xis, etas, phis = _creepages(xi=xi, eta=eta, phi=phi)
-    L1, L2, L3 = flexibilities(a, b, G, nu)
+    if flexibility is None:
+        flexibility = flexibilities(a, b, G, nu)
+    check("flexibility", flexibility, isinstance(flexibility, Flexibilities)
+          and all(math.isfinite(v) and v > 0 for v in flexibility),
+          "a Flexibilities of four positive numbers")
+    L1, L2, L3, L4 = flexibility
 
     t0 = time.perf_counter()
     dy = 2.0 * b / ny
@@ -225,7 +260,7 @@ def creep_curve(a: float, b: float, G: float, nu: float, mu: float, Fn: float,
         else 2.0 * Fn / (math.pi * a * b) * rho2
     bound = mu * pn
     # slip-free increments per unit length: constant along a strip in x; linear in x in y
-    rate_x = xis[:, None] / L1 - phis[:, None] * y_strip[None, :] / L3
+    rate_x = xis[:, None] / L1 - phis[:, None] * y_strip[None, :] / L4
     rate_y = etas[:, None] / L2
     spin_y = phis[:, None] / L3
     px = np.zeros((len(xis), ny, nx))
@@ -258,7 +293,8 @@ def creep_curve(a: float, b: float, G: float, nu: float, mu: float, Fn: float,
 
 def fastsim(a: float, b: float, G: float, nu: float, mu: float, Fn: float, xi: float = 0.0,
             eta: float = 0.0, phi: float = 0.0, nx: int = 40, ny: int = 40,
-            pressure: str = "ellipsoidal") -> FastsimResult:
+            pressure: str = "parabolic", flexibility: Flexibilities | None = None
+            ) -> FastsimResult:
     """Kalker's FASTSIM for steady rolling of a Hertzian contact (module docstring).
 
     Args:
@@ -273,11 +309,13 @@ def fastsim(a: float, b: float, G: float, nu: float, mu: float, Fn: float, xi: f
         phi: spin creepage [1/length].
         nx: elements per strip, >= 1.
         ny: strips, >= 1.
-        pressure: the traction bound's pressure, "ellipsoidal" (Hertz, default) or
-            "parabolic" (Kalker's classical FASTSIM).
+        pressure: the traction bound's pressure, "parabolic" (Kalker's FASTSIM, default) or
+            "ellipsoidal" (Hertz's).
+        flexibility: the simplified theory's flexibilities; default :func:`flexibilities`
+            (Kalker's 1982 choice: ``flexibilities(...).kalker1982()``).
     """
     for name, value in (("xi", xi), ("eta", eta), ("phi", phi)):
         check(name, value, isinstance(value, numbers.Real), "a creepage must be a number "
               "(creep_curve takes arrays)")
     return creep_curve(a, b, G, nu, mu, Fn, xi=xi, eta=eta, phi=phi, nx=nx, ny=ny,
-                       pressure=pressure)[0]
+                       pressure=pressure, flexibility=flexibility)[0]
