@@ -242,3 +242,19 @@ def test_pure_spin_far_past_saturation_solves_with_the_full_slip_moment(coarse_c
     assert -result.Mz < full_slip
     assert -result.Mz > 0.5 * full_slip
     assert abs(result.Fy) < 0.5 * scene.law.mu * result.Fn
+
+
+def test_the_epsilon_sequence_is_relative_to_the_rigid_slip_in_any_units():
+    """Each solve's ε sequence is relative to its rigid slip's size |ξ| + |η| + |φ| max(a, b),
+    capped at μ p0/G (zero creepage: the cap). In SI units (a = 6 mm, b = 9 mm) pure spin
+    φ = 1e-2 /m slips by φ b = 9e-5 at most: φ's own number, capped at μ p0/G = 1.6e-3, would
+    set ε 18 times too coarse (no force test sees it while the traction is far below the bound)."""
+    scene = RollingContact(dim=3, a=6e-3, b=9e-3, G=82e9, nu=0.0, Fn=50e3, cells_per_a=1,
+                           block_size=2.0, growth=1.5)
+    model = scene.build()
+    cap = scene.creepage_scale
+    assert cap == pytest.approx(0.3 * 3 * 50e3 / (2 * np.pi * 6e-3 * 9e-3) / 82e9)
+    for creepage, size in (((0.0, 0.0, 1e-2), 9e-5), ((1e-5, -2e-5, -1e-2), 1.2e-4),
+                           ((0.0, 0.0, 1.0), cap), ((0.0, 0.0, 0.0), cap)):
+        model.creepage.value = np.asarray(creepage)
+        assert model.slip_scale() == pytest.approx(size, rel=1e-12)
