@@ -145,3 +145,19 @@ def test_bad_parameters_raise_naming_the_parameter(name, value):
 def test_static_coefficient_below_the_kinetic_one_is_rejected():
     with pytest.raises(ValueError, match="mu_static=0.2 is invalid"):
         classic(mu_static=0.2)
+
+
+def test_steady_sliding_and_its_linearisation_at_parameters_other_than_one():
+    """x₀ = μ(v_b) N / k and m s² + (c + N μ'(v_b)) s + k = 0, written out by hand for the
+    Stribeck law at m, k, c, N, v_b all different (m = k = 1 would hide m and k swapped)."""
+    m, k, c, N, v_b = 2.5, 40.0, 0.7, 8.0, 0.6
+    oscillator = BeltOscillator(m=m, k=k, c=c, N=N, v_belt=v_b,
+                                law=laws.StribeckFriction(mu_s=0.5, mu_k=0.3, v_s=1.0))
+    mu, slope = 0.3 + 0.2 * np.exp(-v_b), -0.2 * np.exp(-v_b)
+    assert oscillator.steady_sliding() == pytest.approx(mu * N / k, rel=1e-14)
+    damping = c + N * slope
+    root = np.sqrt(complex(damping**2 - 4 * m * k))
+    expected = np.sort_complex(np.array([(-damping - root) / (2 * m),
+                                         (-damping + root) / (2 * m)]))
+    np.testing.assert_allclose(np.sort_complex(oscillator.linear_eigenvalues()), expected,
+                               rtol=1e-12)

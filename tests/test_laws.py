@@ -130,6 +130,18 @@ def test_uniform_penetration_solves_the_compliance_law():
     assert laws.normal_pressure(d, law.c_n, law.m_n) == pytest.approx(0.3, rel=1e-14)
 
 
+def test_normal_traction_is_compliance_plus_damping_with_their_own_exponents():
+    """Martins & Oden's eq. 1 at exponents other than 1 (where d**l = d would hide a dropped
+    exponent) and l_n defaulting to m_n: values written out by hand."""
+    d, rate = 2e-4, 3e-3
+    expected = 1e10 * d**2.5 + 4e7 * d**1.5 * rate
+    assert laws.normal_traction(d, 1e10, 2.5, rate, 4e7, 1.5) == pytest.approx(expected,
+                                                                               rel=1e-14)
+    assert laws.normal_traction(d, 1e10, 2.5, rate, 4e7) == pytest.approx(
+        1e10 * d**2.5 + 4e7 * d**2.5 * rate, rel=1e-14)
+    assert laws.friction_bound(d, 3e9, 2.25) == pytest.approx(3e9 * d**2.25, rel=1e-14)
+
+
 def test_piecewise_linear_friction_defaults_are_those_of_the_slider_paper_eq_59():
     """μ = 0.75 - 0.03|V_rel| for |V_rel| < 15, 0.3 above (the m.d.o.f. slider paper (2003),
     eq. 59)."""

@@ -19,7 +19,7 @@ from fenicsfriction.steady import SteadySolver, continuation
 from fenicsfriction.studies.squeal import geometry
 from fenicsfriction.studies.squeal.model import PinOnDiscModel
 from fenicsfriction.studies.squeal.study import stability_study, transient_growth
-from fenicsfriction.studies.squeal.two_mode import coalescence
+from fenicsfriction.studies.squeal.two_mode import TwoModeModel, coalescence
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 MUS = [0.0, 0.3, 0.45]  # μ_crit = 0.371 on the coarse mesh
@@ -50,6 +50,25 @@ def test_the_closed_form_coalescence_is_where_the_two_frequencies_merge():
     K = K0 + mu_c * B
     assert omega_c**2 == pytest.approx((K[0, 0] + K[1, 1]) / 2)
     assert np.linalg.eigvals(K)[0] == pytest.approx(omega_c**2, rel=1e-6)
+
+
+def test_the_two_mode_model_scales_stiffness_and_damping_from_its_mu1():
+    """TwoModeModel.build from matrices projected at μ₁ = 0.3 (not 1, where μ/μ₁ = μ would hide
+    a dropped μ₁): its eigenvalues at μ are those of λ² + λ (μ/μ₁) C₁ + K0 + μ (K₁ - K0)/μ₁,
+    by the companion matrix; the frequencies are √diag(K0)/2π [Hz]."""
+    K0 = np.diag([(2 * math.pi * 1000.0) ** 2, (2 * math.pi * 1100.0) ** 2])
+    K1 = K0 + np.array([[2e6, 9e6], [-7e6, 1e6]])
+    C1 = np.array([[30.0, 8.0], [-5.0, 12.0]])
+    model = TwoModeModel.build(K0, K1, C1, mu1=0.3, indices=[0, 1])
+    assert model.frequencies == pytest.approx([1000.0, 1100.0], rel=1e-12)
+    mu = 0.45
+    C, K = (mu / 0.3) * C1, K0 + (mu / 0.3) * (K1 - K0)
+    companion = np.block([[np.zeros((2, 2)), np.eye(2)], [-K, -C]])
+    expected = np.linalg.eigvals(companion)
+    expected = np.sort_complex(expected[expected.imag >= 0])
+    # two dense solvers (QZ on the pencil, eig on the unscaled companion with |K| ~ 5e7) agree
+    # to ~4e-10 here; a dropped μ₁ moves the growth rates by a factor 0.3
+    np.testing.assert_allclose(model.eigenvalues(mu), expected, rtol=1e-8)
 
 
 def test_flutter_starts_where_a_pin_mode_meets_a_disc_mode(studied):
