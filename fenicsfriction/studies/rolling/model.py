@@ -290,6 +290,8 @@ class RollingModel:
         msh, facet_tags, V, u: the mesh, its tags (``CONTACT`` is the contact zone), the
             displacement's space and the displacement.
         creepage: (ξ, η, φ) (``fem.Constant``); ``eps``, ``mu``: the law's constants.
+        midpoint_x: rolling: x of each cell's midpoint (DG0), where the rigid slip and the
+            spin moment's arm are read.
         increment, u_old: the shift's Δδ (``fem.Constant``) and the last increment's state.
         p_n: the normal pressure (UFL), ``slip`` and ``traction`` (UFL, dim - 1 components).
         residual, solver: the :class:`~fenicsfriction.forms.Residual` and its
@@ -415,7 +417,8 @@ class RollingModel:
         downstream (lower x) edge, none on its upstream edge.
 
         On the tensor-product grid a Q1 field's ∂u/∂x at a facet's vertex is the difference
-        along the facet's edge in x, so a node's slip is :math:`w - 2(u_{i+1} - u_i)/h`: the
+        along the facet's edge in x, so a node's slip is :math:`w(x_i + h/2) - 2(u_{i+1} -
+        u_i)/h` (the rigid slip at the facet's midpoint, where the difference is centred): the
         node's and its upstream neighbour's, Kalker's discretisation of the convective
         derivative from the leading edge (Kalker 1990, chapter 2). The leading edge's node
         carries no traction (the material enters unstrained), which selects the solution of
