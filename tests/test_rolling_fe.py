@@ -8,7 +8,11 @@ from mpi4py import MPI
 
 import numpy as np
 import pytest
+import ufl
+from dolfinx import fem
 
+from fenicsfriction import _compat
+from fenicsfriction.assembly import assemble_owned
 from fenicsfriction.laws import InterfaceLaw
 from fenicsfriction.studies.rolling import closed_forms
 from fenicsfriction.studies.rolling.kalker import creep_coefficients
@@ -215,6 +219,21 @@ def test_every_zero_pattern_of_the_creepages_solves_and_superposes(coarse_circle
     if not any(pattern):
         assert max(abs(result.Fx), abs(result.Fy), abs(result.Mz)) < 1e-12 * scale
     assert result.adhesion_fraction > 0.9
+
+
+def test_the_jacobian_is_finite_where_the_slip_vanishes(coarse_circle):
+    """At rest and zero creepage the slip vanishes at every node: the smooth law's tangent
+    there is the stick stiffness μ p_n/ε, finite. (Spelt √(s·s)², UFL's derivative was 0·∞,
+    NaN rows on which Newton's first linear solve failed: the issue's pure spin, whose centre
+    node had s = 0 while the rigid slip was read at the node.) The Jacobian's action on a
+    vector of ones is finite."""
+    _, model, _ = coarse_circle
+    model.u.x.array[:] = 0.0
+    model.creepage.value = np.zeros(3)
+    ones = fem.Function(model.V)
+    ones.x.array[:] = 1.0
+    action = _compat.form(ufl.action(model.residual.steady_jacobian(), ones))
+    assert np.all(np.isfinite(assemble_owned(action)))
 
 
 def test_small_spin_is_kalkers_linear_theory_up_to_the_coarse_mesh_error(coarse_circle):
