@@ -222,7 +222,14 @@ def abs_c1_second_derivative(w: Scalar, eps: Scalar) -> Scalar:
 
 def abs_smooth(w: typing.Any, eps: Scalar) -> Scalar:
     """Smooth regularisation :math:`\\psi_\\varepsilon(w) = \\sqrt{|w|^2 + \\varepsilon^2}`."""
-    return _sqrt(_norm(w) ** 2 + eps**2)
+    # |w|² as w·w, not sqrt(w·w)²: UFL differentiates the latter as 2|w| (w/|w|), which is
+    # 0·∞ = NaN where the slip vanishes (a node at rest, the spin's centre at the first Newton
+    # step), and Newton's linear solve fails on the NaN rows
+    if _is_ufl(w):
+        square = ufl.inner(w, w) if w.ufl_shape else w**2
+    else:
+        square = np.asarray(w, dtype=float) ** 2
+    return _sqrt(square + eps**2)
 
 
 def abs_smooth_derivative(w: typing.Any, eps: Scalar) -> typing.Any:

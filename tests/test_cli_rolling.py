@@ -98,3 +98,22 @@ def test_bad_flag_is_refused_by_the_parser_with_exit_2(shared_tmp_path, argv):
     with pytest.raises(SystemExit) as stop:
         main([*argv, "--out", str(shared_tmp_path / "bad")])
     assert stop.value.code == 2
+
+
+def test_fe_pure_spin_of_the_issue_solves_near_the_linear_theory(shared_tmp_path):
+    """The issue's pure spin (φ = 1e-2 /m, φa = 1/40 of the saturation creepage μ p0/G), which
+    stopped with a NaN Jacobian, on a coarse mesh: exit 0, full adhesion, and Fy, Mz of the
+    linear theory's signs and sizes, −G c³ C23 φ and −G c⁴ C33 φ with Kalker's circle
+    (C23 = 1.33, C33 = 1.21 at ν = 0). The spin mesh study (docs/rolling-fe.md) measures
+    C23 −3 % and C33 −10 % at h = a/4 on a block of 10a (growth 1.5); the block's growth 1.3
+    here moves them by under 1 %: 6 % and 15 %."""
+    out = shared_tmp_path / "spin"
+    a, G, phi = 6e-3, 82e9, 1e-2
+    assert main(["rolling", "fe", "--dim", "3", "--a", str(a), "--b", str(a), "--G", str(G),
+                 "--nu", "0", "--mu", "0.3", "--Fn", "50e3", "--phi", str(phi),
+                 "--cells-per-a", "4", "--block-size", "10", "--out", str(out)]) == 0
+    record = _json(out)
+    assert record["adhesion_fraction"] > 0.9
+    kalker = creep_coefficients(a, a, 0.0)
+    assert record["Fy"] == pytest.approx(-G * a**3 * kalker.C23 * phi, rel=0.06)
+    assert record["Mz"] == pytest.approx(-G * a**4 * kalker.C33 * phi, rel=0.15)

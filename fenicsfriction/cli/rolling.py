@@ -154,8 +154,11 @@ def _fe_records(model: typing.Any, p: dict, args: argparse.Namespace,
     records, solutions = [], []
     for k, value in enumerate(xi):
         solution = model.solve((value, args.eta, args.phi))
+        bound = p["mu"] * solution.Fn
+        lateral = "" if model.dim == 2 else (
+            f"  Fy/(μFn) = {solution.Fy / bound:+.5f}  Mz = {solution.Mz:.6g}")
         log.info(f"point {k + 1}/{len(xi)}: ξ = {value:.4g}  Fx/(μFn) = "
-                 f"{solution.Fx / (p['mu'] * solution.Fn):+.5f}  adhesion "
+                 f"{solution.Fx / bound:+.5f}{lateral}  adhesion "
                  f"{solution.adhesion_fraction:.3f}  Newton {solution.newton_iterations} over "
                  f"{len(solution.eps_records)} ε  {solution.wall_time_s:.1f} s")
         records.append(_record("fe", p, solution.Fx, solution.Fy, solution.Mz, solution.Fn,

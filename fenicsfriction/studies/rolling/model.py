@@ -290,6 +290,8 @@ class RollingModel:
         msh, facet_tags, V, u: the mesh, its tags (``CONTACT`` is the contact zone), the
             displacement's space and the displacement.
         creepage: (ξ, η, φ) (``fem.Constant``); ``eps``, ``mu``: the law's constants.
+        midpoint_x: rolling: x of each cell's midpoint (DG0), where the rigid slip and the
+            spin moment's arm are read.
         increment, u_old: the shift's Δδ (``fem.Constant``) and the last increment's state.
         p_n: the normal pressure (UFL), ``slip`` and ``traction`` (UFL, dim - 1 components).
         residual, solver: the :class:`~fenicsfriction.forms.Residual` and its
@@ -331,7 +333,12 @@ class RollingModel:
             self._contact_pressure()
         xi, eta, phi = self.creepage[0], self.creepage[1], self.creepage[2]
         if kinematics == "rolling":
-            w = xi if dim == 2 else ufl.as_vector([xi - phi * self.x[1], eta + phi * self.x[0]])
+            self.midpoint_x = _cell_midpoint_x(self.msh)
+            # the rigid slip where the upwind difference is centred: the facet's midpoint in x
+            # (at the node, the spin's φx would lag the difference by h/2: a lateral creepage
+            # -φh/2, -1.3 h/a of the spin's Fy on the circle, docs/rolling-fe.md)
+            w = xi if dim == 2 else ufl.as_vector([xi - phi * self.x[1],
+                                                   eta + phi * self.midpoint_x])
             self.slip = rolling_slip(self.u, w, dim)
         else:
             self.slip = shift_slip(self.u, self.u_old, self.increment, dim)
@@ -410,16 +417,15 @@ class RollingModel:
         downstream (lower x) edge, none on its upstream edge.
 
         On the tensor-product grid a Q1 field's ∂u/∂x at a facet's vertex is the difference
-        along the facet's edge in x, so a node's slip is :math:`w - 2(u_{i+1} - u_i)/h`: the
+        along the facet's edge in x, so a node's slip is :math:`w(x_i + h/2) - 2(u_{i+1} -
+        u_i)/h` (the rigid slip at the facet's midpoint, where the difference is centred): the
         node's and its upstream neighbour's, Kalker's discretisation of the convective
         derivative from the leading edge (Kalker 1990, chapter 2). The leading edge's node
         carries no traction (the material enters unstrained), which selects the solution of
         the rolling direction; the Galerkin (central) rule is blind to it, and at small
         creepage, where no slip zone is resolved, it returned an antisymmetric traction of
         nearly no net force (docs/rolling-fe.md)."""
-        midpoint = fem.Function(_compat.scalar_function_space(self.msh, "DG", 0))
-        midpoint.interpolate(lambda x: x[0])  # DG0: at the cell's midpoint
-        return ufl.conditional(ufl.gt(midpoint, self.x[0]), 2.0, 0.0)
+        return ufl.conditional(ufl.gt(self.midpoint_x, self.x[0]), 2.0, 0.0)
 
     # --- observables ------------------------------------------------------------------------
 
@@ -433,7 +439,11 @@ class RollingModel:
         values = {"Fx": t[0] * ds, "Fn": self.weight * self.p_n * ds, "contact": in_contact * ds,
                   "stick": stick * ds}
         if self.dim == 3:
-            values.update(Fy=t[1] * ds, Mz=(self.x[0] * t[1] - self.x[1] * t[0]) * ds)
+            # rolling: a node's traction is that of the slip at its facet's midpoint in x,
+            # the moment's arm too (at the node, the arm is h/2 short: -0.55 h/a of the
+            # spin's Mz on the circle, docs/rolling-fe.md)
+            arm = self.midpoint_x if self.kinematics == "rolling" else self.x[0]
+            values.update(Fy=t[1] * ds, Mz=(arm * t[1] - self.x[1] * t[0]) * ds)
         return {k: _compat.form(f) for k, f in values.items()}
 
     def _scalar(self, name: str) -> float:
@@ -543,6 +553,13 @@ class RollingModel:
     def dofs(self) -> int:
         """Number of displacement unknowns."""
         return self.V.dofmap.index_map.size_global * self.V.dofmap.index_map_bs
+
+
+def _cell_midpoint_x(msh: typing.Any) -> fem.Function:
+    """x of each cell's midpoint (DG0); on a surface facet, the facet's midpoint in x."""
+    midpoint = fem.Function(_compat.scalar_function_space(msh, "DG", 0))
+    midpoint.interpolate(lambda x: x[0])  # DG0: at the cell's midpoint
+    return midpoint
 
 
 def _magnitude(w: typing.Any) -> typing.Any:
