@@ -577,6 +577,7 @@ class _Diagonal:
         self.rate: Array = np.full(n, k)
 
     def update(self, over: npt.NDArray[np.intp], change: Array) -> tuple[Array, Array]:
-        delta = np.zeros(self.rate.size)
+        delta: Array = np.zeros(self.rate.size)
         delta[over] = change
-        return delta, -change / self.k
+        relaxed: Array = np.asarray(-change / self.k, dtype=float)
+        return delta, relaxed
