@@ -49,7 +49,7 @@ def test_coupling_map_has_no_stick_slip_without_interaction_and_some_with(shared
     assert main(["multicontact", "stability-map", "--N", "144", "--couplings", "0,0.1",
                  "--spreads", "0.3", "--lives", "6", "--out", str(out)]) == 0
     summary = _json(out)
-    assert summary["stick_slip"] == [[False, True]]
+    assert summary["sustained_stick_slip"] == [[False, True]]
     assert (out / "coupling_map.png").stat().st_size > 0
 
 
@@ -90,7 +90,7 @@ def test_stability_map_is_smooth_well_above_K_star_and_stick_slip_well_below(sha
     summary = _json(out)
     K_star = summary["K_star"][0]
     assert 25 < K_star < 1000  # 0.44 N k for σ = 0.3 x_c
-    assert summary["stick_slip"] == [[True, False]]
+    assert summary["onset_stick_slip"] == [[True, False]]
 
 
 def test_fk_front_runs_near_the_continuum_travelling_wave(shared_tmp_path):

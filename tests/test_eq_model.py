@@ -97,10 +97,10 @@ def test_stiff_drive_slides_smoothly_and_soft_drive_sticks_and_slips():
     # of a few breaks, far below a jump's drop: 5 % of the peak force is 7.5 single breaks
     single = k * 2.2 * x_c * stiff.K / (stiff.K + N * k)
     assert np.mean(stiff.events.breaks) < 2 and np.max(stiff.events.drop) < 7.5 * single
-    assert not stiff.onset_jump and not stiff.stick_slip and stiff.jump_fraction == 0.0
+    assert not stiff.onset_stick_slip and not stiff.sustained_stick_slip and stiff.jump_fraction == 0.0
     # jumping, the slider loses a fraction of F_s − F(X) where the drive's line K (D − X) meets
     # F(X) again: F_s − F_k ≈ 0.1 N k x_c at least (the master equation's)
-    assert soft.onset_drop > 0.1 and soft.onset_jump
+    assert soft.onset_drop > 0.1 and soft.onset_stick_slip
     assert np.max(soft.events.breaks) > N / 10  # a collective break
     # the drop is the slider's slip times K, and breaks make every event
     np.testing.assert_allclose(soft.events.drop, soft.K * soft.events.slip, rtol=1e-9)
@@ -147,14 +147,14 @@ def test_a_single_contact_sticks_and_slips_with_the_closed_form_jumps():
     np.testing.assert_allclose(np.diff(events.start), x_s / v, rtol=1e-3)  # one break per x_s
     # the late window holds three cycles, each advancing the slider by x_s
     assert run.jump_fraction == pytest.approx(slip / x_s, rel=2e-3)
-    assert run.largest_drop == pytest.approx(drop / run.mean_force, rel=2e-3)
+    assert run.largest_late_drop == pytest.approx(drop / run.mean_force, rel=2e-3)
     # infinitely slow and overdamped: each event drops K k x_s/(K + k), the static drop
     slow = model.spring_quasistatic(K=K, D_max=3.5 * x_s * (K + k) / K, late_from=0.0)
     # (thresholds spread by 1e-9 relative)
     np.testing.assert_allclose(slow.events.drop, K * k * x_s / (K + k), rtol=1e-7)
     assert slow.D.size == 5
     np.testing.assert_allclose(slow.D, x_s * (K + k) / K + x_s * np.arange(5), rtol=1e-7)
-    assert slow.onset_jump and slow.stick_slip
+    assert slow.onset_stick_slip and slow.sustained_stick_slip
 
 
 @pytest.mark.parametrize(("field", "value"), [("n_contacts", 0), ("k", -1.0), ("x_s_std", 0.0),
@@ -183,5 +183,5 @@ def test_the_map_classifies_by_the_jump_at_the_static_peak_which_K_star_predicts
     # (the late window starts past 3 x_c; the runs with inertia beside, coarse: not tested)
     smap = instability_map([K], [0.3], n_contacts=1000, steps_per_period=4)
     assert smap.K[0] < smap.K_star[0]
-    assert smap.onset_drop[0, 0] > 0.1 and smap.stick_slip[0, 0]
-    assert smap.late_drop[0, 0] < smap.drop_threshold
+    assert smap.onset_drop[0, 0] > 0.1 and smap.onset_stick_slip[0, 0]
+    assert smap.largest_late_drop[0, 0] < smap.drop_threshold
