@@ -66,16 +66,17 @@ def _audit_eq(out, s, N, sigma, X_max):
     assert abs(s["breaks"] - N * renewals) < 5 * np.sqrt(N * 0.25)
     # the master equation: K* = N k (max X p(X) − 1) and the static force max X − ∫_0^X ξ p
     # before any re-formed contact breaks (p the threshold density), the kinetic force
-    # N k (x_c² + σ²)/(2 x_c); the scheme at h = 0.01 = σ/10: O((h/σ)²) ~ 1e-2 on K*
+    # N k (x_c² + σ²)/(2 x_c); the scheme at h = 0.01 = σ/10 is O((h/σ)²): 2.2e-3 on K*,
+    # 1.7e-4 on the static force
     p = stats.norm(1.0, sigma).pdf
     K_star = N * (-optimize.minimize_scalar(lambda x: -x * p(x), bounds=(1, 1 + 2 * sigma),
                                              method="bounded").fun - 1)
-    assert s["K_star"] == pytest.approx(K_star, rel=2e-2)
+    assert s["K_star"] == pytest.approx(K_star, rel=5e-3)
     first = optimize.minimize_scalar(
         lambda x: -(x - integrate.quad(lambda u: u * p(u), 0, x)[0]), bounds=(0.8, 1.2),
         method="bounded")
     me = s["master_equation"]
-    assert me["static_force"] == pytest.approx(-N * first.fun, rel=1e-3)
+    assert me["static_force"] == pytest.approx(-N * first.fun, rel=5e-4)
     assert me["kinetic_force"] == pytest.approx(N * (1 + sigma**2) / 2, rel=1e-4)
     assert me["X_max"] == X_max and me["h"] == 0.01
     # the transient's end: close to the model's F at X_max (one realisation of N contacts

@@ -251,14 +251,15 @@ def test_a_single_contact_with_inertia_is_classified_by_its_events_as_an_ode_sol
     advance = float(X(t[-1])[0] - X(t[window][0])[0])
     jump_fraction = slips[starts >= late][late_drops > 0.3].sum() / advance
     assert run.events.drop.size == breaks.size == 3
-    # the package breaks at the end of the step that crosses x_s (overshoot <= v dt, 3.9e-4
-    # of x_s) and samples the minimum every T/50 ((ω dt)²/8 = 2e-3 of the swing): 3e-3
+    # the package breaks at the end of the step that crosses x_s (an overshoot <= v dt =
+    # 7.7e-4 x_s) and samples the minimum every T/50 (within (ω dt)²/8 = 2e-3 of the swing,
+    # a bound): 4e-4 measured, 1.5e-3 allowed; an event starts within the step after its break
     np.testing.assert_allclose(run.events.start, starts, atol=1.5 * period / 50)
-    np.testing.assert_allclose(run.events.drop, drops, rtol=3e-3)
-    assert run.peak_force == pytest.approx(spring.max(), rel=3e-3)
-    assert run.onset_drop == pytest.approx(onset, rel=3e-3)
-    assert run.mean_force == pytest.approx(mean_force, rel=3e-3)
-    assert run.largest_late_drop == pytest.approx(late_drops.max(), rel=5e-3)
-    assert run.jump_fraction == pytest.approx(jump_fraction, rel=5e-3)
+    np.testing.assert_allclose(run.events.drop, drops, rtol=1.5e-3)
+    assert run.peak_force == pytest.approx(spring.max(), rel=1.5e-3)
+    assert run.onset_drop == pytest.approx(onset, rel=1.5e-3)
+    assert run.mean_force == pytest.approx(mean_force, rel=1.5e-3)
+    assert run.largest_late_drop == pytest.approx(late_drops.max(), rel=1.5e-3)
+    assert run.jump_fraction == pytest.approx(jump_fraction, rel=1.5e-3)
     assert onset > 0.3 and run.onset_stick_slip
     assert run.sustained_stick_slip == bool(late_drops.max() > 0.3)
