@@ -188,10 +188,10 @@ def test_the_map_classifies_by_the_jump_at_the_static_peak_which_K_star_predicts
     assert smap.largest_late_drop[0, 0] < smap.drop_threshold
 
 
-def _single_contact_by_solve_ivp(k, x_s, K, m, eta, v, t_end):
-    """A single relaxed EQ contact with the slider's inertia, independently: SciPy's RK45 from
-    break to break (the break an event of the integrator, where x = X − a reaches x_s; the
-    contact re-forms relaxed, a = X). Returns the breaks' times and the dense solution."""
+def _single_contact_by_solve_ivp(k, x_s, x0, K, m, eta, v, t_end):
+    """A single EQ contact with the slider's inertia, independently: SciPy's RK45 from break
+    to break (the break an event of the integrator, where x = X − a reaches x_s; the contact
+    re-forms stretched by x0, a = X − x0). Returns the breaks' times and the dense X(t)."""
     a, t0, y0, pieces, breaks = 0.0, 0.0, [0.0, 0.0], [], []
     while t0 < t_end:
         def rhs(t, y, a=a):
@@ -207,7 +207,7 @@ def _single_contact_by_solve_ivp(k, x_s, K, m, eta, v, t_end):
             break
         t0, y0 = float(sol.t_events[0][0]), list(sol.y_events[0][0])
         breaks.append(t0)
-        a = y0[0]
+        a = y0[0] - x0
 
     def X(t):
         t = np.atleast_1d(t)
@@ -224,15 +224,15 @@ def test_a_single_contact_with_inertia_is_classified_by_its_events_as_an_ode_sol
     """The spring-driven run's classification (onset_drop, largest_late_drop, jump_fraction,
     the two stick-slip flags) against the same quantities computed, by their definitions, from
     an independent integration of the single contact's stick-slip (RK45 from break to break)."""
-    k, x_s, K, m, zeta, v = 2.5, 0.7, 4.0, 0.3, 0.2, 0.02
+    # re-formed contacts stretched by x0 = 0.4 (a narrow newborn distribution), so that the
+    # force keeps a floor and the drops are fractions of it below 1
+    k, x_s, x0, K, m, zeta, v = 2.5, 0.7, 0.4, 4.0, 0.3, 0.2, 0.02
     eta = 2 * zeta * np.sqrt(m * (K + k))
     period = 2 * np.pi * np.sqrt(m / (K + k))
     first = (x_s + eta * K * v / (K + k) ** 2) * (K + k) / (K * v)
-    late, t_end = first + 0.5 * x_s / v, first + 2.5 * x_s / v  # two whole cycles late
-    model = EQModel(n_contacts=1, k=k, x_s_mean=x_s, x_s_std=1e-9)
-    run = model.spring_driven(K=K, v=v, mass=m, damping=eta, t_end=t_end, dt=period / 50,
-                              late_from=late, drop_threshold=0.3)
-    breaks, X = _single_contact_by_solve_ivp(k, x_s, K, m, eta, v, t_end)
+    life = (x_s - x0) / v  # a re-formed contact breaks after a further slip x_s − x0
+    late, t_end = first + 0.5 * life, first + 2.5 * life  # two whole cycles late
+    breaks, X = _single_contact_by_solve_ivp(k, x_s, x0, K, m, eta, v, t_end)
     t = np.linspace(0.0, t_end, 400001)
     spring = K * (v * t - X(t))
     drops, slips, starts = [], [], []
@@ -249,11 +249,20 @@ def test_a_single_contact_with_inertia_is_classified_by_its_events_as_an_ode_sol
     onset = drops.max() / spring.max()
     late_drops = drops[starts >= late] / mean_force
     advance = float(X(t[-1])[0] - X(t[window][0])[0])
-    jump_fraction = slips[starts >= late][late_drops > 0.3].sum() / advance
+    # a threshold between the onset's drop (over the peak force) and the late ones (over the
+    # smaller mean force), so that the two flags differ: the first jump is not a jump by this
+    # threshold, the late ones are
+    threshold = 0.5 * (onset + late_drops.min())
+    assert onset < threshold < late_drops.min()
+    jump_fraction = slips[starts >= late][late_drops > threshold].sum() / advance
+    model = EQModel(n_contacts=1, k=k, x_s_mean=x_s, x_s_std=1e-9,
+                    newborn=stats.norm(loc=x0, scale=1e-12))
+    run = model.spring_driven(K=K, v=v, mass=m, damping=eta, t_end=t_end, dt=period / 50,
+                              late_from=late, drop_threshold=threshold)
     assert run.events.drop.size == breaks.size == 3
     # the package breaks at the end of the step that crosses x_s (an overshoot <= v dt =
     # 7.7e-4 x_s) and samples the minimum every T/50 (within (ω dt)²/8 = 2e-3 of the swing,
-    # a bound): 4e-4 measured, 1.5e-3 allowed; an event starts within the step after its break
+    # a bound): 9e-4 measured, 1.5e-3 allowed; an event starts within the step after its break
     np.testing.assert_allclose(run.events.start, starts, atol=1.5 * period / 50)
     np.testing.assert_allclose(run.events.drop, drops, rtol=1.5e-3)
     assert run.peak_force == pytest.approx(spring.max(), rel=1.5e-3)
@@ -261,5 +270,4 @@ def test_a_single_contact_with_inertia_is_classified_by_its_events_as_an_ode_sol
     assert run.mean_force == pytest.approx(mean_force, rel=1.5e-3)
     assert run.largest_late_drop == pytest.approx(late_drops.max(), rel=1.5e-3)
     assert run.jump_fraction == pytest.approx(jump_fraction, rel=1.5e-3)
-    assert onset > 0.3 and run.onset_stick_slip
-    assert run.sustained_stick_slip == bool(late_drops.max() > 0.3)
+    assert not run.onset_stick_slip and run.sustained_stick_slip
