@@ -186,6 +186,7 @@ def test_the_map_classifies_by_the_jump_at_the_static_peak_which_K_star_predicts
     assert smap.K[0] < smap.K_star[0]
     assert smap.onset_drop[0, 0] > 0.1 and smap.onset_stick_slip[0, 0]
     assert smap.largest_late_drop[0, 0] < smap.drop_threshold
+    assert not smap.sustained_stick_slip[0, 0]  # the onset jumps, the late window does not
 
 
 def _single_contact_by_solve_ivp(k, x_s, x0, K, m, eta, v, t_end):
