@@ -274,8 +274,9 @@ class SpringDrives:
             seed: seeds the random generator.
             late_from: start of the late-time window classified; None: t_end/2. The run
                 must reach the static peak: v t_end > F_s/K + x_c.
-            drop_threshold: the spring-force drop of one event, over the late mean force,
-                above which the event is a jump (:class:`SpringDrivenResult`).
+            drop_threshold: the spring-force drop of one event, over the late mean force
+                (the onset's over the peak force), above which the event is a jump
+                (:class:`SpringDrivenResult`).
             slip_speed: the speed, in units of v, of ``fast_slip`` (the former classification).
             prefix, options: the TS's options prefix and defaults
                 (see :class:`~fenicsfriction.timestepping.ReducedDynamics`).
@@ -284,7 +285,6 @@ class SpringDrives:
         return drive(contacts, self.parameters(), K=K, v=v, mass=mass, damping=damping,
                      t_end=t_end, dt=dt, late_from=late_from, drop_threshold=drop_threshold,
                      slip_speed=slip_speed, prefix=prefix, options=options)
-
 
     def spring_quasistatic(self, K: float, D_max: float, seed: int | None = 0,
                            late_from: float | None = None,
