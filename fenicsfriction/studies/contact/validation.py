@@ -201,7 +201,14 @@ class Hertz(_Bodies):
 
     def run(self, comm: MPI.Comm = MPI.COMM_WORLD, model: TwoBodyModel | None = None
             ) -> tuple[dict, TwoBodyModel]:
-        """Solve and compare; returns the summary (see ``docs/cli.md``) and the model."""
+        """Solve and compare; returns the summary (see ``docs/cli.md``) and the model.
+
+        The headline figures: ``half_width`` (2D) where the interpolated nodal gap changes
+        sign; ``contact_radius`` (3D) the radius √(4A/π) of the quarter model's contact area
+        A under the nodal rule (:meth:`TwoBodyModel.contact_area`), the sign change kept as
+        ``gap_crossing_radius``; ``peak_pressure`` the pressure on the axis recovered by
+        :func:`pressure_on_axis` from the nodes' transmitted pressures, the largest of them
+        kept as ``max_pressure``; each beside Hertz's and with its relative ``*_error``."""
         t0 = time.perf_counter()
         model = model or self.build(comm)
         assert self.load is not None
