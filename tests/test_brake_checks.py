@@ -24,6 +24,9 @@ from fenicsfriction.discs import (
 
 gmsh = pytest.importorskip("gmsh")
 
+#: gmsh's geometry alone, no MPI: every rank of the MPI pass would repeat it
+pytestmark = pytest.mark.sequential
+
 
 def test_the_free_discs_faces_are_grouped_by_what_they_are():
     disc = Disc(inner_radius=0.03, outer_radius=0.11, thickness=0.013)
