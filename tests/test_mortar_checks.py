@@ -51,3 +51,27 @@ def test_frequency_bound_scales_with_the_contacts_weight(degree):
     assert half_largest == pytest.approx(0.5 * full_largest, rel=1e-12)
     assert half_largest <= half_bound * (1 + 1e-12)
     assert half_bound / half_largest == pytest.approx(full_bound / full_largest, rel=1e-12)
+
+
+@pytest.mark.parametrize(("dim", "degree"), [(2, 2), (3, 1), (3, 2)])
+def test_mortar_integrals_reproduce_linear_fields_across_non_matching_meshes(dim, degree):
+    """Surfaces that coincide (3 against 4 elements across, no overlap): every field linear
+    in x is interpolated exactly by either side's shape functions, so Σ_k D_jk f_k =
+    Σ_l M_jl f_l = ∫ ψ_j f for f = each coordinate, and the mortar relative position
+    B X = (D X − M X)/A vanishes at every slave node, in the plane as well as across it. The
+    contact patch test sees only its normal component on a flat interface, where any
+    weighting of the master's nodes gives the same height."""
+    msh, _, facet_tags = stacked_blocks(MPI.COMM_SELF, dim, 3, 4)
+    V = _compat.vector_function_space(msh, degree)
+    u = fem.Function(V, name="u")
+    contact = SegmentToSegment(u, facet_tags, SLAVE, MASTER, InterfaceLaw(c_n=1.0, m_n=1.0))
+    contact.update()
+    pairing = contact.pairing
+    X = V.tabulate_dof_coordinates()[:, :dim]
+    slave = pairing.slave_nodes
+    DX, MX = pairing.D @ X, pairing.M @ X
+    assert np.abs(DX[slave] - MX[slave]).max() < 1e-14
+    relative = pairing.reference.x.array.reshape(-1, dim)[slave]
+    assert np.abs(relative).max() < 1e-13
+    # and the check is not empty: the slave nodes' weighted coordinates are not zero
+    assert np.abs(DX[slave, 0]).max() > 1e-3
