@@ -15,6 +15,8 @@ import pytest
 
 from fenicsfriction.reused_lu import ReusedFactorisation
 
+#: serial only: the MPI pass of the suite is near its time budget, and the renewal rule and
+#: the Krylov tolerance do not depend on the partition
 pytestmark = pytest.mark.sequential
 
 

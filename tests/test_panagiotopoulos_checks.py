@@ -14,6 +14,8 @@ import fenicsfriction as ff
 from fenicsfriction.panagiotopoulos import PanagiotopoulosSolver, ProcessError
 from fenicsfriction.studies.block import BlockOnSlab, LayeredBlockOnBelt
 
+#: serial only: the MPI pass of the suite is near its time budget (the process on two ranks
+#: is compared with one in tests/test_panagiotopoulos.py)
 pytestmark = pytest.mark.sequential
 
 
