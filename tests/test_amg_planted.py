@@ -76,12 +76,13 @@ def test_each_amg_linear_solve_reaches_the_documented_relative_tolerance():
     """fenicsfriction.amg ties the Krylov tolerance to Newton's: every linear solve of the AMG
     path to 1e-8 relative, on the unpreconditioned residual (GMRES with right
     preconditioning). Checked on the 2D block's Jacobian at μ = 0.3 (Q2, 1,683 unknowns)
-    with a fixed right-hand side: GMRES's residual at its stop is below 1e-8 ‖b‖, and the
-    true residual ‖b − J x‖, computed here with the assembled matrix, agrees with it to the
-    round-off of the recurrence (measured 2e-7 ‖b‖ to 4e-6 ‖b‖ under load: the compliance
-    makes J ill-conditioned). Newton's iteration counts and converged states do not show a
-    looser tolerance (its last iterations are linear instead of quadratic, and still reach
-    the same tolerance): this test does."""
+    with a fixed right-hand side: GMRES's residual at its stop is below 1e-8 ‖b‖. The true
+    residual ‖b − J x‖, computed here with the assembled matrix, is larger by the round-off
+    of GMRES's recurrence on a badly scaled J (‖J‖₁ = 5e8): measured 2.3e-7 ‖b‖ in four
+    runs and 3.8e-6 ‖b‖ in a first one; it is only required below 1e-4 ‖b‖.
+    Newton's iteration counts and converged states do not show a looser tolerance (its last
+    iterations are linear instead of quadratic, and still reach the same tolerance): this
+    test does."""
     import fenicsfriction as ff
 
     model = ff.BlockOnBelt(refine=2, dim=2, degree=2).build(MPI.COMM_WORLD, with_friction=True)
