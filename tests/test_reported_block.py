@@ -195,12 +195,19 @@ def test_dynamics_columns_are_recomputed_from_the_others(dynamics):
     # the rows: the time step, the counters
     np.testing.assert_allclose(np.diff(t), DT, rtol=1e-9)
     assert summary["steps"] == len(t) - 1
+    assert summary["sampled_every"] == 1 and summary["stage"] is None  # 21 rows: all kept
+    # running_statistics: every column's extremes and trapezoidal time mean over the run,
+    # the counters summed (every step is written here: --record-every 1)
     running = summary["running_statistics"]
-    assert running["records"] == len(t)
-    assert running["totals"]["newton_iterations"] == c["newton_iterations"].sum()
-    for key in ("normal_force", "kinetic_energy", "theta"):
-        field = running["fields"][key]
-        assert (field["min"], field["max"]) == (c[key].min(), c[key].max())
+    assert (running["records"], running["t_from"], running["t_to"]) == (len(t), t[0], t[-1])
+    assert running["totals"] == {key: c[key].sum() for key in ("newton_iterations",
+                                                               "rejected_steps")}
+    assert set(running["fields"]) == set(c) - {"time", "newton_iterations", "rejected_steps"}
+    for key, field in running["fields"].items():
+        assert (field["min"], field["max"], field["max_abs"]) == \
+            (c[key].min(), c[key].max(), np.abs(c[key]).max()), key
+        assert field["mean"] == pytest.approx(trapezoid(c[key], t) / (t[-1] - t[0]),
+                                              rel=1e-9, abs=1e-12 * field["max_abs"]), key
 
 
 # --- block steady ---------------------------------------------------------------------------
