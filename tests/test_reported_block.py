@@ -9,8 +9,10 @@ checked in two ways:
 * on the columns of a short ``block dynamics`` run (one run for the module), recomputed from
   the other columns of the same row and from the parameters echoed in ``summary.json``.
 
-``block steady`` gets the same treatment: one run for the module, its records and summary
-against statics and the mesh's closed-form counts. The ``statistics`` block of
+``block steady`` and ``block stability`` get the same treatment, one run each for the
+module. The steady records and summary are checked against statics and the mesh's
+closed-form counts. The stability loci at μ = 0 are checked against the rigid block's
+closed-form frequencies. The ``statistics`` block of
 ``block dynamics`` is checked in tests/test_cli.py. The audit table is in
 docs/verification.md, under "Reported figures".
 """
@@ -260,3 +262,48 @@ def test_steady_records_and_summary_are_what_they_say(steady):
     assert summary["ranks"] == COMM.size and summary["failure"] is None
     assert summary["eps_last_converged"] is None and summary["stage"] is None
     assert 0 < summary["jit_time_s"] < summary["wall_time_s"]
+
+
+# --- block stability --------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def stability(tmp_path_factory):
+    out = _shared_folder(tmp_path_factory, "stability") / "out"
+    assert main(["block", "stability", "--mu-max", "0.2", "--steps", "1", "--out", str(out)]) == 0
+    return json.loads((out / "stability.json").read_text())
+
+
+def test_stability_loci_at_mu_0_are_the_rigid_blocks_frequencies(stability):
+    """At μ = 0 the rigid block on its linearised compliance has three uncoupled modes (the
+    spring acts at mid-height, through the centre of mass): sliding on the driver spring,
+    ω² = K_x/M; bouncing, ω² = k_n/M, with k_n = m_n W/d₀ the slope of N = c_n d^{m_n} B0 L at
+    the penetration d₀ that carries W; rocking, ω² = k_n (L²/12) / (M (L² + H²)/12)."""
+    data = stability
+    p = data["parameters"]
+    law = p["law"]
+    M, W, L, H = p["mass"], p["weight"], p["L"], p["H"]
+    d0 = (W / (law["c_n"] * p["B0"] * L)) ** (1 / law["m_n"])
+    k_n = law["m_n"] * W / d0
+    expected = sorted([np.sqrt(p["K_x"] / M), np.sqrt(k_n / M),
+                       np.sqrt(k_n * L**2 / (M * (L**2 + H**2)))])
+    rigid = data["rigid"]["steps"][0]
+    assert rigid["mu"] == 0.0
+    assert sorted(im for _, im in rigid["eigenvalues"]) == pytest.approx(expected, rel=1e-9)
+    assert all(re == 0.0 for re, _ in rigid["eigenvalues"])
+    # the FE block's lowest mode is the same sliding on the spring: the block is stiff
+    # against K_x = 11.1 (E B0 ~ 4e7), 2e-7 softer (measured)
+    fe = data["fe"]["steps"]
+    assert min(m["im"] for m in fe[0]["modes"]) == pytest.approx(expected[0], rel=1e-5)
+    for step in fe + data["rigid"]["steps"]:
+        res = [m["re"] for m in step["modes"]] if "modes" in step else \
+            [re for re, _ in step["eigenvalues"]]
+        assert step["max_re"] == max(res)
+    for step in fe:
+        for m in step["modes"]:
+            assert abs(complex(m["re"], m["im"])) <= data["max_frequency"]
+            # stable below the flutter onset (0.37): nothing grows by the growth test
+            assert m["re"] <= data["growth_tol"] * abs(complex(m["re"], m["im"]))
+    assert data["mu_crit"] == {"fe": None, "rigid": None}
+    assert data["fe"]["unstable_intervals"] == {} and data["fe"]["onsets"] == []
+    assert (data["max_frequency"], data["growth_tol"], data["ranks"]) == (3e4, 1e-6, COMM.size)
+    assert [s["mu"] for s in fe] == [0.0, 0.2] and data["failure"] is None
