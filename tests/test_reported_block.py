@@ -20,6 +20,7 @@ docs/verification.md, under "Reported figures".
 import csv
 import dataclasses
 import json
+import logging
 import pathlib
 
 from mpi4py import MPI
@@ -29,6 +30,7 @@ import pytest
 from scipy.integrate import quad, trapezoid
 
 from fenicsfriction.cli import main
+from fenicsfriction.results import get_logger
 
 COMM = MPI.COMM_WORLD
 
@@ -132,12 +134,37 @@ def test_each_column_of_a_rigid_motion_is_its_closed_form():
 KICK, DT = -0.01, 1e-5
 
 
+class _Lines(logging.Handler):
+    """The progress lines a command logs (rank 0's)."""
+
+    def __init__(self) -> None:
+        super().__init__(logging.INFO)
+        self.lines: list[str] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.lines.append(record.getMessage())
+
+
 @pytest.fixture(scope="module")
 def dynamics(tmp_path_factory):
     out = _shared_folder(tmp_path_factory, "dynamics") / "out"
-    assert main(["block", "dynamics", "--mu", "0.6", "--t-end", "2e-4", "--dt", str(DT),
-                 "--b-n", "0.381e10", "--perturbation", str(KICK), "--stride", "100",
-                 "--out", str(out)]) == 0
+    logger = get_logger(COMM)
+    lines = _Lines()
+    logger.addHandler(lines)
+    try:
+        assert main(["block", "dynamics", "--mu", "0.6", "--t-end", "2e-4", "--dt", str(DT),
+                     "--b-n", "0.381e10", "--perturbation", str(KICK), "--stride", "100",
+                     "--out", str(out)]) == 0
+    finally:
+        logger.removeHandler(lines)
+    headline = [x for x in lines.lines if x.startswith("apparent friction coefficient")]
+    if COMM.rank == 0:
+        summary = json.loads((out / "summary.json").read_text())["statistics"]
+        # "apparent friction coefficient <4 decimals> (μ = <mu>), probe node sticks <%>"
+        assert headline == [f"apparent friction coefficient "
+                            f"{summary['apparent_coefficient']:.4f} (μ = 0.6), probe node "
+                            f"sticks {summary['probe_stick_fraction']:.1%} of the time (second "
+                            "half of the run)"]
     with (out / "timeseries.csv").open() as table:
         rows = list(csv.DictReader(table))
     columns = {key: np.array([float(r[key]) for r in rows]) for key in rows[0]}

@@ -11,6 +11,7 @@ audit table is in docs/verification.md, under "Reported figures".
 
 import csv
 import json
+import logging
 import pathlib
 import re
 import time
@@ -21,6 +22,7 @@ import numpy as np
 import pytest
 
 from fenicsfriction.cli import main
+from fenicsfriction.results import get_logger
 
 COMM = MPI.COMM_WORLD
 #: the mesh size at the contact of the Hertz and Cattaneo runs (a/5 at the default a = R/10)
@@ -29,14 +31,44 @@ H = 0.02
 E_STAR = 1.0 / (2 * (1 - 0.3**2))
 
 
+class _Lines(logging.Handler):
+    """The progress lines a command logs (rank 0's; the other ranks log warnings only)."""
+
+    def __init__(self) -> None:
+        super().__init__(logging.INFO)
+        self.lines: list[str] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.lines.append(record.getMessage())
+
+
 def _run(factory: pytest.TempPathFactory, name: str, argv: list[str]
          ) -> tuple[pathlib.Path, float]:
-    """Run ``contact NAME ARGV`` into a module-wide folder; (folder, elapsed seconds)."""
+    """Run ``contact NAME ARGV`` into a module-wide folder; (folder, elapsed seconds). The
+    lines it logs are kept in ``folder/lines.json``."""
     path = factory.mktemp(name) if COMM.rank == 0 else None
     out = pathlib.Path(COMM.bcast(path, root=0)) / "out"
+    logger = get_logger(COMM)  # the package's handlers first, then ours
+    lines = _Lines()
+    logger.addHandler(lines)
     start = time.perf_counter()
-    assert main(["contact", name, *argv, "--out", str(out)]) == 0
+    try:
+        assert main(["contact", name, *argv, "--out", str(out)]) == 0
+    finally:
+        logger.removeHandler(lines)
+    if COMM.rank == 0:
+        (out / "lines.json").write_text(json.dumps(lines.lines))
+    COMM.Barrier()
     return out, time.perf_counter() - start
+
+
+def _headline(out: pathlib.Path, start: str) -> list[float]:
+    """The numbers of the last logged line that starts with ``start`` (not those inside a
+    word, such as the 2 of L2)."""
+    lines = [x for x in json.loads((out / "lines.json").read_text()) if x.startswith(start)]
+    assert lines, start
+    number = r"(?<![\w.])[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?"
+    return [float(v) for v in re.findall(number, lines[-1])]
 
 
 def _summary(out: pathlib.Path) -> dict:
@@ -96,6 +128,8 @@ def test_hertz_dofs_approach_and_wall_time_are_what_they_say(hertz):
     # reported approach is the reported load to that
     assert model.normal_force() == pytest.approx(s["load"], rel=2e-5)
     assert s["solves"] >= 1 and s["newton_iterations"] >= s["solves"] and s["cutbacks"] == 0
+    if COMM.rank == 0:  # the first line: "hertz 2D: <dofs> dofs on <ranks> rank(s), ..."
+        assert _headline(out, "hertz 2D")[1:3] == [s["dofs"], COMM.size]
 
 
 # --- patch ------------------------------------------------------------------------------------
@@ -132,6 +166,12 @@ def test_patch_figures_are_the_uniform_pressure_and_its_deviations(patch):
     # compliance's 0.3 %, measured), one pass does not
     assert s["pressure_deviation"]["two_pass"] < 0.01 < s["pressure_deviation"]["one_pass"]
     assert 0 < sum(s["wall_time_s"].values()) < elapsed
+    # the headline of each pass: its deviation (4 digits) and Newton iterations
+    if COMM.rank == 0:
+        for name in ("one_pass", "two_pass"):
+            deviation, iterations = _headline(out, name.replace("_", " ") + ":")
+            assert deviation == pytest.approx(s["pressure_deviation"][name], rel=1e-3)
+            assert iterations == s["newton_iterations"][name]
 
 
 # --- cattaneo ---------------------------------------------------------------------------------
@@ -206,6 +246,17 @@ def test_cattaneo_figures_against_the_table_and_cattaneo_mindlin(cattaneo):
     assert np.sum(p * w) == pytest.approx(s["load"], rel=5e-3)
     assert np.sum(traction * w) == pytest.approx(q * mu * s["load"], rel=3e-2)
     np.testing.assert_allclose(t["gap"][pressed], -p[pressed] / 1e4, rtol=1e-6)
+    # the headline: each figure beside its reference and the relative error in percent
+    if COMM.rank == 0:
+        numbers = _headline(out, "half-width")
+        hw, hw_ref, hw_pct, st, st_ref, st_pct, err, newton, seconds = numbers
+        assert (hw, hw_ref) == pytest.approx((s["half_width"], a), rel=1e-4)
+        assert hw_pct == pytest.approx(100 * (s["half_width"] / a - 1), abs=0.006)
+        assert (st, st_ref) == pytest.approx((s["stick_half_width"], c), rel=1e-4)
+        assert st_pct == pytest.approx(100 * (s["stick_half_width"] / c - 1), abs=0.006)
+        assert err == pytest.approx(100 * s["traction_error_l2"], abs=6e-4)
+        assert newton == s["newton_iterations"]
+        assert seconds == pytest.approx(s["wall_time_s"], abs=0.06)
 
 
 # --- press-drag ---------------------------------------------------------------------------------
@@ -250,3 +301,10 @@ def test_press_drag_summary_is_recomputed_from_its_energy_table(press_drag):
     # the load P: the Hertz load of a = R/10
     assert p["load"] == pytest.approx(0.1**2 * np.pi * E_STAR / 4, rel=1e-12)
     assert s["dofs"] > 0 and s["contact_period"] > 0 and 0 < s["wall_time_s"] < elapsed
+    if COMM.rank == 0:
+        error, dissipated, penetration, steps, cutbacks, newton = _headline(
+            out, "energy balance error")
+        assert (error, dissipated, penetration) == pytest.approx(
+            (s["energy_balance_error"], s["dissipated"], s["max_penetration"]), rel=1e-3)
+        assert (steps, cutbacks, newton) == (s["steps"], s["rejected_steps"],
+                                             s["newton_iterations"])
