@@ -81,6 +81,8 @@ class Point:
     mu: float = MU
     t_end: float = 0.3
     dt: float = DT
+    #: the FE mesh's refinement (4·refine × 3·refine Q2 cells; the paper's is 1)
+    refine: int = 1
 
 
 def spring_period(K_x: float, mass: float = 0.45) -> float:
@@ -121,7 +123,7 @@ def events(t: np.ndarray, stick: np.ndarray, v_y: np.ndarray, elongation: np.nda
 
 def run_rigid(point: Point, stick_min: float) -> dict[str, typing.Any]:
     """The rigid block of Fig. 13's data at ``point``: its events (and a thinned trace)."""
-    scene = ff.BlockOnBelt(belt_speed=point.belt_speed, K_x=point.K_x,
+    scene = ff.BlockOnBelt(belt_speed=point.belt_speed, K_x=point.K_x, refine=point.refine,
                            law=ff.InterfaceLaw(mu=point.mu, b_n=point.b_n, eps=point.eps))
     block = RigidBlock.from_scene(scene)
     solver = ReducedDynamics(model=block, q0=block.steady_state(),
@@ -156,12 +158,13 @@ def run_rigid(point: Point, stick_min: float) -> dict[str, typing.Any]:
 
 
 def run_fe(point: Point, stick_min: float, comm: MPI.Comm) -> dict[str, typing.Any]:
-    """The FE block (4 × 3 Q2, Fig. 13's data) at ``point``: its events and a thinned trace."""
+    """The FE block (4·refine × 3·refine Q2, Fig. 13's data) at ``point``: its events and a
+    thinned trace."""
     from fenicsfriction.dynamics import DynamicsSolver
 
-    scene = ff.BlockOnBelt(belt_speed=point.belt_speed, K_x=point.K_x,
+    scene = ff.BlockOnBelt(belt_speed=point.belt_speed, K_x=point.K_x, refine=point.refine,
                            law=ff.InterfaceLaw(mu=point.mu, b_n=point.b_n, eps=point.eps))
-    tag = f"caseb_fe_{point.K_x:g}_{point.belt_speed:g}".replace(".", "p")
+    tag = f"caseb_fe_{point.K_x:g}_{point.belt_speed:g}_{point.refine}".replace(".", "p")
     model = scene.build(comm=comm)
     model.initial_guess()
     steady = ff.SteadySolver(model.residual, prefix=f"{tag}_steady_",
@@ -233,7 +236,8 @@ def row(r: dict[str, typing.Any]) -> str:
     """One line of the table of runs."""
     first = r.get("first_stick", [None])[0]
     e = np.array(r["elongation"]) / r["steady_elongation"]
-    return (f"| {r['model']} | {r['K_x']:g} | {r['belt_speed']:g} | {r['eps']:g} | "
+    model = r["model"] if r.get("refine", 1) == 1 else f"{r['model']} (mesh ×{r['refine']})"
+    return (f"| {model} | {r['K_x']:g} | {r['belt_speed']:g} | {r['eps']:g} | "
             f"{r['b_n']:g} | {r['mu']:g} | {r['dt']:g} | {r['reached']:.3g} | "
             f"{'yes' if r['sticks'] else 'no'} | {'-' if first is None else f'{first:.4f}'} | "
             f"{r['longest_stick'] * 1e3:.1f} | {r['stick_share']:.1%} | "
@@ -277,12 +281,16 @@ def main(argv: list[str] | None = None) -> None:
     flags.add_argument("--stick-min", type=float, default=0.01,
                        help="shortest whole-base stick that counts as case (b) [s] (0.01)")
     flags.add_argument("--jobs", type=int, default=2, help="rigid runs in parallel (2)")
+    flags.add_argument("--fe-refine", type=int, default=1,
+                       help="the FE points' mesh refinement: 4·r × 3·r Q2 cells (1, the paper's)")
     args = flags.parse_args(argv)
     for name in ("t_end", "stick_min", "dt"):
         if not getattr(args, name) > 0:
             flags.error(f"--{name.replace('_', '-')}={getattr(args, name)} must be > 0")
     if args.jobs < 1:
         flags.error(f"--jobs={args.jobs} must be >= 1")
+    if args.fe_refine < 1:
+        flags.error(f"--fe-refine={args.fe_refine} must be >= 1")
     lists = {}
     for name in ("rigid_points", "fe_points"):
         try:
@@ -311,7 +319,8 @@ def main(argv: list[str] | None = None) -> None:
     rigid_wall = time.perf_counter() - t0
     fe = []
     for p in lists["fe_points"]:
-        fe.append(run_fe(p, args.stick_min, MPI.COMM_WORLD))
+        fe.append(run_fe(dataclasses.replace(p, refine=args.fe_refine), args.stick_min,
+                         MPI.COMM_WORLD))
         print(row(fe[-1]), flush=True)
         keep(fe[-1], args.out)
     summary = {"stick_min": args.stick_min, "K_readings": K_READINGS,

@@ -13,12 +13,12 @@ run (``--degree2-3d ""`` leaves it out; ``--configs mortar:2`` runs it alone).
 For each run it records:
 
 * the error against Hertz (Hertz 1882; Johnson 1985, eqs. 4.22-4.23 and 4.43-4.45) of the
-  half-width (2D) or contact radius (3D): the scene's own measure, where the interpolated
-  nodal gap changes sign (node-to-segment: the gap of each slave node; mortar: the
-  mortar-weighted gap, an average over the node's support), and the half-width of the Hertz
-  ellipse fitted through the nodal pressures; the peak pressure, fitted and the largest nodal
-  one; the relative L2 error of the nodal pressures against p0 sqrt(1 - r²/a²), with the
-  nodal rule's weights;
+  half-width (2D) or contact radius (3D) where the interpolated nodal gap changes sign (2D: the
+  scene's ``half_width``; 3D: its ``gap_crossing_radius``; node-to-segment: the gap of each
+  slave node; mortar: the mortar-weighted gap, an average over the node's support), and the
+  half-width of the Hertz ellipse fitted through the nodal pressures; the peak pressure, fitted
+  and the largest nodal one; the relative L2 error of the nodal pressures against p0
+  sqrt(1 - r²/a²), with the nodal rule's weights;
 * the nodal pressure is the *transmitted* one: each slave node's contact force over its load
   weight (the integral of its shape function over the slave surface,
   :class:`~fenicsfriction.studies.contact.model.SurfaceValues`), for both formulations. For
@@ -145,13 +145,15 @@ def run_once(dim: int, a_over_h: int, formulation: str, degree: int, comm: MPI.C
     mx = lambda value: comm.allreduce(value, op=MPI.MAX)  # noqa: E731
     pairings = [c.pairing for c in model.contacts]
     values = model.surface_values()
-    width = "half_width" if dim == 2 else "contact_radius"
+    # the edge where the nodal gaps change sign (3D: not the scene's contact_radius, the
+    # radius of the nodal rule's contact area)
+    edge = "half_width_error" if dim == 2 else "gap_crossing_radius_error"
     ksp = solver.snes.getKSP()
     pc = ksp.getPC()
     row = {
         "dim": dim, "formulation": formulation, "degree": degree, "a_over_h": a_over_h,
         "h_contact": scene.h_contact, "a": a, "p0": p0, "c_n": float(scene.law.c_n),
-        "dofs": summary["dofs"], "edge_error": summary[f"{width}_error"],
+        "dofs": summary["dofs"], "edge_error": summary[edge],
         **accuracy(scene, values),
         "newton_iterations": summary["newton_iterations"], "solves": summary["solves"],
         "mesh_time_s": mx(t1 - t0), "model_time_s": mx(t2 - t1), "solve_time_s": solve_time,

@@ -22,6 +22,13 @@ event over the peak force), the late window's largest drop over its mean force, 
 advance carried by jumps, the mean breaks per late event; and the spring-driven runs' speed
 classification for the same N (3 x_c): which classification converges with N to K < K*.
 
+**The map's disagreeing cells against N**: the cells of the instability map (N = 300) whose
+onset classification disagreed with K* (σ = 0.3 x_c at K = N k, 2.3 K*; σ = 0.5 x_c at
+K = 0.32 and 1.0 N k, 2.4 and 7.5 K*), at N = 100 … 3000 (K/(N k) fixed, so K/K* is too),
+six seeds each, the map's slow drive (F_s/K + 6 x_c): the onset drop's mean, spread and
+largest over the seeds, the seeds classified stick-slip, where the largest event falls (its
+drive position against the static peak's), the exponent of the mean's fall with N.
+
 **Interacting contacts, cost against N**: the EQ model on an n × n lattice between two identical
 bodies (coupling k/(E a) = 0.1, σ = 0.3 x_c) moved quasistatically over four contact lives,
 n = 8 … 32, dense (the stiffness matrix, O(N³)) and matrix-free (FFT and conjugate gradients):
@@ -33,7 +40,8 @@ contacts) over its first breaks: the time per break and the iterations per solve
 at couplings 0, 0.1, 0.3, σ = 0.3 x_c, K = S/2 (S the interface's stiffness): onset and late
 drops against N.
 
-``--sections`` picks some of: convergence, noise, map, events, interacting, interacting-events;
+``--sections`` picks some of: convergence, noise, map, map-cells, events, interacting,
+interacting-events;
 ``--sizes`` the N of the events study, ``--sides`` the lattices compared dense against
 matrix-free (a busy machine may want fewer).
 
@@ -70,6 +78,9 @@ EVENT_FACTORS = [0.5, 0.8, 0.9, 1.1, 1.25, 2.0]  # K/K*
 EVENT_SPREADS = [0.1, 0.3]
 RUN_LENGTHS = [3.0, 12.0]  # x_c past the static peak
 COUPLINGS = [0.0, 0.1, 0.3]
+MAP_CELLS = [(0.3, 1.0), (0.5, 10**-0.5), (0.5, 1.0)]  # (σ/x_c, K/(N k)) that disagreed at 300
+CELL_SIZES = [100, 300, 1000, 3000]
+CELL_SEEDS = range(6)
 
 
 def _convergence(out: dict) -> None:
@@ -119,7 +130,7 @@ def _map(out: dict) -> InstabilityMap:
     result = instability_map([s * n for s in STIFFNESS], SPREADS, n_contacts=n)
     out["instability_map"] = {**result.to_json(), "wall_time_s": time.perf_counter() - start}
     below = result.K[None, :] < result.K_star[:, None]
-    agree = float(np.mean(below == result.stick_slip))
+    agree = float(np.mean(below == result.onset_stick_slip))
     agree_speed = float(np.mean(below == result.fast_slip))
     out["instability_map"]["agreement_with_K_star"] = agree
     out["instability_map"]["speed_agreement_with_K_star"] = agree_speed
@@ -129,7 +140,7 @@ def _map(out: dict) -> InstabilityMap:
     print("|---|---|" + "---|" * len(STIFFNESS))
     for i, spread in enumerate(SPREADS):
         cells = [("S" if ss else ".") + ("v" if fs else "") for ss, fs in
-                 zip(result.stick_slip[i], result.fast_slip[i], strict=True)]
+                 zip(result.onset_stick_slip[i], result.fast_slip[i], strict=True)]
         print(f"| {spread} | {result.K_star[i] / n:.3g} | " + " | ".join(cells) + " |")
     return result
 
@@ -154,12 +165,14 @@ def _events(out: dict) -> None:
                     run = model.spring_quasistatic(K=K, D_max=master.static_force / K + length)
                     rows.append({"relative_spread": spread, "N": n, "run_length": length,
                                  "K_over_K_star": factor, "K_star": K_star,
-                                 "onset_drop": run.onset_drop, "onset_jump": run.onset_jump,
-                                 "late_drop": run.largest_drop, "late_stick_slip": run.stick_slip,
+                                 "onset_drop": run.onset_drop,
+                                 "onset_stick_slip": run.onset_stick_slip,
+                                 "largest_late_drop": run.largest_late_drop,
+                                 "sustained_stick_slip": run.sustained_stick_slip,
                                  "jump_fraction": run.jump_fraction,
                                  "mean_breaks": run.mean_breaks, "events": int(run.D.size),
                                  "wall_time_s": time.perf_counter() - start})
-                    cells.append(f"{run.onset_drop:.3f} / {run.largest_drop:.3f}")
+                    cells.append(f"{run.onset_drop:.3f} / {run.largest_late_drop:.3f}")
                 print(f"| {spread} | {n} | {length:g} | " + " | ".join(cells) + " |")
     speed = []
     for spread in EVENT_SPREADS:
@@ -177,7 +190,9 @@ def _events(out: dict) -> None:
                                           dt=period / 20)
                 speed.append({"relative_spread": spread, "N": n, "K_over_K_star": factor,
                               "max_speed": run.max_speed, "fast_slip": run.fast_slip,
-                              "largest_dynamic_drop": run.largest_drop})
+                              "onset_stick_slip": run.onset_stick_slip,
+                              "dynamic_onset_drop": run.onset_drop,
+                              "dynamic_largest_late_drop": run.largest_late_drop})
     out["events_study"] = {"rows": rows, "speed": speed, "drop_threshold": 0.05}
     print("\nspring-driven runs with inertia (v = 1, ζ = 0.1, 3 x_c): max Ẋ/v")
     print("| σ/x_c | N | " + " | ".join(f"K/K* = {f}" for f in EVENT_FACTORS) + " |")
@@ -187,6 +202,56 @@ def _events(out: dict) -> None:
             cells = [f"{r['max_speed']:.1f}" for r in speed
                      if r["relative_spread"] == spread and r["N"] == n]
             print(f"| {spread} | {n} | " + " | ".join(cells) + " |")
+
+
+def _map_cells(out: dict) -> None:
+    rows, summary = [], []
+    print("\nthe map's disagreeing cells against N (slow drive, F_s/K + 6 x_c, six seeds): "
+          "onset drop over the peak force, mean ± std [largest], seeds above 5 %")
+    print("| σ/x_c | K/(N k) | K/K* | " + " | ".join(f"N = {n}" for n in CELL_SIZES)
+          + " | exponent |")
+    print("|---|---|---|" + "---|" * (len(CELL_SIZES) + 1))
+    for spread, stiffness in MAP_CELLS:
+        cells, means = [], []
+        for n in CELL_SIZES:
+            model = EQModel(n_contacts=n, x_s_std=spread)
+            master = MasterEquation(model, h=spread / 50).solve(2.0 + 10 * spread)
+            K = stiffness * n
+            K_star = critical_stiffness(model)
+            peak_at = float(master.X[np.argmax(master.F)]) + master.static_force / K
+            drops = []
+            for seed in CELL_SEEDS:
+                start = time.perf_counter()
+                run = model.spring_quasistatic(K=K, D_max=master.static_force / K + 6.0,
+                                               seed=seed)
+                i = int(np.argmax(run.events.drop))
+                drops.append(run.onset_drop)
+                rows.append({"relative_spread": spread, "K_over_N_k": stiffness, "N": n,
+                             "seed": seed, "K_over_K_star": K / K_star,
+                             "onset_drop": run.onset_drop,
+                             "onset_stick_slip": run.onset_stick_slip,
+                             "largest_late_drop": run.largest_late_drop,
+                             "largest_event_breaks": int(run.events.breaks[i]),
+                             "largest_event_at": float(run.events.start[i]),
+                             "static_peak_at": peak_at, "events": int(run.D.size),
+                             "wall_time_s": time.perf_counter() - start})
+            mean = float(np.mean(drops))
+            means.append(mean)
+            above = int(np.sum(np.asarray(drops) > 0.05))
+            summary.append({"relative_spread": spread, "K_over_N_k": stiffness, "N": n,
+                            "K_over_K_star": K / K_star, "mean_onset_drop": mean,
+                            "std_onset_drop": float(np.std(drops)),
+                            "largest_onset_drop": float(np.max(drops)),
+                            "seeds_above_threshold": above, "seeds": len(drops)})
+            cells.append(f"{mean:.3f} ± {np.std(drops):.3f} [{np.max(drops):.3f}], "
+                         f"{above}/{len(drops)}")
+        exponent = float(np.polyfit(np.log(CELL_SIZES), np.log(means), 1)[0])
+        for row in summary[-len(CELL_SIZES):]:
+            row["exponent"] = exponent
+        print(f"| {spread} | {stiffness:.3g} | {summary[-1]['K_over_K_star']:.2f} | "
+              + " | ".join(cells) + f" | {exponent:.2f} |")
+    out["map_cells"] = {"rows": rows, "summary": summary, "drop_threshold": 0.05,
+                        "drive_distance": 6.0}
 
 
 def _interacting(out: dict) -> None:
@@ -269,16 +334,18 @@ def _interacting_events(out: dict) -> None:
             start = time.perf_counter()
             run = interface.spring_quasistatic(K=K, D_max=n * n / K + 6.0 * n * n / S)
             rows.append({"N": n * n, "coupling": coupling, "K": K, "interface_stiffness": S,
-                         "onset_drop": run.onset_drop, "late_drop": run.largest_drop,
+                         "onset_drop": run.onset_drop,
+                         "largest_late_drop": run.largest_late_drop,
                          "jump_fraction": run.jump_fraction, "mean_breaks": run.mean_breaks,
                          "largest_event_breaks": int(np.max(run.events.breaks, initial=0)),
                          "wall_time_s": time.perf_counter() - start})
-            cells.append(f"{run.onset_drop:.3f} / {run.largest_drop:.3f}")
+            cells.append(f"{run.onset_drop:.3f} / {run.largest_late_drop:.3f}")
         print(f"| {n * n} | " + " | ".join(cells) + " |")
     out["interacting_events"] = rows
 
 
-SECTIONS = ("convergence", "noise", "map", "events", "interacting", "interacting-events")
+SECTIONS = ("convergence", "noise", "map", "map-cells", "events", "interacting",
+            "interacting-events")
 
 
 def main() -> None:
@@ -305,7 +372,8 @@ def main() -> None:
     args.out.mkdir(parents=True, exist_ok=True)
     out: dict = {"sections": chosen}
     result = None
-    steps = {"convergence": _convergence, "noise": _noise, "events": _events,
+    steps = {"convergence": _convergence, "noise": _noise, "map-cells": _map_cells,
+             "events": _events,
              "interacting": _interacting, "interacting-events": _interacting_events}
     for name in SECTIONS:
         if name not in chosen:
@@ -342,9 +410,10 @@ def _figure(out: dict, result: InstabilityMap | None, path) -> None:
     else:
         n = result.parameters["N"]
         K_grid, spread_grid = np.meshgrid(result.K / n, result.relative_spread)
-        ax2.scatter(K_grid[result.stick_slip], spread_grid[result.stick_slip], marker="x",
+        jumps = result.onset_stick_slip
+        ax2.scatter(K_grid[jumps], spread_grid[jumps], marker="x",
                     color="C3", label="jump at the peak (events)")
-        ax2.scatter(K_grid[~result.stick_slip], spread_grid[~result.stick_slip], marker="o",
+        ax2.scatter(K_grid[~jumps], spread_grid[~jumps], marker="o",
                     facecolors="none", edgecolors="C0", label="smooth (events)")
         ax2.scatter(K_grid[result.fast_slip], spread_grid[result.fast_slip], marker="+",
                     s=120, color="k", label="max Ẋ > 10 v")
@@ -356,7 +425,7 @@ def _figure(out: dict, result: InstabilityMap | None, path) -> None:
     if "events_study" in out:
         rows = out["events_study"]["rows"]
         for i, factor in enumerate(EVENT_FACTORS):
-            for key, ax, style in (("onset_drop", ax3, "-"), ("late_drop", ax4, "-")):
+            for key, ax, style in (("onset_drop", ax3, "-"), ("largest_late_drop", ax4, "-")):
                 picked = [r for r in rows if r["K_over_K_star"] == factor
                           and r["relative_spread"] == EVENT_SPREADS[0]
                           and r["run_length"] == RUN_LENGTHS[-1]]

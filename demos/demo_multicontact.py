@@ -134,7 +134,7 @@ smap = instability_map(K=[10.0, 40.0, 400.0, 1200.0], relative_spread=[0.1, 0.3]
                        n_contacts=300, seed=2)
 for i, s in enumerate(smap.relative_spread):
     say(f"σ/x_c = {s}: K* = {smap.K_star[i]:.1f}; stick-slip at K = "
-        f"{[float(K) for K, j in zip(smap.K, smap.stick_slip[i], strict=True) if j]}")
+        f"{[float(K) for K, j in zip(smap.K, smap.onset_stick_slip[i], strict=True) if j]}")
 
 # %% [markdown]
 # **Check.** Far from the boundary (a factor 3 on either side of K*) the runs fall on the side
@@ -146,7 +146,7 @@ for i in range(len(smap.relative_spread)):
     critical = smap.K_star[i]
     far = (stiffness < critical / 3) | (stiffness > 3 * critical)
     predicted = stiffness < critical
-    assert np.all(smap.stick_slip[i][far] == predicted[far]), (i, smap.stick_slip[i])
+    assert np.all(smap.onset_stick_slip[i][far] == predicted[far]), (i, smap.onset_stick_slip[i])
 
 # %% [markdown]
 # ## 3. The elastic interaction of contacts
@@ -203,7 +203,7 @@ spreads_i, couplings = [0.1, 0.2, 0.3, 0.5], [0.0, 0.003, 0.01, 0.03, 0.1, 0.3]
 cmap = coupling_map(couplings, spreads_i, n_side=16, lives=8.0)
 say("interacting contacts (16 × 16, rigid drive), stick-slip runs per coupling: "
     + ", ".join(f"{c:g}: {n}/{len(spreads_i)}"
-                for c, n in zip(couplings, cmap.stick_slip.sum(axis=0), strict=True))
+                for c, n in zip(couplings, cmap.sustained_stick_slip.sum(axis=0), strict=True))
     + "; largest avalanche " + ", ".join(f"{a:.0%}" for a in cmap.largest_avalanche.max(axis=0)))
 coupled = {c: InteractingEQModel.lattice(EQModel(n_contacts=256, x_s_std=0.3), c)
            for c in (0.0, 0.01, 0.3)}
@@ -220,7 +220,7 @@ if comm.rank == 0:
     a1.legend(fontsize=8)
     shown = np.where(cmap.coupling > 0, cmap.coupling, 1e-3)
     for i, s in enumerate(cmap.relative_spread):
-        a2.plot(shown, cmap.largest_drop[i], "o-", ms=4, label=f"σ/x_c = {s:g}")
+        a2.plot(shown, cmap.largest_late_drop[i], "o-", ms=4, label=f"σ/x_c = {s:g}")
     a2.axhline(cmap.drop_threshold, color="gray", ls=":", label="stick-slip above")
     a2.set(xscale="log", yscale="log", xlabel="k/(Ea) (no interaction at 1e-3)",
            ylabel="largest drop of F in one avalanche / F_k", title="stick-slip widens")
@@ -235,7 +235,7 @@ if comm.rank == 0:
 # spread sticks and slips.
 
 # %%
-per_coupling = cmap.stick_slip.sum(axis=0)
+per_coupling = cmap.sustained_stick_slip.sum(axis=0)
 assert per_coupling[0] == 0 and np.all(cmap.largest_avalanche[:, 0] == 1 / 256)
 assert np.all(np.diff(per_coupling) >= 0) and per_coupling[-1] == len(spreads_i), per_coupling
 

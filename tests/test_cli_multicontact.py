@@ -2,17 +2,28 @@
 against the closed forms of the EQ model and the travelling front, the figures, and a bad value
 as one line and exit status 2. Serial and under ``mpirun -n 2``."""
 
+import csv
 import json
 
 import numpy as np
 import pytest
 from cli_errors import assert_one_error_line
+from scipy import integrate, optimize, stats
 
 from fenicsfriction.cli import main
 
 
 def _json(path):
     return json.loads((path / "multicontact.json").read_text())
+
+
+def _csv(path):
+    """A CSV table as columns: floats, or bools where the column holds True/False."""
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    return {key: np.array([r[key] in ("True", "true") for r in rows])
+            if rows[0][key] in ("True", "False", "true", "false")
+            else np.array([float(r[key]) for r in rows]) for key in rows[0]}
 
 
 def test_eq_against_its_master_equation_and_the_kinetic_closed_form(shared_tmp_path):
@@ -29,6 +40,48 @@ def test_eq_against_its_master_equation_and_the_kinetic_closed_form(shared_tmp_p
     assert summary["static_force"] == pytest.approx(me["static_force"], rel=0.03)
     assert summary["K_star"] > 0 and len(summary["X"]) == len(summary["F"])
     assert (out / "eq.png").stat().st_size > 0
+    _audit_eq(out, summary, N=4000, sigma=0.1, X_max=6.0)
+
+
+def _audit_eq(out, s, N, sigma, X_max):
+    """Every key of ``eq``'s JSON and force.csv against its definition (k = x_c = 1)."""
+    X, F = np.array(s["X"]), np.array(s["F"])
+    assert s["command"] == "eq" and s["realisations"] == 1
+    assert s["parameters"]["N"] == N and s["parameters"]["x_s_std"] == sigma
+    assert s["parameters"]["newborn"] == {"name": "delta", "at": 0.0}
+    assert X[0] == 0.0 and X[-1] == X_max and s["kinetic_from"] == X_max / 2
+    assert s["kinetic_force"] == pytest.approx(np.mean(F[X_max / 2 <= X]), rel=1e-14)
+    assert s["static_force"] == F.max()
+    assert np.all(np.array(s["F_std"]) == 0.0)  # one realisation
+    table = _csv(out / "force.csv")
+    for key in ("X", "F", "F_std"):
+        np.testing.assert_array_equal(table[key], s[key])
+    # the stretchings' histogram is a density: it integrates to 1
+    edges, density = np.array(s["histogram_edges"]), np.array(s["histogram"])
+    assert float(np.sum(density * np.diff(edges))) == pytest.approx(1.0, rel=1e-12)
+    # breaks: N times the renewal function Σ_n P(n lives <= X_max) of the Gaussian lives
+    # (conditioned x_s > 0: 1e-23 at 10 σ), 5 standard deviations of N counts of variance
+    # <= 1/4 each (a contact's count is one of two neighbours here)
+    renewals = sum(stats.norm.cdf((X_max - n) / (sigma * np.sqrt(n))) for n in range(1, 20))
+    assert abs(s["breaks"] - N * renewals) < 5 * np.sqrt(N * 0.25)
+    # the master equation: K* = N k (max X p(X) − 1) and the static force max X − ∫_0^X ξ p
+    # before any re-formed contact breaks (p the threshold density), the kinetic force
+    # N k (x_c² + σ²)/(2 x_c); the scheme at h = 0.01 = σ/10 is O((h/σ)²): 2.2e-3 on K*,
+    # 1.7e-4 on the static force
+    p = stats.norm(1.0, sigma).pdf
+    K_star = N * (-optimize.minimize_scalar(lambda x: -x * p(x), bounds=(1, 1 + 2 * sigma),
+                                             method="bounded").fun - 1)
+    assert s["K_star"] == pytest.approx(K_star, rel=5e-3)
+    first = optimize.minimize_scalar(
+        lambda x: -(x - integrate.quad(lambda u: u * p(u), 0, x)[0]), bounds=(0.8, 1.2),
+        method="bounded")
+    me = s["master_equation"]
+    assert me["static_force"] == pytest.approx(-N * first.fun, rel=5e-4)
+    assert me["kinetic_force"] == pytest.approx(N * (1 + sigma**2) / 2, rel=1e-4)
+    assert me["X_max"] == X_max and me["h"] == 0.01
+    # the transient's end: close to the model's F at X_max (one realisation of N contacts
+    # differs from the mean field by ~N^(-1/2))
+    assert me["force_at_X_max"] == pytest.approx(F[-1], rel=5 / np.sqrt(N))
 
 
 def test_eq_with_interacting_contacts_writes_its_avalanches(shared_tmp_path):
@@ -42,6 +95,23 @@ def test_eq_with_interacting_contacts_writes_its_avalanches(shared_tmp_path):
     assert summary["X"][-1] == pytest.approx(5 * 144 / summary["interface_stiffness"])
     rows = (out / "avalanches.csv").read_text().splitlines()
     assert len(rows) > 144 and summary["largest_avalanche"] > 0.1  # avalanches, not single
+    # every key by its definition: S = 1ᵀ (1/k + G)⁻¹ 1 by a dense solve of the lattice's
+    # compliance; breaks, largest avalanche and avalanches.csv from the avalanche records; and
+    # F = S X − Σ of the drops before X (F is linear in X between avalanches)
+    from fenicsfriction.studies.multicontact import lattice_compliance
+    _, G = lattice_compliance(12, 1.0, 1.0 / 0.1, 0.3)
+    S = float(np.sum(np.linalg.solve(np.eye(144) + G, np.ones(144))))
+    assert summary["interface_stiffness"] == pytest.approx(S, rel=1e-10)
+    at, size, drop = (np.array(summary[k]) for k in ("avalanche_X", "avalanche_size",
+                                                     "force_drop"))
+    assert summary["breaks"] == size.sum() and summary["largest_avalanche"] == size.max() / 144
+    table = _csv(out / "avalanches.csv")
+    np.testing.assert_array_equal(table["X"], at)
+    np.testing.assert_array_equal(table["breaks"], size)
+    np.testing.assert_array_equal(table["force_drop"], drop)
+    X = np.array(summary["X"])
+    rebuilt = S * X - np.array([drop[at <= x].sum() for x in X])
+    np.testing.assert_allclose(summary["F"], rebuilt, atol=1e-9 * 144)
 
 
 def test_coupling_map_has_no_stick_slip_without_interaction_and_some_with(shared_tmp_path):
@@ -49,8 +119,40 @@ def test_coupling_map_has_no_stick_slip_without_interaction_and_some_with(shared
     assert main(["multicontact", "stability-map", "--N", "144", "--couplings", "0,0.1",
                  "--spreads", "0.3", "--lives", "6", "--out", str(out)]) == 0
     summary = _json(out)
-    assert summary["stick_slip"] == [[False, True]]
+    assert summary["sustained_stick_slip"] == [[False, True]]
     assert (out / "coupling_map.png").stat().st_size > 0
+    _audit_coupling_map(out, summary)
+
+
+def _audit_coupling_map(out, s):
+    """Every key of the coupling map against its definition: at coupling 0 by closed forms
+    (single breaks, S = N k), at 0.1 recomputed from a rerun's avalanche records."""
+    from fenicsfriction.studies.multicontact import EQModel, InteractingEQModel
+    n, threshold = 144, s["drop_threshold"]
+    assert threshold == 0.05 and s["lives"] == 6.0 and s["parameters"]["N"] == n
+    drop = np.array(s["largest_late_drop"])
+    np.testing.assert_array_equal(s["sustained_stick_slip"], drop > threshold)
+    assert s["interface_stiffness"][0] == 1.0 and s["mean_avalanche"][0][0] == 1.0
+    assert s["largest_avalanche"][0][0] == 1 / n
+    # no interaction: kinetic force (x_c² + σ²)/(2 x_c) per N k, within the noise of one
+    # interface of 144 contacts over 3 lives (5 %)
+    assert s["kinetic_force"][0][0] == pytest.approx((1 + 0.09) / 2, rel=0.05)
+    interface = InteractingEQModel.lattice(EQModel(n_contacts=n, x_s_std=0.3), 0.1)
+    assert s["interface_stiffness"][1] == pytest.approx(interface.interface_stiffness / n,
+                                                        rel=1e-12)
+    run = interface.quasistatic(6.0 / s["interface_stiffness"][1], seed=0)
+    late = run.avalanche_X >= run.kinetic_from
+    assert drop[0][1] == pytest.approx(run.force_drop[late].max() / run.kinetic_force,
+                                       rel=1e-12)
+    assert s["largest_avalanche"][0][1] == run.avalanche_size[late].max() / n
+    assert s["mean_avalanche"][0][1] == pytest.approx(run.avalanche_size[late].mean(),
+                                                      rel=1e-12)
+    assert s["kinetic_force"][0][1] == pytest.approx(run.kinetic_force / n, rel=1e-12)
+    table = _csv(out / "map.csv")
+    np.testing.assert_array_equal(table["coupling"], [0.0, 0.1])
+    np.testing.assert_array_equal(table["sustained_stick_slip"], [False, True])
+    np.testing.assert_array_equal(table["largest_late_drop"], drop[0])
+    np.testing.assert_array_equal(table["largest_avalanche"], s["largest_avalanche"][0])
 
 
 def test_master_equation_conserves_the_contacts(shared_tmp_path):
@@ -90,7 +192,60 @@ def test_stability_map_is_smooth_well_above_K_star_and_stick_slip_well_below(sha
     summary = _json(out)
     K_star = summary["K_star"][0]
     assert 25 < K_star < 1000  # 0.44 N k for σ = 0.3 x_c
-    assert summary["stick_slip"] == [[True, False]]
+    assert summary["onset_stick_slip"] == [[True, False]]
+    _audit_stability_map(out, summary)
+
+
+def _audit_stability_map(out, s):
+    """Every key of the stability map (N = 300, σ = 0.3 x_c, K = 25, 1000) against its
+    definition, recomputed from the events and records of the two drives rerun."""
+    from fenicsfriction.studies.multicontact import EQModel, MasterEquation
+    N, threshold, drive = 300, s["drop_threshold"], s["drive"]
+    model = EQModel(n_contacts=N, x_s_std=0.3)
+    master = MasterEquation(model, 0.3 / 50).solve(2 + 10 * 0.3)
+    # K* = −max F'(X) of the master equation's first breaks, by differences of its F
+    assert s["K_star"][0] == pytest.approx(-np.min(np.gradient(master.F, master.h)), rel=1e-3)
+    onset, late = np.array(s["onset_drop"])[0], np.array(s["largest_late_drop"])[0]
+    np.testing.assert_array_equal(s["onset_stick_slip"][0], onset > threshold)
+    np.testing.assert_array_equal(s["sustained_stick_slip"][0], late > threshold)
+    np.testing.assert_array_equal(s["fast_slip"][0], np.array(s["max_speed"][0]) > 10.0)
+    table = _csv(out / "map.csv")
+    for key in ("onset_stick_slip", "sustained_stick_slip", "onset_drop", "largest_late_drop",
+                "jump_fraction", "fast_slip", "max_speed"):
+        np.testing.assert_array_equal(table[key], s[key][0], err_msg=key)
+    np.testing.assert_array_equal(table["K"], s["K"])
+    for j, K in enumerate(s["K"]):
+        D_max = drive["v"] * (drive["drive_distance"] + master.static_force / K) / drive["v"]
+        slow = model.spring_quasistatic(K=K, D_max=D_max)
+        D, drops, slips = slow.events.start, slow.events.drop, slow.events.slip
+        # between events the spring force rises with slope K S/(K + S), S = N k, and the
+        # slider advances by K/(K + S) per unit of D; each event drops the force and slips
+        slope, follow = K * N / (K + N), K / (K + N)
+        after = np.concatenate([[0.0], np.cumsum(slope * np.diff(D, prepend=0.0) - drops)])
+        before = after[:-1] + slope * np.diff(D, prepend=0.0)
+        assert onset[j] == pytest.approx(drops.max() / before.max(), rel=1e-9)
+        d = np.linspace(D_max / 2, D_max, 200001)  # the late window: the second half
+        i = np.searchsorted(D, d, side="right")
+        force = after[i] + slope * (d - np.concatenate([[0.0], D])[i])
+        mean_force = float(np.mean(force))  # the trapezoid-like mean of the sawtooth: 1e-5
+        in_late = D_max / 2 <= D
+        assert late[j] == pytest.approx(np.max(drops[in_late], initial=0) / mean_force,
+                                        rel=1e-4)
+        advance = slips[in_late].sum() + follow * D_max / 2
+        jumps = slips[in_late][drops[in_late] / mean_force > threshold].sum()
+        assert s["jump_fraction"][0][j] == pytest.approx(jumps / advance, rel=1e-4, abs=1e-12)
+        # the run with inertia, from its records
+        m, v = drive["mass"], drive["v"]
+        period = 2 * np.pi * np.sqrt(m / (N + K))
+        run = model.spring_driven(K=K, v=v, mass=m,
+                                  damping=2 * drive["damping_ratio"] * np.sqrt(m * (N + K)),
+                                  t_end=D_max / v, dt=period / drive["steps_per_period"])
+        window = run.t >= run.t[-1] / 2
+        assert s["max_speed"][0][j] == pytest.approx(run.X_dot.max() / v, rel=1e-12)
+        assert s["stuck_fraction"][0][j] == pytest.approx(np.mean(run.X_dot[window] < v / 10))
+        assert s["velocity_spread"][0][j] == pytest.approx(np.std(run.X_dot[window]) / v)
+        spring = run.spring_force[window]
+        assert s["force_spread"][0][j] == pytest.approx(np.std(spring) / np.mean(spring))
 
 
 def test_fk_front_runs_near_the_continuum_travelling_wave(shared_tmp_path):
@@ -117,6 +272,24 @@ def test_interaction_response_falls_like_r_minus_3_beyond_the_correlation_length
     # (docs/multicontact-interaction.md)
     assert summary["far_exponent"] == pytest.approx(-3.0, abs=0.35)
     assert (out / "interaction.png").stat().st_size > 0
+    # every key by its definition: least-squares lines in log-log of the stored profile on
+    # r < max(λ_c/4, 2) and r > 3 λ_c, and where they cross
+    r, dF, lam = np.array(summary["r"]), np.array(summary["dF"]), 4.0
+    assert summary["parameters"] == {"n": 192, "nu": 0.3, "lambda_c": lam, "spacing": 1.0,
+                                     "E": 1.0, "contact_radius": 0.5}
+    near, far = r < max(lam / 4, 2.0), r > 3 * lam
+    p_near, c_near = np.polyfit(np.log(r[near]), np.log(dF[near]), 1)
+    p_far, c_far = np.polyfit(np.log(r[far]), np.log(dF[far]), 1)
+    assert summary["near_exponent"] == pytest.approx(p_near, rel=1e-12)
+    assert summary["far_exponent"] == pytest.approx(p_far, rel=1e-12)
+    crossing = np.exp((c_far - c_near) / (p_near - p_far))
+    assert summary["crossover"] == pytest.approx(crossing, rel=1e-10)
+    assert summary["crossover_over_lambda_c"] == pytest.approx(crossing / lam, rel=1e-10)
+    table = _csv(out / "response.csv")
+    np.testing.assert_array_equal(table["r"], r)
+    np.testing.assert_array_equal(table["dF"], dF)
+    # the profile: geometric means of r in the bins of geomspace(1, n/4, 40), increasing
+    assert np.all(np.diff(r) > 0) and r[0] >= 1.0 and r[-1] < 192 / 4
 
 
 @pytest.mark.parametrize(("argv", "name"), [

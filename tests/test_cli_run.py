@@ -3,7 +3,9 @@ its value and what is allowed, exit status 2, before any mesh is built (timed, a
 builder replaced by one that fails the test if reached); a good one runs and writes its files.
 """
 
+import csv
 import json
+import math
 import pathlib
 import time
 
@@ -178,3 +180,15 @@ def test_a_good_case_runs_and_writes_its_files(shared_tmp_path):
     for name in ("steady.csv", "cea.csv", "steady.xdmf", "loci.png", "coupling_map.png",
                  "continuation.png"):
         assert (out / name).stat().st_size > 0, name
+    # cea.csv's columns are what their names say: f = Im λ / 2π, ζ = -Re λ / |λ| (the pair
+    # that couples by μ = 0.2 has Re λ = ±0.2 1/s, so the sign of ζ is checked)
+    with open(out / "cea.csv") as f:
+        rows = list(csv.DictReader(f))
+    damped = 0
+    for row in rows:
+        lam = complex(float(row["re"]), float(row["im"]))
+        assert float(row["frequency_hz"]) == pytest.approx(lam.imag / (2 * math.pi), rel=1e-14)
+        assert float(row["damping_ratio"]) == pytest.approx(-lam.real / abs(lam), rel=1e-14,
+                                                            abs=1e-300)
+        damped += abs(lam.real) > 1e-3 * abs(lam)
+    assert damped >= 2

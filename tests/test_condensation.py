@@ -178,6 +178,10 @@ def test_without_mumps_the_schur_complement_is_formed_by_solves():
     assert not PETSc.Options().hasName("condslu_condensed_pc_factor_mat_solver_type")
     assert mumps.condensation._mumps_schur and not solver.condensation._mumps_schur
     assert not solver.condensation.whole
+    # the condensation is the exact inverse: GMRES stops after one iteration at every Newton
+    # step (the last solve's), and one factorisation serves the whole continuation
+    assert solver.snes.getLinearSolveIterations() == solver.snes.getIterationNumber() > 0
+    assert solver.condensation.factorisations == 1
     assert ([r["newton_iterations"] for r in with_superlu]
             == [r["newton_iterations"] for r in with_mumps])
     for a, b in zip(with_mumps, with_superlu, strict=True):

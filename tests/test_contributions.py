@@ -78,6 +78,21 @@ def test_contributions_of_every_body_mode_sum_to_one(slab_at_0_2):
         assert abs(record.unexplained) < 1e-8
 
 
+def test_the_shares_do_not_depend_on_the_modes_phase(slab_at_0_2):
+    """An eigenvector is known up to a complex factor: w and e^{iθ} w (θ = 1 rad, which mixes
+    its real and imaginary parts) have the same shares, each |q|² the same to round-off
+    (1e-12 of the total asked)."""
+    import dataclasses
+    _, _, _, modes, fim = slab_at_0_2
+    for mode in modes:
+        turned = dataclasses.replace(mode, vector=np.exp(1j) * mode.vector)
+        a, b = (fim.contributions(m, min_share=0.0) for m in (mode, turned))
+        shares = {(c.body, c.mode): c.share for c in a.contributions}
+        assert len(b.contributions) == len(shares)
+        for c in b.contributions:
+            assert c.share == pytest.approx(shares[(c.body, c.mode)], abs=1e-12)
+
+
 def test_a_truncated_basis_leaves_the_rest_unexplained(slab_at_0_2):
     """With a few modes of each body the unexplained part is what the basis misses, between 0
     and 1, and listed shares + ``others`` + ``unexplained`` = 1. The pair near 880 Hz lives in

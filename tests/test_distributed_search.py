@@ -23,7 +23,7 @@ from fenicsfriction.contact.mortar import MortarIntegrals, SegmentToSegment
 from fenicsfriction.contact.pairing import CANDIDATES, Pairing, _candidates, _Facets, facet_nodes
 from fenicsfriction.laws import InterfaceLaw
 from fenicsfriction.studies.contact import geometry
-from fenicsfriction.studies.contact.validation import Hertz
+from fenicsfriction.studies.contact.validation import Hertz, pressure_on_axis
 
 #: a coarse quarter sphere on a block (about 3,300 unknowns): seconds to solve
 H_CONTACT = 0.08
@@ -153,10 +153,12 @@ def test_contact_partition_gives_every_rank_slave_nodes():
 def test_hertz_pressures_agree_on_one_and_two_ranks():
     """The quarter sphere pressed to Hertz's a = R/10 on this communicator (the contact
     partition) and on each rank alone: the nodal pressures agree to 1e-8 of the peak (Newton
-    converges quadratically, its last step leaves round-off; the search is the same)."""
+    converges quadratically, its last step leaves round-off; the search is the same), and so
+    do the recovered contact area (summed over the ranks) and the pressure on the axis
+    (projected from the gathered nodal values)."""
     scene = Hertz(dim=3)
     delta = (scene.radius / 10) ** 2 / scene.radius
-    pressures = []
+    pressures, recovered = [], []
     for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
         model = scene.model(_hertz_mesh(comm), fix_load_face=False)
         model.solve_at(delta)
@@ -164,10 +166,19 @@ def test_hertz_pressures_agree_on_one_and_two_ranks():
         # by coordinates rounded off (a partition's coordinates may differ by 1e-17)
         order = np.lexsort(np.round(values.x, 12).T[::-1])
         pressures.append((values.x[order], values.pressure[order]))
+        area = model.contact_area()
+        r = np.linalg.norm(values.x[:, :2], axis=1)
+        # the whole zone: this coarse mesh has few nodes near the axis
+        recovered.append((area, pressure_on_axis(r, values.pressure, values.load_weight,
+                                                 np.sqrt(4 * area / np.pi), disc=1.0)))
     (x1, p1), (x2, p2) = pressures
     assert np.allclose(x1, x2, rtol=0, atol=1e-12)  # the same nodes
     assert p1.max() > 0
     assert np.abs(p1 - p2).max() <= 1e-8 * p1.max()
+    (area1, axis1), (area2, axis2) = recovered
+    assert area1 > 0
+    assert area1 == pytest.approx(area2, rel=1e-12)  # the same nodes in contact
+    assert axis1 == pytest.approx(axis2, rel=1e-8)
 
 
 def _mortar_contacts(u: fem.Function, mesh: geometry.TwoBodyMesh) -> list[SegmentToSegment]:

@@ -113,13 +113,13 @@ def test_interaction_softens_the_interface_and_its_breaks_cascade():
 def test_stick_slip_widens_with_the_coupling():
     cmap = coupling_map([0.0, 0.1], [0.1, 0.5], n_side=12, lives=6.0)
     # no interaction, rigid drive: single breaks, each dropping F by k x_s ≈ 2 x_s/(N x_c) of it
-    assert not np.any(cmap.stick_slip[:, 0])
+    assert not np.any(cmap.sustained_stick_slip[:, 0])
     assert np.all(cmap.largest_avalanche[:, 0] == pytest.approx(1 / 144))
     # (a threshold beyond x_c + 4σ has odds 3e-5 in each of the ~500 late draws)
     single = (1 + 4 * cmap.relative_spread) / (144 * cmap.kinetic_force[:, 0])
-    assert np.all(cmap.largest_drop[:, 0] < single)
+    assert np.all(cmap.largest_late_drop[:, 0] < single)
     # interaction: avalanches of a tenth of the contacts or more, whatever the spread
-    assert np.all(cmap.stick_slip[:, 1])
+    assert np.all(cmap.sustained_stick_slip[:, 1])
     assert np.all(cmap.largest_avalanche[:, 1] > 0.1)
     assert cmap.interface_stiffness[0] == pytest.approx(1.0)
 

@@ -282,8 +282,11 @@ def _run_hertz(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) ->
         return _failed(out, "hertz", scene, err, comm)
     results.write_summary(out / "contact.json", summary, comm)
     fitted = summary[f"fitted_{width}"], summary["fitted_max_pressure"]
+    peak = summary["peak_pressure"]
     log.info(f"{width.replace('_', ' ')} {_percent(summary[width], a)}; peak pressure "
-             f"{_percent(summary['max_pressure'], p0)}; Hertz's ellipse fitted to the nodal "
+             + ("none" if peak is None else _percent(peak, p0))
+             + f" (on the axis), largest nodal {_percent(summary['max_pressure'], p0)}; "
+             "Hertz's ellipse fitted to the nodal "
              "pressures: " + (f"{_percent(fitted[0], a)}, {_percent(fitted[1], p0)}"
                               if fitted[0] is not None else "none")
              + f"; {summary['newton_iterations']} Newton iterations in {summary['solves']} "

@@ -252,17 +252,27 @@ def _run_stability_map(args: argparse.Namespace, log: logging.Logger, comm: MPI.
                            x_s_mean=args.x_s_mean, seed=args.seed)
     results.write_summary(out / "multicontact.json", {"command": "stability-map",
                                                    **smap.to_json()}, comm)
+    columns = ("onset_stick_slip", "sustained_stick_slip", "onset_drop", "largest_late_drop",
+               "jump_fraction", "fast_slip", "max_speed")
     write_rows(out / "map.csv", ({"relative_spread": s, "K": K, "K_star": smap.K_star[i],
-                            "stick_slip": bool(smap.stick_slip[i, j]),
-                            "max_speed": smap.max_speed[i, j]}
-                           for i, s in enumerate(smap.relative_spread)
-                           for j, K in enumerate(smap.K)), comm)
+                                  **{c: _cell(getattr(smap, c)[i, j]) for c in columns}}
+                                 for i, s in enumerate(smap.relative_spread)
+                                 for j, K in enumerate(smap.K)), comm)
     if comm.rank == 0:
         figures.stability_map_figure(smap, out / "stability_map.png")
-    agree = np.mean(smap.stick_slip == (smap.K[None, :] < smap.K_star[:, None]))
-    log.info(f"{agree:.0%} of the runs on the side of K* the master equation predicts; "
-             f"results in {out}/: multicontact.json, map.csv, stability_map.png")
+    agree = np.mean(smap.onset_stick_slip == (smap.K[None, :] < smap.K_star[:, None]))
+    log.info(f"{agree:.0%} of the runs jump at the static peak on the side of K* the master "
+             f"equation predicts; sustained stick-slip in {int(smap.sustained_stick_slip.sum())}"
+             f" of {smap.sustained_stick_slip.size}; results in {out}/: multicontact.json, "
+             "map.csv, stability_map.png")
     return 0
+
+
+def _cell(value: typing.Any) -> bool | float:
+    """A map cell for the CSV: a classification as a bool, a measure as a float."""
+    import numpy as np
+
+    return bool(value) if np.asarray(value).dtype == np.bool_ else float(value)
 
 
 def _run_coupling_map(args: argparse.Namespace, log: logging.Logger, comm: MPI.Comm) -> int:
@@ -286,16 +296,18 @@ def _run_coupling_map(args: argparse.Namespace, log: logging.Logger, comm: MPI.C
     results.write_summary(out / "multicontact.json", {"command": "stability-map",
                                                    **cmap.to_json()}, comm)
     write_rows(out / "map.csv", ({"relative_spread": s, "coupling": c,
-                                  "stick_slip": bool(cmap.stick_slip[i, j]),
-                                  "largest_drop": cmap.largest_drop[i, j],
+                                  "sustained_stick_slip":
+                                      bool(cmap.sustained_stick_slip[i, j]),
+                                  "largest_late_drop": cmap.largest_late_drop[i, j],
                                   "largest_avalanche": cmap.largest_avalanche[i, j]}
                                  for i, s in enumerate(cmap.relative_spread)
                                  for j, c in enumerate(cmap.coupling)), comm)
     if comm.rank == 0:
         figures.coupling_map_figure(cmap, out / "coupling_map.png")
-    log.info(f"stick-slip in {int(np.sum(cmap.stick_slip))} of {cmap.stick_slip.size} runs; "
-             "per coupling: " + ", ".join(f"{c:g}: {int(n)}" for c, n in
-                                           zip(cmap.coupling, cmap.stick_slip.sum(axis=0),
+    log.info(f"sustained stick-slip in {int(np.sum(cmap.sustained_stick_slip))} of "
+             f"{cmap.sustained_stick_slip.size} runs; per coupling: "
+             + ", ".join(f"{c:g}: {int(n)}" for c, n in
+                         zip(cmap.coupling, cmap.sustained_stick_slip.sum(axis=0),
                                                strict=True))
              + f"; results in {out}/: multicontact.json, map.csv, coupling_map.png")
     return 0

@@ -45,7 +45,8 @@ def pressure_figure(scene: Hertz, summary: dict, values: SurfaceValues, r: np.nd
         [(r[near], values.pressure[near], "computed (slave nodes)")], path,
         "x" if dim == 2 else "r = √(x² + y²)",
         f"{summary['scene']} {dim}D: {width.replace('_', ' ')} {summary[width]:.4g} "
-        f"(Hertz {a:.4g}), peak {summary['max_pressure']:.4g} (Hertz {p0:.4g})",
+        f"(Hertz {a:.4g}), largest nodal pressure {summary['max_pressure']:.4g} "
+        f"(Hertz's peak {p0:.4g})",
         reference=(grid, closed_forms.hertz_pressure(grid, a, p0), "Hertz"),
         marks=(-a, a) if dim == 2 else (a,))
 

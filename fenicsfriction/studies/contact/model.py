@@ -377,6 +377,33 @@ class TwoBodyModel:
                              pressure=rows[:, d + 2], traction=rows[:, d + 3:2 * d + 3],
                              force=rows[:, 2 * d + 3:3 * d + 3], load_weight=rows[:, 3 * d + 3])
 
+    def contact_area(self) -> float:
+        r"""The contact zone's area as the contact's nodal rule integrates it (2D: length),
+        on the contact plane :math:`x_d = 0` (the master's surface, normal :math:`e_d`):
+
+        .. math:: A_h = \sum_k \bar A_k\,[p_k > 0], \qquad
+                  \bar A_k = \int_{\Gamma_s} N_k\, |n\cdot e_d|\, ds,
+
+        :math:`p_k` the law's pressure at the slave node k of the first pass (the nodes the
+        law acts at; one pass: those that carry load) and :math:`\bar A_k` the node's
+        tributary area projected on the plane. The zone's boundary then runs about midway
+        between the last nodes in contact and the first open ones, so its error is of either
+        sign and averages out along a 3D zone's rim (where the gap's sign change, which hugs
+        the last contact node, is biased inwards by about h/2). Summed over the ranks."""
+        contact = self.contacts[0]
+        contact.update()
+        pressure = self._surface_nodal()[:, 1]
+        inside = pressure > 0
+        return self.comm.allreduce(float(self._projected_weight[inside].sum()))
+
+    @functools.cached_property
+    def _projected_weight(self) -> np.ndarray:
+        """∫ N_k |n·e_d| over the slave surface of each owned node: its tributary area
+        (length) projected on the contact plane."""
+        q = ufl.TestFunction(self.contacts[0].nodal_space)
+        n = ufl.FacetNormal(self.geometry.mesh)
+        return assemble_owned(_compat.form(q * abs(n[self.dim - 1]) * self.ds(SLAVE)))
+
     @functools.cached_property
     def _load_weight(self) -> np.ndarray:
         """∫ N_k over the slave surface of each owned node (exact: P1 geometry)."""

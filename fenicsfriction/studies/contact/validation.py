@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import math
 import time
 import typing
 
@@ -36,7 +37,7 @@ from fenicsfriction.studies.contact.model import (
     check_discretisation,
 )
 
-__all__ = ["Cattaneo", "Hertz", "Patch", "surface_comparison"]
+__all__ = ["AXIS_DISC", "Cattaneo", "Hertz", "Patch", "pressure_on_axis", "surface_comparison"]
 
 #: the regularisation during Cattaneo's normal loading, relative to the contact half-width
 NORMAL_LOADING_EPS = 1e-2
@@ -45,7 +46,44 @@ NORMAL_LOADING_EPS = 1e-2
 #: repeated after failing within the solver's default 50
 PENALTY_MAX_IT = 400
 
+#: the disc r <= AXIS_DISC a_h over which :func:`pressure_on_axis` projects the nodal
+#: pressures (a_h the measured half-width or radius): the projection of Hertz's profile onto
+#: c0 + c1 r² over it overestimates p0 by 0.35 %, and it holds about 13 slave nodes of the
+#: default 3D mesh, whose node-to-node scatter it averages out
+AXIS_DISC = 0.6
+
 log = logging.getLogger(__name__)
+
+
+def pressure_on_axis(r: np.ndarray, pressure: np.ndarray, weight: np.ndarray,
+                     radius: float, disc: float = AXIS_DISC) -> float:
+    r"""The pressure on the axis r = 0 recovered from nodal pressures by a local L2 projection.
+
+    The nodal pressures :math:`p_k` at distances :math:`r_k` from the axis are projected, in
+    the nodal rule's inner product (weights :math:`w_k`), onto the even quadratics
+    :math:`c_0 + c_1 r^2` over the disc :math:`r \le` ``disc`` × ``radius``: :math:`c_0` minimises
+    :math:`\sum_{r_k \le \rho} w_k (c_0 + c_1 r_k^2 - p_k)^2`, a patch recovery in the manner
+    of Zienkiewicz & Zhu (1992) on a patch fixed in physical size. It reproduces any such
+    quadratic exactly; the node-to-node scatter of the pressures is averaged over the disc's
+    nodes; Hertz's profile :math:`p_0\sqrt{1 - r^2/a^2}` is overestimated by its truncation,
+    +0.15 %, +0.35 %, +0.72 % for discs of 0.5, 0.6, 0.7 a. Returns :math:`c_0`.
+
+    Args:
+        r: the nodes' distances from the axis (2D: |x|).
+        pressure: their pressures.
+        weight: their weights in the nodal rule (tributary lengths or areas), > 0.
+        radius: the contact zone's measured half-width or radius.
+        disc: the disc's radius relative to ``radius``, in (0, 1].
+    """
+    check("disc", disc, 0 < disc <= 1, "a fraction of the contact radius in (0, 1]")
+    r, pressure, weight = (np.asarray(v, dtype=float) for v in (r, pressure, weight))
+    inside = (r <= disc * radius) & (weight > 0)
+    check("pressure", int(inside.sum()), bool(inside.any() and np.ptp(r[inside]) > 0),
+          f"nodes at two distances at least, with weight > 0, within r <= {disc} x radius")
+    basis = np.column_stack([np.ones(int(inside.sum())), r[inside] ** 2])
+    root = np.sqrt(weight[inside])
+    coefficients = np.linalg.lstsq(basis * root[:, None], pressure[inside] * root, rcond=None)[0]
+    return float(coefficients[0])
 
 
 @dataclasses.dataclass
@@ -163,7 +201,14 @@ class Hertz(_Bodies):
 
     def run(self, comm: MPI.Comm = MPI.COMM_WORLD, model: TwoBodyModel | None = None
             ) -> tuple[dict, TwoBodyModel]:
-        """Solve and compare; returns the summary (see ``docs/cli.md``) and the model."""
+        """Solve and compare; returns the summary (see ``docs/cli.md``) and the model.
+
+        The headline figures: ``half_width`` (2D) where the interpolated nodal gap changes
+        sign; ``contact_radius`` (3D) the radius √(4A/π) of the quarter model's contact area
+        A under the nodal rule (:meth:`TwoBodyModel.contact_area`), the sign change kept as
+        ``gap_crossing_radius``; ``peak_pressure`` the pressure on the axis recovered by
+        :func:`pressure_on_axis` from the nodes' transmitted pressures, the largest of them
+        kept as ``max_pressure``; each beside Hertz's and with its relative ``*_error``."""
         t0 = time.perf_counter()
         model = model or self.build(comm)
         assert self.load is not None
@@ -173,9 +218,13 @@ class Hertz(_Bodies):
         solved = model.solve_for_load(share * self.load, guess=a**2 / self.radius, rtol=1e-5)
         edge = model.contact_edge()
         values = model.surface_values()
-        measured = (np.ptp(edge[:, 0]) / 2 if self.dim == 2
+        # where the interpolated nodal gap changes sign: next to the last contact node
+        crossing = (np.ptp(edge[:, 0]) / 2 if self.dim == 2
                     else float(np.mean(np.linalg.norm(edge[:, :2], axis=1))))
         width = "half_width" if self.dim == 2 else "contact_radius"
+        # 2D: the sign change; 3D: the radius of the nodal rule's contact area on the quarter
+        # model (four quarters make the circle πa²)
+        measured = crossing if self.dim == 2 else math.sqrt(4 * model.contact_area() / math.pi)
         r = values.x[:, 0] if self.dim == 2 else np.linalg.norm(values.x[:, :2], axis=1)
         # the pressure each node transmits (its force over its load weight; nodes of zero
         # load weight, a 6-node triangle's vertices, carry none): node-to-segment's law
@@ -189,6 +238,11 @@ class Hertz(_Bodies):
         except ValueError:  # fewer than two contact nodes, or no falling profile
             fitted = (None, None)
         peak = float(transmitted.max(initial=0.0))
+        try:
+            on_axis: float | None = pressure_on_axis(np.abs(r[loaded]), transmitted,
+                                                     values.load_weight[loaded], measured)
+        except ValueError:  # fewer than two node distances within the disc
+            on_axis = None
         summary = {
             "scene": "hertz", "dim": self.dim, "load": solved["load"] / share,
             "parameters": {"radius": self.radius, "E1": self.E1, "nu1": self.nu1,
@@ -200,7 +254,11 @@ class Hertz(_Bodies):
             width: measured, f"hertz_{width}": a,
             "max_pressure": peak, "hertz_max_pressure": p0,
             f"{width}_error": measured / a - 1, "max_pressure_error": peak / p0 - 1,
+            "peak_pressure": on_axis,
+            "peak_pressure_error": None if on_axis is None else on_axis / p0 - 1,
             "max_law_pressure": float(values.pressure.max()),
+            **({} if self.dim == 2 else {"gap_crossing_radius": crossing,
+                                         "gap_crossing_radius_error": crossing / a - 1}),
             f"fitted_{width}": fitted[0], "fitted_max_pressure": fitted[1],
             f"fitted_{width}_error": None if fitted[0] is None else fitted[0] / a - 1,
             "fitted_max_pressure_error": None if fitted[1] is None else fitted[1] / p0 - 1,

@@ -41,7 +41,8 @@ from fenicsfriction.laws import check, check_positive
 from fenicsfriction.results import Record
 
 __all__ = ["Contacts", "Distribution", "EQModel", "IndependentContacts", "QuasistaticResult",
-           "SlipEvents", "SpringDrivenResult", "SpringQuasistaticResult", "check_quasistatic",
+           "SlipEvents", "SpringDrivenResult", "SpringDrives", "SpringQuasistaticResult",
+           "check_quasistatic",
            "describe_distribution", "drive", "drive_quasistatic", "slip_events"]
 
 
@@ -185,15 +186,21 @@ class SpringDrivenResult(Record):
         stuck_fraction: the fraction of late steps with Ẋ < v/10.
         events: the slip events of the whole run (:func:`slip_events`).
         mean_force: the mean spring force over the late window.
-        largest_drop: the largest spring-force drop of a late event over ``mean_force``.
+        peak_force: the largest spring force of the run (the static peak).
+        onset_drop: the largest event's drop over ``peak_force``.
+        largest_late_drop: the largest spring-force drop of a late event over ``mean_force``.
         jump_fraction: the share of the slider's late displacement made in events whose
-            drop exceeds ``drop_threshold`` (the drive carried by jumps).
-        drop_threshold: the drop, over ``mean_force``, that makes an event a jump.
+            drop, over ``mean_force``, exceeds ``drop_threshold`` (the drive carried by jumps).
+        drop_threshold: the drop that makes an event a jump.
+        onset_stick_slip: ``onset_drop > drop_threshold``.
+        sustained_stick_slip: ``largest_late_drop > drop_threshold``.
 
-        At a finite drive speed the events are ambiguous: a slider that follows a falling
-        F(X) (K > K*) outruns the drive too, and the whole decline after the static peak is one
-        falling interval, as large as a jump. The regimes are told apart in the limit v → 0
-        (:func:`drive_quasistatic`, :meth:`EQModel.spring_quasistatic`), which classifies.
+        The classification is that of the infinitely slow drive
+        (:class:`SpringQuasistaticResult`), by the same names, with the events of
+        :func:`slip_events`. At a finite drive speed it is ambiguous near K*: a slider that
+        follows a falling F(X) (K > K*) outruns the drive too, and the whole decline after the
+        static peak is one falling interval, as large as a jump; the limit v → 0
+        (:func:`drive_quasistatic`) is where the regimes separate.
         max_speed: max Ẋ/v over the run.
         fast_slip: ``max_speed > slip_speed``, the former speed classification, kept under its
             own name. It does not separate the regimes: a slider that follows its
@@ -220,16 +227,78 @@ class SpringDrivenResult(Record):
     stuck_fraction: float
     events: SlipEvents
     mean_force: float
-    largest_drop: float
+    peak_force: float
+    onset_drop: float
+    largest_late_drop: float
     jump_fraction: float
     drop_threshold: float
+    onset_stick_slip: bool
+    sustained_stick_slip: bool
     max_speed: float
     fast_slip: bool
     parameters: dict
 
 
+class SpringDrives:
+    """The slider pulled through a spring, whatever holds its contacts: a model gives
+    :meth:`contacts` (a fresh realisation) and :meth:`parameters`, and the drives are these
+    (:class:`EQModel`'s independent contacts, the interacting models' coupled ones)."""
+
+    def contacts(self, rng: np.random.Generator) -> Contacts:
+        """A fresh realisation of the contacts, every contact relaxed at X = 0."""
+        raise NotImplementedError
+
+    def parameters(self) -> dict[str, typing.Any]:
+        """The model's parameters, which go into every result."""
+        raise NotImplementedError
+
+    def spring_driven(self, K: float, v: float, mass: float, damping: float, t_end: float,
+                      dt: float, seed: int | None = 0, late_from: float | None = None,
+                      drop_threshold: float = 0.05, slip_speed: float = 10.0,
+                      prefix: str = "eq_", options: dict | None = None) -> SpringDrivenResult:
+        """Pull the slider, from rest with every contact relaxed, through a spring K whose end
+        moves at speed v: m Ẍ + η Ẋ + F(X) = K (v t − X), by PETSc TS (generalized-α), the
+        contacts breaking at step resolution (:func:`drive`); interacting contacts resolve an
+        avalanche within the step whose end puts a contact over its threshold.
+
+        The drive is a second degree of freedom D with D̈ = 0, D(0) = 0, Ḋ(0) = v, which the
+        scheme integrates exactly (D = v t), so the residual needs no explicit time.
+
+        Args:
+            K: the drive's spring stiffness (force / length).
+            v: the drive's speed (length / time).
+            mass: m, the slider's mass.
+            damping: η, the slider's viscous damping (force · time / length), >= 0.
+            t_end: the duration.
+            dt: the time step; a contact overshoots its threshold by at most |Ẋ| dt.
+            seed: seeds the random generator.
+            late_from: start of the late-time window classified; None: t_end/2. The run
+                must reach the static peak: v t_end > F_s/K + x_c.
+            drop_threshold: the spring-force drop of one event, over the late mean force
+                (the onset's over the peak force), above which the event is a jump
+                (:class:`SpringDrivenResult`).
+            slip_speed: the speed, in units of v, of ``fast_slip`` (the former classification).
+            prefix, options: the TS's options prefix and defaults
+                (see :class:`~fenicsfriction.timestepping.ReducedDynamics`).
+        """
+        contacts = self.contacts(np.random.default_rng(seed))
+        return drive(contacts, self.parameters(), K=K, v=v, mass=mass, damping=damping,
+                     t_end=t_end, dt=dt, late_from=late_from, drop_threshold=drop_threshold,
+                     slip_speed=slip_speed, prefix=prefix, options=options)
+
+    def spring_quasistatic(self, K: float, D_max: float, seed: int | None = 0,
+                           late_from: float | None = None,
+                           drop_threshold: float = 0.05) -> SpringQuasistaticResult:
+        """Pull the slider through a spring K infinitely slowly, event by event
+        (:func:`drive_quasistatic`, whose arguments these are), every contact relaxed at
+        D = 0; an event's breaks include any avalanche through the bodies."""
+        contacts = self.contacts(np.random.default_rng(seed))
+        return drive_quasistatic(contacts, self.parameters(), K=K, D_max=D_max,
+                                 late_from=late_from, drop_threshold=drop_threshold)
+
+
 @dataclasses.dataclass
-class EQModel:
+class EQModel(SpringDrives):
     """The earthquake-like model's interface (Braun (slides), the earthquake-like model).
 
     Args:
@@ -353,48 +422,9 @@ class EQModel:
             static_force=float(np.max(mean_F)), kinetic_from=float(kinetic_from),
             realisations=realisations, breaks=int(alive), parameters=self.parameters())
 
-    def spring_driven(self, K: float, v: float, mass: float, damping: float, t_end: float,
-                      dt: float, seed: int | None = 0, late_from: float | None = None,
-                      drop_threshold: float = 0.05, slip_speed: float = 10.0,
-                      prefix: str = "eq_", options: dict | None = None) -> SpringDrivenResult:
-        """Pull the slider, from rest with every contact relaxed, through a spring K whose end
-        moves at speed v: m Ẍ + η Ẋ + F(X) = K (v t − X), by PETSc TS (generalized-α), the
-        contacts breaking at step resolution.
-
-        The drive is a second degree of freedom D with D̈ = 0, D(0) = 0, Ḋ(0) = v, which the
-        scheme integrates exactly (D = v t), so the residual needs no explicit time.
-
-        Args:
-            K: the drive's spring stiffness (force / length).
-            v: the drive's speed (length / time).
-            mass: m, the slider's mass.
-            damping: η, the slider's viscous damping (force · time / length), >= 0.
-            t_end: the duration.
-            dt: the time step; a contact overshoots its threshold by at most |Ẋ| dt.
-            seed: seeds the random generator.
-            late_from: start of the late-time window classified; None: t_end/2. The run
-                must reach the static peak: v t_end > F_s/K + x_c.
-            drop_threshold: the spring-force drop of one event, over the late mean force,
-                above which the event is a jump (:class:`SpringDrivenResult`).
-            slip_speed: the speed, in units of v, of ``fast_slip`` (the former classification).
-            prefix, options: the TS's options prefix and defaults
-                (see :class:`~fenicsfriction.timestepping.ReducedDynamics`).
-        """
-        contacts = IndependentContacts(self, np.random.default_rng(seed))
-        return drive(contacts, self.parameters(), K=K, v=v, mass=mass, damping=damping,
-                     t_end=t_end, dt=dt, late_from=late_from, drop_threshold=drop_threshold,
-                     slip_speed=slip_speed, prefix=prefix, options=options)
-
-
-    def spring_quasistatic(self, K: float, D_max: float, seed: int | None = 0,
-                           late_from: float | None = None,
-                           drop_threshold: float = 0.05) -> SpringQuasistaticResult:
-        """Pull the slider through a spring K infinitely slowly, event by event
-        (:func:`drive_quasistatic`, whose arguments these are), every contact relaxed at
-        D = 0."""
-        contacts = IndependentContacts(self, np.random.default_rng(seed))
-        return drive_quasistatic(contacts, self.parameters(), K=K, D_max=D_max,
-                                 late_from=late_from, drop_threshold=drop_threshold)
+    def contacts(self, rng: np.random.Generator) -> IndependentContacts:
+        """A fresh realisation, every contact relaxed at X = 0."""
+        return IndependentContacts(self, rng)
 
 
 class Contacts(typing.Protocol):
@@ -480,6 +510,8 @@ def drive(contacts: Contacts, parameters: dict, K: float, v: float, mass: float,
     advance = float(X[-1] - X[late][0])
     jumps = float(np.sum(late_events.slip[drops > drop_threshold]))
     largest = float(np.max(drops, initial=0.0))
+    peak = float(np.max(spring))
+    onset = float(np.max(events.drop, initial=0.0)) / peak
     max_speed = float(np.max(X_dot) / v)
     return SpringDrivenResult(
         t=t, X=X, X_dot=X_dot, spring_force=spring, friction_force=friction,
@@ -488,9 +520,10 @@ def drive(contacts: Contacts, parameters: dict, K: float, v: float, mass: float,
         force_spread=float(np.std(spring[late]) / abs(mean_force)),
         velocity_spread=float(np.std(X_dot[late]) / v),
         stuck_fraction=float(np.mean(X_dot[late] < 0.1 * v)), events=events,
-        mean_force=mean_force, largest_drop=largest,
+        mean_force=mean_force, peak_force=peak, onset_drop=onset, largest_late_drop=largest,
         jump_fraction=jumps / advance if advance > 0 else 0.0,
-        drop_threshold=float(drop_threshold), max_speed=max_speed,
+        drop_threshold=float(drop_threshold), onset_stick_slip=onset > drop_threshold,
+        sustained_stick_slip=largest > drop_threshold, max_speed=max_speed,
         fast_slip=max_speed > slip_speed, parameters=parameters)
 
 
@@ -506,7 +539,7 @@ class SpringQuasistaticResult(Record):
         late_from: where the late window starts (a drive position).
         mean_force: the mean spring force over the late window (exact: it is linear in D
             between events).
-        largest_drop: the largest drop of a late event over ``mean_force``.
+        largest_late_drop: the largest drop of a late event over ``mean_force``.
         jump_fraction: the share of the slider's late advance made in events whose drop
             exceeds ``drop_threshold``.
         mean_breaks: the mean breaks per late event.
@@ -514,10 +547,13 @@ class SpringQuasistaticResult(Record):
         onset_drop: the largest drop of any event over ``peak_force``: the first collective
             break, from all contacts relaxed, where F(X) falls fastest.
         drop_threshold: the drop that makes an event a jump.
-        onset_jump: ``onset_drop > drop_threshold``: the slider jumps at the static peak,
-            which the elastic instability predicts for K < K* as N → ∞
-            (:func:`~fenicsfriction.studies.multicontact.instability.critical_stiffness`).
-        stick_slip: ``largest_drop > drop_threshold``: the jumps go on in the late window.
+        onset_stick_slip: ``onset_drop > drop_threshold``: the slider jumps at the static
+            peak, which the elastic instability predicts for K < K* as N → ∞
+            (:func:`~fenicsfriction.studies.multicontact.instability.critical_stiffness`):
+            the plain model's stick-slip, the static-to-kinetic transition.
+        sustained_stick_slip: ``largest_late_drop > drop_threshold``: the jumps go on in the
+            late window. Without ageing the contacts' phases spread after the first collective
+            break and this fades with N for every K (docs/multicontact.md).
         parameters: the model's parameters.
     """
 
@@ -526,14 +562,14 @@ class SpringQuasistaticResult(Record):
     K: float
     late_from: float
     mean_force: float
-    largest_drop: float
+    largest_late_drop: float
     jump_fraction: float
     mean_breaks: float
     peak_force: float
     onset_drop: float
     drop_threshold: float
-    onset_jump: bool
-    stick_slip: bool
+    onset_stick_slip: bool
+    sustained_stick_slip: bool
     parameters: dict
 
 
@@ -620,11 +656,11 @@ def drive_quasistatic(contacts: Contacts, parameters: dict, K: float, D_max: flo
     onset = float(np.max(events.drop, initial=0.0)) / peak
     return SpringQuasistaticResult(
         D=D_events, events=events, K=float(K), late_from=float(late_from),
-        mean_force=mean_force, largest_drop=largest,
+        mean_force=mean_force, largest_late_drop=largest,
         jump_fraction=jumps / advance if advance > 0 else 0.0,
         mean_breaks=float(np.mean(late.breaks)) if late.breaks.size else 0.0,
         peak_force=peak, onset_drop=onset, drop_threshold=float(drop_threshold),
-        onset_jump=onset > drop_threshold, stick_slip=largest > drop_threshold,
+        onset_stick_slip=onset > drop_threshold, sustained_stick_slip=largest > drop_threshold,
         parameters=parameters)
 
 

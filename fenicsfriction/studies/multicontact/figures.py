@@ -63,7 +63,7 @@ def stability_map_figure(smap: typing.Any, path: PathLike) -> None:
     """The spring-driven runs (an :class:`~.instability.InstabilityMap`) over K and σ/x_c,
     with the master equation's K*."""
     with plotting.saved_figure(path, figsize=(6.5, 4.5)) as (ax,):
-        _classified(ax, smap.K, smap.relative_spread, smap.stick_slip)
+        _classified(ax, smap.K, smap.relative_spread, smap.onset_stick_slip)
         ax.plot(smap.K_star, smap.relative_spread, "k-", label="K* = −max F′(X)")
         ax.set(xscale="log", xlabel="drive stiffness K", ylabel="threshold spread σ/x_c",
                title="elastic instability of the EQ interface")
@@ -76,12 +76,12 @@ def coupling_map_figure(cmap: typing.Any, path: PathLike) -> None:
     with plotting.saved_figure(path, ncols=2, figsize=(11, 4.5)) as (a1, a2):
         shown = np.where(cmap.coupling > 0, cmap.coupling,
                          np.min(cmap.coupling[cmap.coupling > 0], initial=1.0) / 3)
-        _classified(a1, shown, cmap.relative_spread, cmap.stick_slip)
+        _classified(a1, shown, cmap.relative_spread, cmap.sustained_stick_slip)
         a1.set(xscale="log", xlabel="coupling k/(E a) (no interaction at the left edge)",
                ylabel="threshold spread σ/x_c", title="stick-slip of interacting contacts")
         a1.legend(fontsize=8)
         for i, s in enumerate(cmap.relative_spread):
-            a2.plot(shown, cmap.largest_drop[i], "o-", label=f"σ/x_c = {s:g}")
+            a2.plot(shown, cmap.largest_late_drop[i], "o-", label=f"σ/x_c = {s:g}")
         a2.axhline(cmap.drop_threshold, color="gray", ls=":", label="threshold")
         a2.set(xscale="log", yscale="log", xlabel="coupling k/(E a)",
                ylabel="largest drop of F in one avalanche / F_k",

@@ -16,8 +16,10 @@ jumps at the static peak when one event there drops the spring force by more tha
 ``drop_threshold`` of it. K* is the limit N → ∞ of a mean field; a finite interface's own F(X)
 fluctuates by ~N^(-1/2), so runs with K near K* may fall on either side
 (``benchmarks/bench_multicontact.py`` measures where). K* speaks of the first collective break
-only: later, the contacts' phases spread and F(X) flattens, and the late window's jumps fade
-as N grows for every K (the same benchmark). The spring-driven runs with inertia are kept
+only (the map's ``onset_stick_slip``): later, the contacts' phases spread and F(X) flattens,
+and the late window's jumps (``sustained_stick_slip``) fade as N grows for every K (the same
+benchmark): repeated stick-slip needs contacts that re-form in phase, i.e. ageing, which the
+plain model does not have. The spring-driven runs with inertia are kept
 beside, with their former speed classification, max Ẋ > 10 v.
 """
 
@@ -66,10 +68,14 @@ class InstabilityMap(Record):
         K: the drive stiffnesses.
         relative_spread: σ/x_c of the Gaussian thresholds.
         K_star: the critical stiffness of each row (:func:`critical_stiffness`).
-        stick_slip: the classification by the events of the infinitely slow drive: a jump at
-            the static peak (``onset_drop > drop_threshold``).
+        onset_stick_slip: the map's classification, by the events of the infinitely slow
+            drive: a jump at the static peak (``onset_drop > drop_threshold``), which K*
+            predicts as N → ∞.
+        sustained_stick_slip: jumps in the late window (``largest_late_drop >
+            drop_threshold``), reported beside: without ageing it fades with N for every K.
         onset_drop: the largest event's drop over the peak force (infinitely slow drive).
-        late_drop: the largest late event's drop over the late mean force (the same runs).
+        largest_late_drop: the largest late event's drop over the late mean force (the same
+            runs).
         jump_fraction: the late advance made in jumps (the same runs).
         fast_slip, max_speed, stuck_fraction, velocity_spread, force_spread: the measures of
             the spring-driven runs with inertia (see
@@ -82,9 +88,10 @@ class InstabilityMap(Record):
     K: np.ndarray
     relative_spread: np.ndarray
     K_star: np.ndarray
-    stick_slip: np.ndarray
+    onset_stick_slip: np.ndarray
+    sustained_stick_slip: np.ndarray
     onset_drop: np.ndarray
-    late_drop: np.ndarray
+    largest_late_drop: np.ndarray
     jump_fraction: np.ndarray
     fast_slip: np.ndarray
     max_speed: np.ndarray
@@ -132,7 +139,7 @@ def instability_map(K: typing.Sequence[float], relative_spread: typing.Sequence[
     check_positive("mass", m)
     check("drop_threshold", drop_threshold, 0 < drop_threshold < 1, "must lie in (0, 1)")
     shape = (spreads.size, K_values.size)
-    stick_slip, fast_slip = np.zeros(shape, dtype=bool), np.zeros(shape, dtype=bool)
+    onset_jump, sustained, fast_slip = (np.zeros(shape, dtype=bool) for _ in range(3))
     onset, drop, jumps, speed, stuck, velocity, force = (np.zeros(shape) for _ in range(7))
     K_star = np.zeros(spreads.size)
     for i, spread in enumerate(spreads):
@@ -149,15 +156,17 @@ def instability_map(K: typing.Sequence[float], relative_spread: typing.Sequence[
                                       dt=period / steps_per_period, seed=seed)
             slow = model.spring_quasistatic(K=float(K_j), D_max=v * t_end, seed=seed,
                                             drop_threshold=drop_threshold)
-            stick_slip[i, j], fast_slip[i, j] = slow.onset_jump, run.fast_slip
-            onset[i, j], drop[i, j] = slow.onset_drop, slow.largest_drop
+            onset_jump[i, j], fast_slip[i, j] = slow.onset_stick_slip, run.fast_slip
+            sustained[i, j] = slow.sustained_stick_slip
+            onset[i, j], drop[i, j] = slow.onset_drop, slow.largest_late_drop
             jumps[i, j] = slow.jump_fraction
             speed[i, j], stuck[i, j] = run.max_speed, run.stuck_fraction
             velocity[i, j] = run.velocity_spread
             force[i, j] = run.force_spread
     return InstabilityMap(
-        K=K_values, relative_spread=spreads, K_star=K_star, stick_slip=stick_slip,
-        onset_drop=onset, late_drop=drop, jump_fraction=jumps, fast_slip=fast_slip,
+        K=K_values, relative_spread=spreads, K_star=K_star, onset_stick_slip=onset_jump,
+        sustained_stick_slip=sustained, onset_drop=onset, largest_late_drop=drop,
+        jump_fraction=jumps, fast_slip=fast_slip,
         max_speed=speed, stuck_fraction=stuck, velocity_spread=velocity, force_spread=force,
         drop_threshold=float(drop_threshold),
         drive={"v": v, "mass": m, "damping_ratio": damping_ratio,
@@ -173,9 +182,10 @@ class CouplingMap(Record):
     Attributes:
         coupling: k/(E a) of each column.
         relative_spread: σ/x_c of each row.
-        stick_slip: ``largest_drop > drop_threshold``.
-        largest_drop: the largest fall of the friction force in one avalanche, late window,
-            over the kinetic force.
+        sustained_stick_slip: ``largest_late_drop > drop_threshold``: jumps that go on in
+            the late window (coupled contacts keep them, docs/multicontact.md).
+        largest_late_drop: the largest fall of the friction force in one avalanche, late
+            window, over the kinetic force.
         largest_avalanche: the most breaks in one avalanche, late window, over N.
         mean_avalanche: the mean breaks per avalanche, late window.
         interface_stiffness: S/(N k) of each column (the bodies' compliance in series).
@@ -187,8 +197,8 @@ class CouplingMap(Record):
 
     coupling: np.ndarray
     relative_spread: np.ndarray
-    stick_slip: np.ndarray
-    largest_drop: np.ndarray
+    sustained_stick_slip: np.ndarray
+    largest_late_drop: np.ndarray
     largest_avalanche: np.ndarray
     mean_avalanche: np.ndarray
     interface_stiffness: np.ndarray
@@ -256,8 +266,8 @@ def coupling_map(couplings: typing.Sequence[float], relative_spread: typing.Sequ
             mean[i, j] = np.mean(run.avalanche_size[late]) if np.any(late) else 0.0
             kinetic[i, j] = run.kinetic_force / (n * k * x_s_mean)
     return CouplingMap(
-        coupling=values, relative_spread=spreads, stick_slip=drop > drop_threshold,
-        largest_drop=drop, largest_avalanche=largest, mean_avalanche=mean,
+        coupling=values, relative_spread=spreads, sustained_stick_slip=drop > drop_threshold,
+        largest_late_drop=drop, largest_avalanche=largest, mean_avalanche=mean,
         interface_stiffness=stiffness, kinetic_force=kinetic,
         drop_threshold=float(drop_threshold), lives=float(lives),
         parameters={"N": n, "k": k, "x_s_mean": x_s_mean, "nu": nu, "n_side": n_side,

@@ -70,11 +70,8 @@ from fenicsfriction.laws import check, check_positive
 from fenicsfriction.studies.multicontact.eq_model import (
     EQModel,
     QuasistaticResult,
-    SpringDrivenResult,
-    SpringQuasistaticResult,
+    SpringDrives,
     check_quasistatic,
-    drive,
-    drive_quasistatic,
 )
 from fenicsfriction.studies.multicontact.interaction import (
     green_tensor,
@@ -364,8 +361,9 @@ class InteractingQuasistaticResult(QuasistaticResult):
     interface_stiffness: float
 
 
-class _Interface:
-    """The drives of interacting contacts, whatever holds their stiffness."""
+class _Interface(SpringDrives):
+    """The drives of interacting contacts, whatever holds their stiffness (the spring drives
+    are :class:`~fenicsfriction.studies.multicontact.eq_model.SpringDrives`')."""
 
     model: EQModel
 
@@ -416,28 +414,6 @@ class _Interface:
             avalanche_X=where, avalanche_size=size.astype(int), force_drop=drop,
             largest_avalanche=float(np.max(size, initial=0) / self.model.n_contacts),
             interface_stiffness=self.interface_stiffness)
-
-    def spring_driven(self, K: float, v: float, mass: float, damping: float, t_end: float,
-                      dt: float, seed: int | None = 0, late_from: float | None = None,
-                      drop_threshold: float = 0.05, slip_speed: float = 10.0,
-                      prefix: str = "eq_", options: dict | None = None) -> SpringDrivenResult:
-        """The slider pulled through a spring K (arguments and result as
-        :meth:`EQModel.spring_driven`); an avalanche is resolved within the step whose end
-        puts a contact over its threshold."""
-        contacts = self.contacts(np.random.default_rng(seed))
-        return drive(contacts, self.parameters(), K=K, v=v, mass=mass, damping=damping,
-                     t_end=t_end, dt=dt, late_from=late_from, drop_threshold=drop_threshold,
-                     slip_speed=slip_speed, prefix=prefix, options=options)
-
-    def spring_quasistatic(self, K: float, D_max: float, seed: int | None = 0,
-                           late_from: float | None = None,
-                           drop_threshold: float = 0.05) -> SpringQuasistaticResult:
-        """The slider pulled through a spring K infinitely slowly, event by event (arguments
-        and result as :meth:`EQModel.spring_quasistatic`); an event's breaks include the
-        avalanches through the bodies."""
-        contacts = self.contacts(np.random.default_rng(seed))
-        return drive_quasistatic(contacts, self.parameters(), K=K, D_max=D_max,
-                                 late_from=late_from, drop_threshold=drop_threshold)
 
 
 @dataclasses.dataclass
@@ -517,11 +493,7 @@ class LatticeEQModel(_Interface):
     beyond a dense M (16,384 contacts and more).
 
     Args:
-        model: the contacts; N must be a square n².
-        coupling: k/(E a), the interaction's strength (0: none, E = ∞).
-        nu: Poisson's ratio of the bodies.
-        spacing: the lattice spacing a (length).
-        contact_radius: the contacts' radius for the self term; None: a/2.
+        model, coupling, nu, spacing, contact_radius: as :meth:`InteractingEQModel.lattice`.
         rtol: the relative residual of each conjugate-gradient solve.
         max_rounds: the rounds an avalanche may take before the run stops with an error.
     """

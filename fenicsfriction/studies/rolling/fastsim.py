@@ -32,7 +32,11 @@ lateral force of spin right and the spin moment of spin wrong by the factor
 :math:`F_y` (:math:`-\pi a^3 b \phi/(4 L_3)`) and the longitudinal one :math:`-\phi y` only
 :math:`M_z` (:math:`-8 a^2 b^3 \phi/(15 L_4)`), so the default gives the latter its own
 flexibility :math:`L_4`, fitted to :math:`C_{33}`: the simplified theory then reproduces all
-four of Kalker's coefficients.
+four of Kalker's coefficients. The linear theory's fifth term, the moment of the lateral
+creepage :math:`G c^3 C_{23} \eta`, is not fitted: the brush gives
+:math:`\pi a^3 b \eta/(4 L_2) = (3\pi/32) C_{22} G a^2 b \eta`, i.e. :math:`C_{23}` replaced
+by :math:`3\pi C_{22}\sqrt{a/b}/32` (0.67 of it on the wheel-rail case, 0.75 on the circle
+at :math:`\nu = 0`).
 Kalker's original is ``flexibility=Flexibilities(L1, L2, L3, L3)``
 (:meth:`Flexibilities.kalker1982`).
 
