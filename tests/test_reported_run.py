@@ -23,7 +23,7 @@ COMM = MPI.COMM_WORLD
 
 #: a 2 × 1 block (ρ = 1: mass 2 per unit breadth) held by a spring k = 10 at its left edge,
 #: pressed by p = 1 on a belt moving at 1; μ from 0 to 0.2 in 2 steps; the CEA; a transient
-#: of 200 steps (ω dt = 0.04 for the unstable pair at 160 rad/s)
+#: of 100 steps (ω dt = 0.08 for the unstable pair at 160 rad/s)
 CASE = """
 [model]
 dim = 2
@@ -62,11 +62,11 @@ stop = 0.2
 steps = 2
 [cea]
 band = [0.0, 100.0]
-onset_tol = 1e-3
+onset_tol = 1e-2
 [transient]
 amplitude = 1e-6
 t_end = 0.05
-dt = 2.5e-4
+dt = 5e-4
 stride = 1000
 """
 
@@ -138,12 +138,12 @@ def test_cea_table_and_onset_are_what_they_say(run):
     # block's own compliance, E = 1e3 in series with k = 10, softens it by about 1 %)
     lowest = min(m["im"] for m in steps[0]["modes"])
     assert lowest == pytest.approx(np.sqrt(10.0 / 2.0), rel=0.02)
-    # the onset: bisected to onset_tol (1e-3) between the grid steps that bracket it; the
+    # the onset: bisected to onset_tol (1e-2) between the grid steps that bracket it; the
     # eigenvalue there grows (Re λ > growth_tol |λ|, 1e-6) and its frequency lies between
     # the two colliding modes' on the stable side
     onset = summary["onsets"][0]
     low, high = onset["interval"]
-    assert high - low <= 1e-3 and low <= onset["mu_crit"] <= high
+    assert high - low <= 1e-2 and low <= onset["mu_crit"] <= high
     assert summary["mu_crit"] == onset["mu_crit"]
     grid = [s["mu"] for s in steps]
     assert any(a <= low and high <= b for a, b in zip(grid[:-1], grid[1:], strict=True))
@@ -159,7 +159,7 @@ def test_transient_grows_at_re_lambda_and_its_rate_is_the_tables(run):
     rows = _table(out / "transient.csv")
     t = np.array([float(r["time"]) for r in rows])
     amplitude = np.array([float(r["amplitude"]) for r in rows])
-    assert transient["steps"] == len(rows) - 1 == 200
+    assert transient["steps"] == len(rows) - 1 == 100
     np.testing.assert_allclose(transient["time"], t, rtol=1e-15)
     np.testing.assert_allclose(transient["amplitude"], amplitude, rtol=1e-15)
     # started at the last steady value, from its most unstable mode, at the amplitude asked
@@ -174,7 +174,7 @@ def test_transient_grows_at_re_lambda_and_its_rate_is_the_tables(run):
     late = t >= 0.5 * t[-1]
     slope = np.polyfit(t[late], np.log(amplitude[late]), 1)[0]
     assert transient["growth_rate_measured"] == pytest.approx(slope, rel=1e-9)
-    # and the mode grows like exp(Re λ t): generalized-α at ω dt = 0.04 errs by O((ω dt)²)
-    # (measured 5e-4)
+    # and the mode grows like exp(Re λ t): generalized-α at ω dt = 0.08 errs by O((ω dt)²)
+    # (measured: the rate 1.6e-3 low, the amplitude within 1.6e-5 of the exponential)
     assert transient["growth_rate_measured"] == pytest.approx(top["re"], rel=1e-2)
     np.testing.assert_allclose(amplitude, 1e-6 * np.exp(top["re"] * t), rtol=1e-4)
