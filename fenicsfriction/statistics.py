@@ -30,7 +30,8 @@ if typing.TYPE_CHECKING:
     from fenicsfriction.events import HybridEvent, HybridResult
 
 __all__ = ["BeltRun", "BeltSummary", "LimitCycle", "StickSlipStatistics", "belt_summary",
-           "displacement_extrema", "limit_cycle", "mode_intervals", "stick_slip_statistics"]
+           "displacement_extrema", "limit_cycle", "mean_force_figures", "mode_intervals",
+           "stick_slip_statistics"]
 
 
 class BeltRun(typing.Protocol):
@@ -114,6 +115,34 @@ def _time_mean(t: np.ndarray, values: np.ndarray) -> float:
     return float(trapezoid(values, t) / (t[-1] - t[0]))
 
 
+def mean_force_figures(mean_normal_force: float, mean_friction_force: float,
+                       normal_force_range: typing.Sequence[float], mu: float
+                       ) -> dict[str, typing.Any]:
+    r"""The figures of a window's mean forces, however the means were taken.
+
+    One definition for both readers: :func:`stick_slip_statistics` (means of a list of
+    records) and ``block dynamics`` (means of every step, from its running statistics).
+
+    Args:
+        mean_normal_force, mean_friction_force: the window's time means :math:`\bar N`,
+            :math:`\bar F_T`.
+        normal_force_range: (min, max) of the normal force over the window.
+        mu: the law's friction coefficient.
+
+    Returns:
+        ``mean_normal_force``, ``mean_friction_force``, ``normal_force_range`` (a list),
+        ``apparent_coefficient`` :math:`|\bar F_T| / \bar N` and ``ratio_to_mu``, the apparent
+        coefficient over μ (NaN for μ = 0): the :class:`StickSlipStatistics` fields of the
+        same names.
+    """
+    apparent = abs(mean_friction_force) / mean_normal_force
+    return {"mean_normal_force": float(mean_normal_force),
+            "mean_friction_force": float(mean_friction_force),
+            "normal_force_range": [float(v) for v in normal_force_range],
+            "apparent_coefficient": float(apparent),
+            "ratio_to_mu": float(apparent / mu) if mu > 0 else float("nan")}
+
+
 def stick_slip_statistics(records: list[dict], mu: float, eps: float,
                           t_from: float = 0.0) -> StickSlipStatistics:
     r"""What an experimenter would measure on a run, over the records with time ≥ ``t_from``.
@@ -145,15 +174,11 @@ def stick_slip_statistics(records: list[dict], mu: float, eps: float,
                "probe_pressure")}
     in_contact = series["probe_pressure"] > 0
     sticks = in_contact & (np.abs(series["probe_slip"]) < eps)
-    mean_n = _time_mean(t, series["normal_force"])
-    mean_f = _time_mean(t, series["friction_force"])
+    forces = mean_force_figures(_time_mean(t, series["normal_force"]),
+                                _time_mean(t, series["friction_force"]),
+                                (series["normal_force"].min(), series["normal_force"].max()), mu)
     return StickSlipStatistics(
-        t_from=float(t[0]), t_to=float(t[-1]), mu=mu, eps=eps,
-        mean_normal_force=mean_n, mean_friction_force=mean_f,
-        normal_force_range=[float(series["normal_force"].min()),
-                            float(series["normal_force"].max())],
-        apparent_coefficient=abs(mean_f) / mean_n,
-        ratio_to_mu=abs(mean_f) / mean_n / mu if mu > 0 else float("nan"),
+        t_from=float(t[0]), t_to=float(t[-1]), mu=mu, eps=eps, **forces,
         probe_stick_fraction=_time_mean(t, sticks.astype(float)),
         probe_open_fraction=_time_mean(t, (~in_contact).astype(float)),
         probe_longest_stick=_longest_run(t, sticks),

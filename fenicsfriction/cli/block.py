@@ -421,7 +421,7 @@ def run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
     from fenicsfriction.laws import check
     from fenicsfriction.results import CsvRows, RunningStatistics, SampledRecords
     from fenicsfriction.signals import Interrupted, StopSignals, checkpoint
-    from fenicsfriction.statistics import stick_slip_statistics
+    from fenicsfriction.statistics import mean_force_figures, stick_slip_statistics
     from fenicsfriction.steady import ContinuationError, SteadySolver
     from fenicsfriction.timestepping import DynamicsError
 
@@ -528,13 +528,9 @@ def run_dynamics(args: argparse.Namespace, log: logging.Logger) -> int:
             exact["max_energy_error"] = whole["energy_error"]["max_abs"]
         if failure is None and interrupted is None and window.count > 2:
             # the second half of the run as asked: its means from every step
-            mean_n, mean_f = window.mean("normal_force"), window.mean("friction_force")
-            exact.update(
-                t_from=window.t_first, mean_normal_force=mean_n, mean_friction_force=mean_f,
-                normal_force_range=[window["normal_force"]["min"],
-                                    window["normal_force"]["max"]],
-                apparent_coefficient=abs(mean_f) / mean_n,
-                ratio_to_mu=abs(mean_f) / mean_n / args.mu if args.mu > 0 else float("nan"))
+            exact.update(t_from=window.t_first, **mean_force_figures(
+                window.mean("normal_force"), window.mean("friction_force"),
+                (window["normal_force"]["min"], window["normal_force"]["max"]), args.mu))
         statistics = dataclasses.replace(statistics, **exact)
         if comm.rank == 0:
             plotting.plot_stick_slip({f"U = {scene.belt_speed} cm/s": records},

@@ -89,6 +89,8 @@ def _hertz_flags(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--refine", type=int,
                         help="mesh refinement level: each halves the element size (0: 0.005 R "
                              "at the contact)")
+    parser.add_argument("--h-contact", type=float,
+                        help="the element size at the contact before --refine (0.005 R)")
 
 
 def _partition_flag(parser: argparse.ArgumentParser) -> None:
