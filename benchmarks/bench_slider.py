@@ -36,7 +36,9 @@ takes 19 min (160 × 16: 15 min).
 
 from __future__ import annotations
 
+import json
 import math
+import pathlib
 import sys
 import time
 
@@ -103,6 +105,103 @@ def richardson(q: list[float]) -> dict:
             else float("nan"), "monotone": d1 * d2 > 0, "spread": max(q) - min(q)}
 
 
+def _ensemble_levels(args) -> list[tuple[int, int, float]]:
+    """The ensemble study's levels (nx, ny, dt), cheapest first: the time steps on
+    ``--dt-mesh``, then the meshes at ``--mesh-dt`` (a level both studies share runs once)."""
+    dt_mesh = tuple(int(v) for v in args.dt_mesh.split("x"))
+    levels = [(dt_mesh[0], dt_mesh[1], float(dt)) for dt in args.steps.split(",") if dt]
+    levels += [(int(m.split("x")[0]), int(m.split("x")[1]), args.mesh_dt)
+               for m in args.meshes.split(",")]
+    unique = list(dict.fromkeys(levels))
+    return sorted(unique, key=lambda lv: lv[0] * lv[1] / lv[2])
+
+
+def ensemble_statistics(rows: list[dict], levels: list[tuple[int, int, float]],
+                        quantity: str) -> dict:
+    r"""Mean and standard error :math:`s/\sqrt n` of ``quantity`` over the seeds run at each
+    of three ``levels``; the observed order and Richardson's estimate of the means only where
+    both differences exceed twice their standard error (:math:`\sqrt{s_1^2/n_1 + s_2^2/n_2}`),
+    else ``nan`` and ``within_noise``. The seeds are independent realisations, so at one level
+    the mean's error is the standard error; a difference between levels smaller than its
+    own noise says nothing about the order."""
+    means, errors, counts = [], [], []
+    for nx, ny, dt in levels:
+        values = np.array([r[quantity] for r in rows
+                           if (r["nx"], r["ny"], r["dt"]) == (nx, ny, dt)
+                           and np.isfinite(r[quantity])])
+        counts.append(len(values))
+        means.append(float(np.mean(values)) if len(values) else float("nan"))
+        errors.append(float(np.std(values, ddof=1) / math.sqrt(len(values)))
+                      if len(values) > 1 else float("nan"))
+    noise = [math.hypot(errors[i], errors[i + 1]) for i in range(len(levels) - 1)]
+    resolved = len(levels) == 3 and all(
+        abs(means[i] - means[i + 1]) > 2 * noise[i] for i in range(2))
+    fit = richardson(means) if resolved else {"order": float("nan"),
+                                              "extrapolated": float("nan")}
+    return {"levels": [list(lv) for lv in levels], "n": counts, "mean": means,
+            "standard_error": errors, "difference_noise": noise,
+            "within_noise": not resolved, "order": fit["order"],
+            "extrapolated": fit["extrapolated"]}
+
+
+def ensemble(args, comm: MPI.Comm) -> int:
+    """The random-threshold study: every level for one seed, then the next seed, each run
+    appended to ``bench_slider_ensemble.jsonl`` as it ends (a partial study is usable; a
+    rerun skips the runs the file already holds), then the statistics per level."""
+    seeds = [int(v) for v in args.seeds.split(",")]
+    levels = _ensemble_levels(args)
+    path = pathlib.Path(args.out) / "bench_slider_ensemble.jsonl"
+    done: list[dict] = []
+    if path.exists():
+        done = [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
+    scene_keys = {"spread": args.spread, "patches": args.patches, "viscosity": args.viscosity}
+
+    def have(nx: int, ny: int, dt: float, seed: int) -> bool:
+        return any((r["nx"], r["ny"], r["dt"], r["seed"]) == (nx, ny, dt, seed)
+                   and all(r.get(k) == v for k, v in scene_keys.items()) for r in done)
+
+    if comm.rank == 0:
+        args.out.mkdir(parents=True, exist_ok=True)
+    for seed in seeds:
+        for nx, ny, dt in levels:
+            if have(nx, ny, dt, seed):
+                continue
+            r = run(nx, ny, dt, seed, args, comm)
+            row = {**{k: v for k, v in r.items() if k not in ("time", "push_force")},
+                   **scene_keys}
+            done.append(row)
+            if comm.rank == 0:
+                with path.open("a") as stream:
+                    stream.write(json.dumps(row) + "\n")
+                print(f"  seed {seed}, {nx} x {ny}, dt {dt:g}: {r['wall_time_s']:.1f} s, "
+                      f"peak {r['peak_force']:.1f}, slip {r['slip_force']:.1f} N/m",
+                      file=sys.stderr, flush=True)
+    rows = [r for r in done if all(r.get(k) == v for k, v in scene_keys.items())
+            and r["seed"] in seeds]
+    dt_mesh = tuple(int(v) for v in args.dt_mesh.split("x"))
+    studies = {
+        "time_step": [(dt_mesh[0], dt_mesh[1], float(dt)) for dt in args.steps.split(",") if dt],
+        "mesh": [(int(m.split("x")[0]), int(m.split("x")[1]), args.mesh_dt)
+                 for m in args.meshes.split(",")]}
+    summary = {name: {q: ensemble_statistics(rows, lv, q) for q in QUANTITIES}
+               for name, lv in studies.items()}
+    if comm.rank == 0:
+        print("| study | quantity | levels | seeds | mean ± standard error | order, Richardson |")
+        print("|---|---|---|---|---|---|")
+        for name, table in summary.items():
+            for q, s in table.items():
+                cells = ", ".join(f"{m:.1f} ± {e:.1f}" for m, e in
+                                  zip(s["mean"], s["standard_error"], strict=True))
+                fit = "within noise" if s["within_noise"] else \
+                    f"p = {s['order']:.2f}, {s['extrapolated']:.1f}"
+                print(f"| {name} | {q} | {', '.join(str(lv) for lv in s['levels'])} | "
+                      f"{', '.join(map(str, s['n']))} | {cells} | {fit} |")
+    write_summary(args.out / "bench_slider_ensemble.json",
+                  {"t_end": T_END, **scene_keys, "seeds": seeds, "studies": summary,
+                   "rows": rows}, comm)
+    return 0
+
+
 def main() -> int:
     flags = benchmark_parser(__doc__)
     flags.add_argument("--meshes", default="20x2,40x4,80x8", help="three meshes nx x ny")
@@ -114,9 +213,14 @@ def main() -> int:
     flags.add_argument("--spread", type=float, default=0.0, help="threshold spread δ")
     flags.add_argument("--patches", type=int, default=0, help="threshold patches (0: per node)")
     flags.add_argument("--seeds", default="3", help="threshold seeds, comma-separated")
+    flags.add_argument("--ensemble", action="store_true",
+                       help="the random-threshold ensemble study: per seed every level, "
+                            "appended to bench_slider_ensemble.jsonl as it goes")
     flags.add_argument("--dpi", type=int, default=110)
     args = flags.parse_args()
     comm = MPI.COMM_WORLD
+    if args.ensemble:
+        return ensemble(args, comm)
     seeds = [int(v) for v in args.seeds.split(",")]
     meshes = [tuple(int(v) for v in m.split("x")) for m in args.meshes.split(",")]
     steps = [float(v) for v in args.steps.split(",") if v]

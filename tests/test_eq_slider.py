@@ -247,6 +247,36 @@ def test_kelvin_voigt_viscosity_dissipates_tau_times_the_strain_rate_power():
             new["dt"] * new["rate"], rel=1e-8, abs=1e-12 * records[0]["energy"])
 
 
+def test_one_compiled_form_runs_two_kelvin_voigt_times_and_tau_zero_conserves_energy():
+    # tau is a fem.Constant of the form: one model, one solver (its forms compiled once) runs
+    # tau = 3 and 6 us and tau = 0 from the same initial state. Unbreakable contacts, no
+    # pusher, a linear system: undamped, the trapezoidal rule (generalized-alpha at spectral
+    # radius 1) conserves the energy to round-off; damped, it loses more the larger tau
+    scene = ElasticSlider(nx=10, ny=2, threshold=np.inf, k_push=0.0, viscosity=3e-6)
+    model = ElasticSliderModel(scene, MPI.COMM_WORLD)
+    assert model.viscosity in model.residual.form.constants()
+    solver = model.solver()
+    x = model.V.tabulate_dof_coordinates()
+    start = np.zeros_like(model.residual.u_dot.x.array)
+    start[0::2] = 0.1 * np.sin(np.pi * x[:, 0] / scene.L)
+    compiled = (solver.L, solver.a)
+
+    def lost(tau: float) -> float:
+        model.viscosity.value = tau
+        for field, value in ((model.residual.u, 0.0), (model.residual.u_dot, start),
+                             (model.residual.u_ddot, 0.0)):
+            field.x.array[:] = value
+            field.x.scatter_forward()
+        records = solver.run(1e-4, 2e-6, observe=lambda t: {
+            "energy": sum(model.energies().values())})
+        return (records[0]["energy"] - records[-1]["energy"]) / records[0]["energy"]
+
+    damped, twice, undamped = lost(3e-6), lost(6e-6), lost(0.0)
+    assert (solver.L, solver.a) == compiled
+    assert damped > 0.05 and twice > 1.2 * damped  # more damping, more energy lost
+    assert abs(undamped) < 1e-10
+
+
 @pytest.mark.mpi(min_size=2)
 def test_front_history_is_the_same_on_one_and_on_all_ranks(shared_tmp_path):
     models = [ElasticSliderModel(PUSHED, comm) for comm in (MPI.COMM_WORLD, MPI.COMM_SELF)]

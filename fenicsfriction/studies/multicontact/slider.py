@@ -296,6 +296,8 @@ class ElasticSliderModel:
         anchor, attached: scalar degree-1 fields of the anchors U_j [m] and the switches a_j
             (base nodes only).
         time: ``fem.Constant`` clock of the pusher.
+        viscosity: ``fem.Constant`` Kelvin-Voigt time τ [s] (from the scene; set its
+            ``value`` to run another τ with the same compiled forms).
         node, x, weight, threshold, breaks_so_far, off_since, ever_broken: per owned base
             node: its number j, abscissa, share w_j of the base, current threshold, breaks,
             time it broke (``nan`` while attached), broken since the start.
@@ -320,14 +322,16 @@ class ElasticSliderModel:
         Q = _compat.scalar_function_space(msh, "Lagrange", 1)
         self.anchor, self.attached = fem.Function(Q), fem.Function(Q)
         self.time = fem.Constant(msh, 0.0)
+        # a Constant, not a number in the form: one compiled form serves every τ (τ = 0 too)
+        self.viscosity = fem.Constant(msh, np.float64(s.viscosity))
         ds = ufl.Measure("ds", domain=msh, subdomain_data=self.facet_tags,
                          metadata=_compat.nodal_quadrature(fdim))
         self.ds_base, self.ds_left = ds(BASE), ds(LEFT)
         u, u_dot, u_ddot = fem.Function(V, name="displacement"), fem.Function(V), fem.Function(V)
         v = ufl.TestFunction(V)
         form = inertia(s.rho, u_ddot, v, ufl.dx(domain=msh)) \
-            + elasticity(u + s.viscosity * u_dot if s.viscosity > 0 else u, v, s.E, s.nu,
-                         ufl.dx(domain=msh), s.plane_stress) \
+            + elasticity(u + self.viscosity * u_dot, v, s.E, s.nu, ufl.dx(domain=msh),
+                         s.plane_stress) \
             + s.k * self.attached * (u[0] - self.anchor) * v[0] * self.ds_base
         if s.k_push > 0:
             form += s.k_push * (u[0] - s.push_speed * self.time) * v[0] * self.ds_left
