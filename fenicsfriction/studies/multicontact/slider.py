@@ -167,8 +167,9 @@ class Front(Record):
     Attributes:
         start_time, end_time: first and last break of the burst [s].
         start_x, tip_x: where it started and the furthest break it reached [m].
-        speed: mean speed of its tip, (tip_x - start_x) / (time of the tip - start_time) [m/s]
-            (``nan`` for a single break).
+        tip_time: when it reached ``tip_x`` (the first break there) [s].
+        speed: mean speed of its tip, (tip_x - start_x) / (tip_time - start_time) [m/s]
+            (``nan`` when the tip broke in the first break's step).
         arrested: it stopped before the far (leading) edge: a precursor.
         push_force: pusher force per unit breadth when it started [N/m].
         size: how many breaks it grouped.
@@ -178,6 +179,7 @@ class Front(Record):
     end_time: float
     start_x: float
     tip_x: float
+    tip_time: float
     speed: float
     arrested: bool
     push_force: float
@@ -229,7 +231,7 @@ def fronts(breaks: typing.Sequence[Break], push_force: typing.Callable[[float], 
         duration = tip.time - first.time
         speed = (tip.x - first.x) / duration if duration > 0 else float("nan")
         result.append(Front(start_time=first.time, end_time=group[-1].time, start_x=first.x,
-                            tip_x=tip.x, speed=speed, arrested=tip.x < far_edge,
+                            tip_x=tip.x, tip_time=tip.time, speed=speed, arrested=tip.x < far_edge,
                             push_force=push_force(first.time), size=len(group)))
     return result
 
