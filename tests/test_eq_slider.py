@@ -166,9 +166,13 @@ def _front(start_x: float, start_time: float, speed: float, count: int, h: float
 
 def test_causal_grouping_finds_a_known_front_and_two_simultaneous_ones():
     c = 1000.0
-    one = fronts(_front(0.0, 1e-3, 300.0, 20), lambda t: 2 * t, 1e-4, 0.05, c)
-    assert len(one) == 1 and one[0].size == 20 and one[0].arrested
+    # and a break behind the tip after it (the front filling in): the speed is the tip's
+    run = _front(0.0, 1e-3, 300.0, 20)
+    backfill = Break(time=run[-1].time + 2e-6, x=0.01, stretch=1e-6, energy=0.0)
+    one = fronts([*run, backfill], lambda t: 2 * t, 1e-4, 0.05, c)
+    assert len(one) == 1 and one[0].size == 21 and one[0].arrested
     assert one[0].speed == pytest.approx(300.0, rel=1e-12)
+    assert (one[0].tip_time, one[0].end_time) == (run[-1].time, backfill.time)
     assert (one[0].start_x, one[0].tip_x, one[0].push_force) == (0.0, pytest.approx(0.019),
                                                                  2e-3)
     # two fronts starting together 5 cm apart, one running right at 300 m/s, one left at
