@@ -27,6 +27,15 @@ p = log₂(|q₁ − q₂| / |q₂ − q₃|) and q₃ + (q₃ − q₂) / (2ᵖ
 *Verification and Validation in Computational Science and Engineering*), ``nan`` where the
 differences change sign.
 
+``--ensemble`` (with ``--spread`` > 0, ``--patches`` and ``--seeds``): the random-threshold
+study, whose converged quantity is the mean over realisations (one realisation's cascade
+order flips with Δt and h). Seed by seed, every level of both refinements, each run appended
+to ``bench_slider_ensemble.jsonl`` as it ends (a partial study is usable, a rerun resumes);
+then ``bench_slider_ensemble.json``: per level the mean ± standard error s/√n, and the
+observed order and Richardson's estimate of the means only where both differences between
+levels, paired by seed, exceed twice their standard error (else "within noise"). One
+process: about 3 minutes a seed.
+
 Writes ``bench_slider.json`` and ``bench_slider.png`` (push force against time, per level) to
 ``--out``. Serial or under MPI (the history is the same on any number of ranks). About 4
 minutes with the defaults on the shared 2-core machine (the 80 × 8 mesh 1.6 min, 0.5 µs on
@@ -119,28 +128,35 @@ def _ensemble_levels(args) -> list[tuple[int, int, float]]:
 def ensemble_statistics(rows: list[dict], levels: list[tuple[int, int, float]],
                         quantity: str) -> dict:
     r"""Mean and standard error :math:`s/\sqrt n` of ``quantity`` over the seeds run at each
-    of three ``levels``; the observed order and Richardson's estimate of the means only where
-    both differences exceed twice their standard error (:math:`\sqrt{s_1^2/n_1 + s_2^2/n_2}`),
-    else ``nan`` and ``within_noise``. The seeds are independent realisations, so at one level
-    the mean's error is the standard error; a difference between levels smaller than its
-    own noise says nothing about the order."""
-    means, errors, counts = [], [], []
-    for nx, ny, dt in levels:
-        values = np.array([r[quantity] for r in rows
-                           if (r["nx"], r["ny"], r["dt"]) == (nx, ny, dt)
-                           and np.isfinite(r[quantity])])
-        counts.append(len(values))
-        means.append(float(np.mean(values)) if len(values) else float("nan"))
-        errors.append(float(np.std(values, ddof=1) / math.sqrt(len(values)))
-                      if len(values) > 1 else float("nan"))
-    noise = [math.hypot(errors[i], errors[i + 1]) for i in range(len(levels) - 1)]
-    resolved = len(levels) == 3 and all(
-        abs(means[i] - means[i + 1]) > 2 * noise[i] for i in range(2))
+    of three ``levels``, and the differences between neighbouring levels paired by seed (the
+    same realisation on every level: the realisations' own scatter cancels), each with its
+    standard error. The observed order and Richardson's estimate of the means only where both
+    paired differences exceed twice their standard error; else ``nan`` and ``within_noise``:
+    a difference smaller than its own noise says nothing about the order. The means and the
+    differences are over the seeds run at every level."""
+    def values(level: tuple[int, int, float]) -> dict[int, float]:
+        return {r["seed"]: float(r[quantity]) for r in rows
+                if (r["nx"], r["ny"], r["dt"]) == level and np.isfinite(r[quantity])}
+
+    per_level = [values(lv) for lv in levels]
+    seeds = sorted(set.intersection(*(set(v) for v in per_level))) if per_level else []
+    table = np.array([[v[seed] for seed in seeds] for v in per_level])  # levels x seeds
+    n = len(seeds)
+
+    def error(x: np.ndarray) -> float:
+        return float(np.std(x, ddof=1) / math.sqrt(n)) if n > 1 else float("nan")
+
+    means = [float(np.mean(row)) if n else float("nan") for row in table]
+    differences = [table[i] - table[i + 1] for i in range(len(levels) - 1)]
+    noise = [error(d) for d in differences]
+    resolved = len(levels) == 3 and n > 1 and all(
+        abs(float(np.mean(d))) > 2 * e for d, e in zip(differences, noise, strict=True))
     fit = richardson(means) if resolved else {"order": float("nan"),
                                               "extrapolated": float("nan")}
-    return {"levels": [list(lv) for lv in levels], "n": counts, "mean": means,
-            "standard_error": errors, "difference_noise": noise,
-            "within_noise": not resolved, "order": fit["order"],
+    return {"levels": [list(lv) for lv in levels], "seeds": seeds, "mean": means,
+            "standard_error": [error(row) for row in table],
+            "difference": [float(np.mean(d)) if n else float("nan") for d in differences],
+            "difference_error": noise, "within_noise": not resolved, "order": fit["order"],
             "extrapolated": fit["extrapolated"]}
 
 
@@ -186,16 +202,19 @@ def ensemble(args, comm: MPI.Comm) -> int:
     summary = {name: {q: ensemble_statistics(rows, lv, q) for q in QUANTITIES}
                for name, lv in studies.items()}
     if comm.rank == 0:
-        print("| study | quantity | levels | seeds | mean ± standard error | order, Richardson |")
-        print("|---|---|---|---|---|---|")
+        print("| study | quantity | levels | seeds | mean ± standard error | paired differences "
+              "| order, Richardson |")
+        print("|---|---|---|---|---|---|---|")
         for name, table in summary.items():
             for q, s in table.items():
-                cells = ", ".join(f"{m:.1f} ± {e:.1f}" for m, e in
+                cells = ", ".join(f"{m:.4g} ± {e:.2g}" for m, e in
                                   zip(s["mean"], s["standard_error"], strict=True))
+                steps = ", ".join(f"{d:.3g} ± {e:.2g}" for d, e in
+                                  zip(s["difference"], s["difference_error"], strict=True))
                 fit = "within noise" if s["within_noise"] else \
-                    f"p = {s['order']:.2f}, {s['extrapolated']:.1f}"
+                    f"p = {s['order']:.2f}, {s['extrapolated']:.4g}"
                 print(f"| {name} | {q} | {', '.join(str(lv) for lv in s['levels'])} | "
-                      f"{', '.join(map(str, s['n']))} | {cells} | {fit} |")
+                      f"{len(s['seeds'])} | {cells} | {steps} | {fit} |")
     write_summary(args.out / "bench_slider_ensemble.json",
                   {"t_end": T_END, **scene_keys, "seeds": seeds, "studies": summary,
                    "rows": rows}, comm)
