@@ -27,6 +27,15 @@ p = log₂(|q₁ − q₂| / |q₂ − q₃|) and q₃ + (q₃ − q₂) / (2ᵖ
 *Verification and Validation in Computational Science and Engineering*), ``nan`` where the
 differences change sign.
 
+``--ensemble`` (with ``--spread`` > 0, ``--patches`` and ``--seeds``): the random-threshold
+study, whose converged quantity is the mean over realisations (one realisation's cascade
+order flips with Δt and h). Seed by seed, every level of both refinements, each run appended
+to ``bench_slider_ensemble.jsonl`` as it ends (a partial study is usable, a rerun resumes);
+then ``bench_slider_ensemble.json``: per level the mean ± standard error s/√n, and the
+observed order and Richardson's estimate of the means only where both differences between
+levels, paired by seed, exceed twice their standard error (else "within noise"). One
+process: about 3 minutes a seed.
+
 Writes ``bench_slider.json`` and ``bench_slider.png`` (push force against time, per level) to
 ``--out``. Serial or under MPI (the history is the same on any number of ranks). About 4
 minutes with the defaults on the shared 2-core machine (the 80 × 8 mesh 1.6 min, 0.5 µs on
@@ -36,7 +45,9 @@ takes 19 min (160 × 16: 15 min).
 
 from __future__ import annotations
 
+import json
 import math
+import pathlib
 import sys
 import time
 
@@ -103,6 +114,113 @@ def richardson(q: list[float]) -> dict:
             else float("nan"), "monotone": d1 * d2 > 0, "spread": max(q) - min(q)}
 
 
+def _ensemble_levels(args) -> list[tuple[int, int, float]]:
+    """The ensemble study's levels (nx, ny, dt), cheapest first: the time steps on
+    ``--dt-mesh``, then the meshes at ``--mesh-dt`` (a level both studies share runs once)."""
+    dt_mesh = tuple(int(v) for v in args.dt_mesh.split("x"))
+    levels = [(dt_mesh[0], dt_mesh[1], float(dt)) for dt in args.steps.split(",") if dt]
+    levels += [(int(m.split("x")[0]), int(m.split("x")[1]), args.mesh_dt)
+               for m in args.meshes.split(",")]
+    unique = list(dict.fromkeys(levels))
+    return sorted(unique, key=lambda lv: lv[0] * lv[1] / lv[2])
+
+
+def ensemble_statistics(rows: list[dict], levels: list[tuple[int, int, float]],
+                        quantity: str) -> dict:
+    r"""Mean and standard error :math:`s/\sqrt n` of ``quantity`` over the seeds run at each
+    of three ``levels``, and the differences between neighbouring levels paired by seed (the
+    same realisation on every level: the realisations' own scatter cancels), each with its
+    standard error. The observed order and Richardson's estimate of the means only where both
+    paired differences exceed twice their standard error; else ``nan`` and ``within_noise``:
+    a difference smaller than its own noise says nothing about the order. The means and the
+    differences are over the seeds run at every level."""
+    def values(level: tuple[int, int, float]) -> dict[int, float]:
+        return {r["seed"]: float(r[quantity]) for r in rows
+                if (r["nx"], r["ny"], r["dt"]) == level and np.isfinite(r[quantity])}
+
+    per_level = [values(lv) for lv in levels]
+    seeds = sorted(set.intersection(*(set(v) for v in per_level))) if per_level else []
+    table = np.array([[v[seed] for seed in seeds] for v in per_level])  # levels x seeds
+    n = len(seeds)
+
+    def error(x: np.ndarray) -> float:
+        return float(np.std(x, ddof=1) / math.sqrt(n)) if n > 1 else float("nan")
+
+    means = [float(np.mean(row)) if n else float("nan") for row in table]
+    differences = [table[i] - table[i + 1] for i in range(len(levels) - 1)]
+    noise = [error(d) for d in differences]
+    resolved = len(levels) == 3 and n > 1 and all(
+        abs(float(np.mean(d))) > 2 * e for d, e in zip(differences, noise, strict=True))
+    fit = richardson(means) if resolved else {"order": float("nan"),
+                                              "extrapolated": float("nan")}
+    return {"levels": [list(lv) for lv in levels], "seeds": seeds, "mean": means,
+            "standard_error": [error(row) for row in table],
+            "difference": [float(np.mean(d)) if n else float("nan") for d in differences],
+            "difference_error": noise, "within_noise": not resolved, "order": fit["order"],
+            "extrapolated": fit["extrapolated"]}
+
+
+def ensemble(args, comm: MPI.Comm) -> int:
+    """The random-threshold study: every level for one seed, then the next seed, each run
+    appended to ``bench_slider_ensemble.jsonl`` as it ends (a partial study is usable; a
+    rerun skips the runs the file already holds), then the statistics per level."""
+    seeds = [int(v) for v in args.seeds.split(",")]
+    levels = _ensemble_levels(args)
+    path = pathlib.Path(args.out) / "bench_slider_ensemble.jsonl"
+    done: list[dict] = []
+    if path.exists():
+        done = [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
+    scene_keys = {"spread": args.spread, "patches": args.patches, "viscosity": args.viscosity}
+
+    def have(nx: int, ny: int, dt: float, seed: int) -> bool:
+        return any((r["nx"], r["ny"], r["dt"], r["seed"]) == (nx, ny, dt, seed)
+                   and all(r.get(k) == v for k, v in scene_keys.items()) for r in done)
+
+    if comm.rank == 0:
+        args.out.mkdir(parents=True, exist_ok=True)
+    for seed in seeds:
+        for nx, ny, dt in levels:
+            if have(nx, ny, dt, seed):
+                continue
+            r = run(nx, ny, dt, seed, args, comm)
+            row = {**{k: v for k, v in r.items() if k not in ("time", "push_force")},
+                   **scene_keys}
+            done.append(row)
+            if comm.rank == 0:
+                with path.open("a") as stream:
+                    stream.write(json.dumps(row) + "\n")
+                print(f"  seed {seed}, {nx} x {ny}, dt {dt:g}: {r['wall_time_s']:.1f} s, "
+                      f"peak {r['peak_force']:.1f}, slip {r['slip_force']:.1f} N/m",
+                      file=sys.stderr, flush=True)
+    rows = [r for r in done if all(r.get(k) == v for k, v in scene_keys.items())
+            and r["seed"] in seeds]
+    dt_mesh = tuple(int(v) for v in args.dt_mesh.split("x"))
+    studies = {
+        "time_step": [(dt_mesh[0], dt_mesh[1], float(dt)) for dt in args.steps.split(",") if dt],
+        "mesh": [(int(m.split("x")[0]), int(m.split("x")[1]), args.mesh_dt)
+                 for m in args.meshes.split(",")]}
+    summary = {name: {q: ensemble_statistics(rows, lv, q) for q in QUANTITIES}
+               for name, lv in studies.items()}
+    if comm.rank == 0:
+        print("| study | quantity | levels | seeds | mean ± standard error | paired differences "
+              "| order, Richardson |")
+        print("|---|---|---|---|---|---|---|")
+        for name, table in summary.items():
+            for q, s in table.items():
+                cells = ", ".join(f"{m:.4g} ± {e:.2g}" for m, e in
+                                  zip(s["mean"], s["standard_error"], strict=True))
+                steps = ", ".join(f"{d:.3g} ± {e:.2g}" for d, e in
+                                  zip(s["difference"], s["difference_error"], strict=True))
+                fit = "within noise" if s["within_noise"] else \
+                    f"p = {s['order']:.2f}, {s['extrapolated']:.4g}"
+                print(f"| {name} | {q} | {', '.join(str(lv) for lv in s['levels'])} | "
+                      f"{len(s['seeds'])} | {cells} | {steps} | {fit} |")
+    write_summary(args.out / "bench_slider_ensemble.json",
+                  {"t_end": T_END, **scene_keys, "seeds": seeds, "studies": summary,
+                   "rows": rows}, comm)
+    return 0
+
+
 def main() -> int:
     flags = benchmark_parser(__doc__)
     flags.add_argument("--meshes", default="20x2,40x4,80x8", help="three meshes nx x ny")
@@ -114,9 +232,14 @@ def main() -> int:
     flags.add_argument("--spread", type=float, default=0.0, help="threshold spread δ")
     flags.add_argument("--patches", type=int, default=0, help="threshold patches (0: per node)")
     flags.add_argument("--seeds", default="3", help="threshold seeds, comma-separated")
+    flags.add_argument("--ensemble", action="store_true",
+                       help="the random-threshold ensemble study: per seed every level, "
+                            "appended to bench_slider_ensemble.jsonl as it goes")
     flags.add_argument("--dpi", type=int, default=110)
     args = flags.parse_args()
     comm = MPI.COMM_WORLD
+    if args.ensemble:
+        return ensemble(args, comm)
     seeds = [int(v) for v in args.seeds.split(",")]
     meshes = [tuple(int(v) for v in m.split("x")) for m in args.meshes.split(",")]
     steps = [float(v) for v in args.steps.split(",") if v]

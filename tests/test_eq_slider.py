@@ -166,9 +166,13 @@ def _front(start_x: float, start_time: float, speed: float, count: int, h: float
 
 def test_causal_grouping_finds_a_known_front_and_two_simultaneous_ones():
     c = 1000.0
-    one = fronts(_front(0.0, 1e-3, 300.0, 20), lambda t: 2 * t, 1e-4, 0.05, c)
-    assert len(one) == 1 and one[0].size == 20 and one[0].arrested
+    # and a break behind the tip after it (the front filling in): the speed is the tip's
+    run = _front(0.0, 1e-3, 300.0, 20)
+    backfill = Break(time=run[-1].time + 2e-6, x=0.01, stretch=1e-6, energy=0.0)
+    one = fronts([*run, backfill], lambda t: 2 * t, 1e-4, 0.05, c)
+    assert len(one) == 1 and one[0].size == 21 and one[0].arrested
     assert one[0].speed == pytest.approx(300.0, rel=1e-12)
+    assert (one[0].tip_time, one[0].end_time) == (run[-1].time, backfill.time)
     assert (one[0].start_x, one[0].tip_x, one[0].push_force) == (0.0, pytest.approx(0.019),
                                                                  2e-3)
     # two fronts starting together 5 cm apart, one running right at 300 m/s, one left at
@@ -245,6 +249,36 @@ def test_kelvin_voigt_viscosity_dissipates_tau_times_the_strain_rate_power():
     for old, new in zip(records[:-1], records[1:], strict=True):
         assert old["energy"] - new["energy"] == pytest.approx(
             new["dt"] * new["rate"], rel=1e-8, abs=1e-12 * records[0]["energy"])
+
+
+def test_one_compiled_form_runs_two_kelvin_voigt_times_and_tau_zero_conserves_energy():
+    # tau is a fem.Constant of the form: one model, one solver (its forms compiled once) runs
+    # tau = 3 and 6 us and tau = 0 from the same initial state. Unbreakable contacts, no
+    # pusher, a linear system: undamped, the trapezoidal rule (generalized-alpha at spectral
+    # radius 1) conserves the energy to round-off; damped, it loses more the larger tau
+    scene = ElasticSlider(nx=10, ny=2, threshold=np.inf, k_push=0.0, viscosity=3e-6)
+    model = ElasticSliderModel(scene, MPI.COMM_WORLD)
+    assert model.viscosity in model.residual.form.constants()
+    solver = model.solver()
+    x = model.V.tabulate_dof_coordinates()
+    start = np.zeros_like(model.residual.u_dot.x.array)
+    start[0::2] = 0.1 * np.sin(np.pi * x[:, 0] / scene.L)
+    compiled = (solver.L, solver.a)
+
+    def lost(tau: float) -> float:
+        model.viscosity.value = tau
+        for field, value in ((model.residual.u, 0.0), (model.residual.u_dot, start),
+                             (model.residual.u_ddot, 0.0)):
+            field.x.array[:] = value
+            field.x.scatter_forward()
+        records = solver.run(1e-4, 2e-6, observe=lambda t: {
+            "energy": sum(model.energies().values())})
+        return (records[0]["energy"] - records[-1]["energy"]) / records[0]["energy"]
+
+    damped, twice, undamped = lost(3e-6), lost(6e-6), lost(0.0)
+    assert (solver.L, solver.a) == compiled
+    assert damped > 0.05 and twice > 1.2 * damped  # more damping, more energy lost
+    assert abs(undamped) < 1e-10
 
 
 @pytest.mark.mpi(min_size=2)

@@ -8,6 +8,7 @@ import pytest
 from fenicsfriction.studies.multicontact.frenkel_kontorova import (
     FKChain,
     TriangleRamp,
+    _Chain,
     front_speeds,
 )
 
@@ -136,3 +137,25 @@ def test_bad_runs_are_named():
         c.simulate(1.0, 1.0, relaxed=11)
     with pytest.raises(ValueError, match="f=0.5"):
         c.continuum_front_speed(0.5)
+
+
+def test_sound_speed_is_the_long_wave_limit_of_the_chains_dispersion():
+    # the equations of motion (their Jacobian by differences: linear between breaks) have
+    # omega_j^2 = (k + K)/m + 4 (g/m) sin^2(j pi / 2n) with free ends; the lowest mode's
+    # wavenumber is q_1 = pi / (n a), so (omega_1^2 - omega_0^2) / q_1^2 = c_0^2 up to the
+    # relative (pi / 2n)^2 / 3 = 4e-5 at n = 144. A spacing a != 1 so that c_0 carries it
+    chain = FKChain(n=144, m=2.0, eta=1.0, g=50.0, k=1.0, K=0.25, u_s=1.0, a=0.5)
+    system = _Chain(chain, lambda t: 0.0)
+    n, y0 = chain.n, np.zeros(system.size)
+    stiffness = np.empty((n, n))
+    for j in range(n):
+        y = y0.copy()
+        y[j] = 1.0
+        stiffness[:, j] = -(system.rhs(0.0, y, 0) - system.rhs(0.0, y0, 0))[n:2 * n]
+    omega2 = np.sort(np.linalg.eigvalsh(0.5 * (stiffness + stiffness.T)))
+    j = np.arange(n)
+    assert omega2 == pytest.approx((chain.k + chain.K) / chain.m
+                                   + 4 * chain.g / chain.m * np.sin(j * np.pi / (2 * n)) ** 2,
+                                   rel=1e-10)
+    q1 = np.pi / (n * chain.a)
+    assert chain.sound_speed == pytest.approx(np.sqrt(omega2[1] - omega2[0]) / q1, rel=1e-4)

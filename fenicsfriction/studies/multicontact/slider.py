@@ -167,8 +167,9 @@ class Front(Record):
     Attributes:
         start_time, end_time: first and last break of the burst [s].
         start_x, tip_x: where it started and the furthest break it reached [m].
-        speed: mean speed of its tip, (tip_x - start_x) / (time of the tip - start_time) [m/s]
-            (``nan`` for a single break).
+        tip_time: when it reached ``tip_x`` (the first break there) [s].
+        speed: mean speed of its tip, (tip_x - start_x) / (tip_time - start_time) [m/s]
+            (``nan`` when the tip broke in the first break's step).
         arrested: it stopped before the far (leading) edge: a precursor.
         push_force: pusher force per unit breadth when it started [N/m].
         size: how many breaks it grouped.
@@ -178,6 +179,7 @@ class Front(Record):
     end_time: float
     start_x: float
     tip_x: float
+    tip_time: float
     speed: float
     arrested: bool
     push_force: float
@@ -229,7 +231,7 @@ def fronts(breaks: typing.Sequence[Break], push_force: typing.Callable[[float], 
         duration = tip.time - first.time
         speed = (tip.x - first.x) / duration if duration > 0 else float("nan")
         result.append(Front(start_time=first.time, end_time=group[-1].time, start_x=first.x,
-                            tip_x=tip.x, speed=speed, arrested=tip.x < far_edge,
+                            tip_x=tip.x, tip_time=tip.time, speed=speed, arrested=tip.x < far_edge,
                             push_force=push_force(first.time), size=len(group)))
     return result
 
@@ -296,6 +298,8 @@ class ElasticSliderModel:
         anchor, attached: scalar degree-1 fields of the anchors U_j [m] and the switches a_j
             (base nodes only).
         time: ``fem.Constant`` clock of the pusher.
+        viscosity: ``fem.Constant`` Kelvin-Voigt time τ [s] (from the scene; set its
+            ``value`` to run another τ with the same compiled forms).
         node, x, weight, threshold, breaks_so_far, off_since, ever_broken: per owned base
             node: its number j, abscissa, share w_j of the base, current threshold, breaks,
             time it broke (``nan`` while attached), broken since the start.
@@ -320,14 +324,16 @@ class ElasticSliderModel:
         Q = _compat.scalar_function_space(msh, "Lagrange", 1)
         self.anchor, self.attached = fem.Function(Q), fem.Function(Q)
         self.time = fem.Constant(msh, 0.0)
+        # a Constant, not a number in the form: one compiled form serves every τ (τ = 0 too)
+        self.viscosity = fem.Constant(msh, np.float64(s.viscosity))
         ds = ufl.Measure("ds", domain=msh, subdomain_data=self.facet_tags,
                          metadata=_compat.nodal_quadrature(fdim))
         self.ds_base, self.ds_left = ds(BASE), ds(LEFT)
         u, u_dot, u_ddot = fem.Function(V, name="displacement"), fem.Function(V), fem.Function(V)
         v = ufl.TestFunction(V)
         form = inertia(s.rho, u_ddot, v, ufl.dx(domain=msh)) \
-            + elasticity(u + s.viscosity * u_dot if s.viscosity > 0 else u, v, s.E, s.nu,
-                         ufl.dx(domain=msh), s.plane_stress) \
+            + elasticity(u + self.viscosity * u_dot, v, s.E, s.nu, ufl.dx(domain=msh),
+                         s.plane_stress) \
             + s.k * self.attached * (u[0] - self.anchor) * v[0] * self.ds_base
         if s.k_push > 0:
             form += s.k_push * (u[0] - s.push_speed * self.time) * v[0] * self.ds_left
