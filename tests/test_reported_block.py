@@ -241,17 +241,29 @@ def test_dynamics_columns_are_recomputed_from_the_others(dynamics):
 
 # --- block steady ---------------------------------------------------------------------------
 
+def _run_logged(argv: list[str]) -> list[str]:
+    """Run a command, returning the progress lines it logged (rank 0's; none elsewhere)."""
+    logger = get_logger(COMM)
+    lines = _Lines()
+    logger.addHandler(lines)
+    try:
+        assert main(argv) == 0
+    finally:
+        logger.removeHandler(lines)
+    return lines.lines
+
+
 @pytest.fixture(scope="module")
 def steady(tmp_path_factory):
     out = _shared_folder(tmp_path_factory, "steady") / "out"
-    assert main(["block", "steady", "--mu-max", "0.9", "--steps", "3", "--snapshots", "0",
-                 "--out", str(out)]) == 0
+    lines = _run_logged(["block", "steady", "--mu-max", "0.9", "--steps", "3", "--snapshots",
+                         "0", "--out", str(out)])
     return (json.loads((out / "steady.json").read_text()),
-            json.loads((out / "summary.json").read_text()))
+            json.loads((out / "summary.json").read_text()), lines)
 
 
 def test_steady_records_and_summary_are_what_they_say(steady):
-    records, summary = steady
+    records, summary, _ = steady
     p = summary["parameters"]
     law = p["law"]
     L, B0, W = p["L"], p["B0"], p["weight"]
@@ -293,11 +305,34 @@ def test_steady_records_and_summary_are_what_they_say(steady):
 
 # --- block stability --------------------------------------------------------------------------
 
+def test_steady_progress_lines_repeat_the_records(steady):
+    """Each step's line prints its record's μ, Newton count, |R|, N, F_T and x_cp (to the
+    digits shown), and the first line the dofs and both tipping limits of the summary."""
+    records, summary, lines = steady
+    if COMM.rank != 0:
+        assert lines == []
+        return
+    first = next(x for x in lines if " dofs on " in x)
+    assert first.startswith(f"block: {summary['dofs']} dofs on {COMM.size} rank(s)")
+    assert f"tipping limit μ = {summary['tipping_limit']:.4g}" in first
+    assert first.endswith(f": {summary['discrete_tipping_limit']:.6g})")
+    steps = [x for x in lines if x.startswith("step ")]
+    assert len(steps) == len(records)
+    for k, (line, r) in enumerate(zip(steps, records, strict=True)):
+        assert line.startswith(f"step {k:3d}/{len(records) - 1}  ")
+        assert f"μ={r['mu']:.4f}" in line
+        assert f"Newton {r['newton_iterations']:2d}" in line
+        assert f"|R|={r['residual_norm']:.2e}" in line
+        assert f"N={r['normal_force']:.4g}" in line and f"F_T={r['friction_force']:.4g}" in line
+        assert f"x_cp={r['centre_of_pressure']:.4g}" in line
+
+
 @pytest.fixture(scope="module")
 def stability(tmp_path_factory):
     out = _shared_folder(tmp_path_factory, "stability") / "out"
-    assert main(["block", "stability", "--mu-max", "0.2", "--steps", "1", "--out", str(out)]) == 0
-    return json.loads((out / "stability.json").read_text())
+    lines = _run_logged(["block", "stability", "--mu-max", "0.2", "--steps", "1", "--out",
+                         str(out)])
+    return json.loads((out / "stability.json").read_text()), lines
 
 
 def test_stability_loci_at_mu_0_are_the_rigid_blocks_frequencies(stability):
@@ -305,7 +340,7 @@ def test_stability_loci_at_mu_0_are_the_rigid_blocks_frequencies(stability):
     spring acts at mid-height, through the centre of mass): sliding on the driver spring,
     ω² = K_x/M; bouncing, ω² = k_n/M, with k_n = m_n W/d₀ the slope of N = c_n d^{m_n} B0 L at
     the penetration d₀ that carries W; rocking, ω² = k_n (L²/12) / (M (L² + H²)/12)."""
-    data = stability
+    data, _ = stability
     p = data["parameters"]
     law = p["law"]
     M, W, L, H = p["mass"], p["weight"], p["L"], p["H"]
@@ -334,3 +369,22 @@ def test_stability_loci_at_mu_0_are_the_rigid_blocks_frequencies(stability):
     assert data["fe"]["unstable_intervals"] == {} and data["fe"]["onsets"] == []
     assert (data["max_frequency"], data["growth_tol"], data["ranks"]) == (3e4, 1e-6, COMM.size)
     assert [s["mu"] for s in fe] == [0.0, 0.2] and data["failure"] is None
+
+
+def test_stability_progress_lines_repeat_the_loci(stability):
+    """Each μ's line prints its step's μ, mode count and max Re λ; the closing line the
+    critical μ of both models and the FE unstable intervals of stability.json."""
+    data, lines = stability
+    if COMM.rank != 0:
+        assert lines == []
+        return
+    steps = [x for x in lines if x.startswith("μ=")]
+    fe = data["fe"]["steps"]
+    assert len(steps) == len(fe)
+    for line, step in zip(steps, fe, strict=True):
+        assert line.startswith(f"μ={step['mu']:.4f}  {len(step['modes'])} modes  "
+                               f"max Re λ={step['max_re']:.4g}")
+    closing = [x for x in lines if x.startswith("μ_crit:")]
+    assert closing == [f"μ_crit: FE {data['fe']['mu_crit']}, rigid {data['rigid']['mu_crit']}; "
+                       f"FE unstable intervals by mode {data['fe']['unstable_intervals']}; "
+                       f"rigid {data['rigid']['unstable_intervals']}"]
