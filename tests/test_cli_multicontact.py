@@ -20,12 +20,14 @@ def _json(path):
 
 
 def _csv(path):
-    """A CSV table as columns: floats, or bools where the column holds True/False."""
+    """A CSV table as columns: floats (an empty cell is NaN), or bools where the column holds
+    True/False."""
     with open(path, newline="") as f:
         rows = list(csv.DictReader(f))
     return {key: np.array([r[key] in ("True", "true") for r in rows])
             if rows[0][key] in ("True", "False", "true", "false")
-            else np.array([float(r[key]) for r in rows]) for key in rows[0]}
+            else np.array([float(r[key]) if r[key] else np.nan for r in rows])
+            for key in rows[0]}
 
 
 def test_eq_against_its_master_equation_and_the_kinetic_closed_form(shared_tmp_path):
@@ -248,13 +250,6 @@ def _audit_stability_map(out, s):
         assert s["velocity_spread"][0][j] == pytest.approx(np.std(run.X_dot[window]) / v)
         spring = run.spring_force[window]
         assert s["force_spread"][0][j] == pytest.approx(np.std(spring) / np.mean(spring))
-
-
-def _csv(path):
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
-    return {key: np.array([float(r[key]) if r[key] else np.nan for r in rows])
-            for key in rows[0]}
 
 
 def test_fk_reports_each_figure_as_its_name_says(shared_tmp_path):
