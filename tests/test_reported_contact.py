@@ -219,10 +219,12 @@ def test_cattaneo_figures_against_the_table_and_cattaneo_mindlin(cattaneo):
     right, left = x[~pressed & (x > 0)].min(), x[~pressed & (x < 0)].max()
     assert s["half_width"] < (right - left) / 2
     # the Hertz figures are the normal loading's, the table is written after Q: for identical
-    # bodies (Dundurs' β = 0) Q leaves the pressure unchanged (Johnson 1985, chapter 7), to
-    # 2e-4 here (measured). max_law_pressure is the largest law pressure at the nodes;
-    # max_pressure the largest transmitted one, along the master normal
-    assert s["max_law_pressure"] == pytest.approx(p.max(), rel=1e-3)
+    # bodies (Dundurs' β = 0) Q leaves the pressure unchanged (Johnson 1985, chapter 7), but
+    # only to the discretisation error, as gmsh meshes the two bodies differently (measured
+    # 2e-4 with Debian 12's gmsh, 1.7e-3 with Debian 13's: h/a = 0.2 here, so 5e-3).
+    # max_law_pressure is the largest law pressure at the nodes; max_pressure the largest
+    # transmitted one, along the master normal
+    assert s["max_law_pressure"] == pytest.approx(p.max(), rel=5e-3)
     assert s["max_pressure"] == pytest.approx(s["max_law_pressure"], rel=1e-3)
     # the stick zone: the nodes whose traction is below μp by more than 1e-3, over their
     # extent. The table holds the traction's x-component only, at most its magnitude, so a
