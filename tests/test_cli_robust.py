@@ -174,6 +174,11 @@ def test_record_every_k_writes_every_kth_step_and_keeps_statistics_of_all(shared
     between = 1e-7
     assert thinned[3]["normal_force"] == pytest.approx(full[21]["normal_force"], rel=between)
     t = np.array([r["time"] for r in full])
+    # energy_error is a balance of energies near round-off (1e-8 J here), so its statistics are
+    # compared on the scale of the work it balances (3e-4 J), not on its own: between two MPI
+    # runs it moves by 1e-4 of itself, which is 1e-9 of the work
+    power = np.array([abs(r["friction_power"]) + abs(r["damping_power"]) for r in full])
+    work = trapezoid(power, t)
     for name, rel in (("k1", 1e-12), ("k7", between)):
         summary = json.loads((shared_tmp_path / name / "summary.json").read_text())
         stats = summary["running_statistics"]
@@ -181,13 +186,14 @@ def test_record_every_k_writes_every_kth_step_and_keeps_statistics_of_all(shared
         for key in ("normal_force", "energy_error", "spring_elongation"):
             x = np.array([r[key] for r in full])
             got, scale = stats["fields"][key], np.abs(x).max()
-            close = {"rel": rel, "abs": rel * scale}
+            floor = max(scale, work) if key == "energy_error" else scale
+            close = {"rel": rel, "abs": rel * floor}
             assert got["min"] == pytest.approx(x.min(), **close)
             assert got["max"] == pytest.approx(x.max(), **close)
             assert got["max_abs"] == pytest.approx(scale, **close)
             assert got["mean"] == pytest.approx(trapezoid(x, t) / (t[-1] - t[0]), **close)
         assert summary["statistics"]["max_energy_error"] == pytest.approx(
-            np.abs([r["energy_error"] for r in full]).max(), rel=rel)
+            np.abs([r["energy_error"] for r in full]).max(), rel=rel, abs=rel * work)
         if name == "k1":  # the same run's table
             assert summary["statistics"]["newton_iterations"] == sum(
                 int(r["newton_iterations"]) for r in full)
