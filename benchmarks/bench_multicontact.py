@@ -130,19 +130,46 @@ def _map(out: dict) -> InstabilityMap:
     result = instability_map([s * n for s in STIFFNESS], SPREADS, n_contacts=n)
     out["instability_map"] = {**result.to_json(), "wall_time_s": time.perf_counter() - start}
     below = result.K[None, :] < result.K_star[:, None]
-    agree = float(np.mean(below == result.onset_stick_slip))
-    agree_speed = float(np.mean(below == result.fast_slip))
-    out["instability_map"]["agreement_with_K_star"] = agree
-    out["instability_map"]["speed_agreement_with_K_star"] = agree_speed
-    print(f"\ninstability map: the events agree with K > K* in {100 * agree:.0f} % of runs, "
-          f"max Ẋ > 10 v in {100 * agree_speed:.0f} %")
-    print("| σ/x_c | K*/(N k) | " + " | ".join(f"{s:.3g}" for s in STIFFNESS) + " |")
-    print("|---|---|" + "---|" * len(STIFFNESS))
-    for i, spread in enumerate(SPREADS):
-        cells = [("S" if ss else ".") + ("v" if fs else "") for ss, fs in
-                 zip(result.onset_stick_slip[i], result.fast_slip[i], strict=True)]
-        print(f"| {spread} | {result.K_star[i] / n:.3g} | " + " | ".join(cells) + " |")
+    agreement = {"agreement_with_K_star": result.onset_stick_slip,
+                 "sustained_agreement_with_K_star": result.sustained_stick_slip,
+                 "speed_agreement_with_K_star": result.fast_slip}
+    for key, flags in agreement.items():
+        out["instability_map"][key] = float(np.mean(below == flags))
+    print(_map_table(out["instability_map"]))
     return result
+
+
+def _map_table(record: dict) -> str:
+    """The map as docs/multicontact.md shows it, from its JSON record: each cell
+    ``onset_drop / largest_late_drop``, bold where above the threshold (``onset_stick_slip``,
+    ``sustained_stick_slip``), ``v`` where ``fast_slip``; K/K* beside the cells whose onset
+    classification disagrees with K*'s side."""
+    K, K_star = np.array(record["K"]), np.array(record["K_star"])
+    n, threshold = record["parameters"]["N"], record["drop_threshold"]
+    below = K[None, :] < K_star[:, None]
+    counts = {key: int(round(record[key + "_agreement_with_K_star"] * below.size))
+              if key else int(round(record["agreement_with_K_star"] * below.size))
+              for key in ("", "sustained", "speed")}
+    lines = [f"\ninstability map (N = {n}, {below.size} cells, {record['wall_time_s']:.0f} s): "
+             f"onset_stick_slip on K*'s side in {counts['']} of {below.size}, "
+             f"sustained_stick_slip in {counts['sustained']}, fast_slip in {counts['speed']}",
+             "| σ/x_c | K*/(N k) | " + " | ".join(f"K/(N k) = {k / n:.3g}" if j == 0 else
+                                                  f"{k / n:.3g}" for j, k in enumerate(K))
+             + " |", "|---|---|" + "---|" * K.size]
+
+    def bold(value: float) -> str:
+        return f"**{value:#.3g}**" if value > threshold else f"{value:#.3g}"
+
+    for i, spread in enumerate(record["relative_spread"]):
+        cells = []
+        for j in range(K.size):
+            onset, late = record["onset_drop"][i][j], record["largest_late_drop"][i][j]
+            cell = f"{bold(onset)} / {bold(late)}" + (" v" if record["fast_slip"][i][j] else "")
+            if record["onset_stick_slip"][i][j] != below[i, j]:
+                cell += f" ({K[j] / K_star[i]:.2f} K*)"
+            cells.append(cell)
+        lines.append(f"| {spread} | {K_star[i] / n:.3g} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
 
 
 def _events(out: dict) -> None:

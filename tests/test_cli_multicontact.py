@@ -6,6 +6,8 @@ as one line and exit status 2. Serial and under ``mpirun -n 2``."""
 import csv
 import json
 
+from mpi4py import MPI
+
 import numpy as np
 import pytest
 from cli_errors import assert_one_error_line
@@ -357,6 +359,130 @@ def test_interaction_response_falls_like_r_minus_3_beyond_the_correlation_length
     np.testing.assert_array_equal(table["dF"], dF)
     # the profile: geometric means of r in the bins of geomspace(1, n/4, 40), increasing
     assert np.all(np.diff(r) > 0) and r[0] >= 1.0 and r[-1] < 192 / 4
+
+
+def _half_space_lattice(n, E, nu, contact_radius):
+    """The (3N, 3N) surface compliance of an n × n unit lattice, written from its definition
+    apart from the package: Cerruti's and Boussinesq's point-load solutions on the surface
+    (Landau & Lifshitz 1986, §8; Johnson 1985, §3.2), g = (1 + ν)/(2π E r),
+    u_x = 2g [(1 − ν) + ν x²/r²] Q_x, u_y = 2g ν x y/r² Q_x, u_z = −g (1 − 2ν) x/r Q_x
+    (z outward) and the normal column by reciprocity; the self term the centre displacement of
+    a uniformly loaded disc of the contact's radius."""
+    sites = [(i, j) for i in range(n) for j in range(n)]
+    G = np.zeros((3 * n * n, 3 * n * n))
+    for s, (i, j) in enumerate(sites):
+        for t, (p, q) in enumerate(sites):
+            if s == t:
+                tangential = (1 + nu) * (2 - nu) / (np.pi * E * contact_radius)
+                normal = 2 * (1 - nu**2) / (np.pi * E * contact_radius)
+                G[3 * s:3 * s + 3, 3 * s:3 * s + 3] = np.diag([tangential, tangential, normal])
+                continue
+            x, y = float(i - p), float(j - q)
+            r = np.hypot(x, y)
+            g, cx, cy = (1 + nu) / (2 * np.pi * E * r), x / r, y / r
+            G[3 * s:3 * s + 3, 3 * t:3 * t + 3] = [
+                [2 * g * ((1 - nu) + nu * cx * cx), 2 * g * nu * cx * cy,
+                 g * (1 - 2 * nu) * cx],
+                [2 * g * nu * cx * cy, 2 * g * ((1 - nu) + nu * cy * cy),
+                 g * (1 - 2 * nu) * cy],
+                [-g * (1 - 2 * nu) * cx, -g * (1 - 2 * nu) * cy, 2 * g * (1 - nu)]]
+    return np.array(sites, dtype=float), G
+
+
+def test_interaction_dF_is_the_force_change_of_a_break_in_an_independent_dense_model(
+        shared_tmp_path):
+    """``dF`` is the profile of the force change when the centre contact breaks. Rebuilt apart
+    from the package: the springs k = E a/λ_c on the half-space's compliance G (written from
+    the point-load solutions), F = (1 + KG)⁻¹ K U₀ solved densely, the break exactly — the
+    contact removed (k = 0 there) and F solved again — then |δF| averaged by geometric means
+    in the bins of geomspace(1, n/4, 40) (empty ones dropped) over the broken contact's |δF|.
+    The command computes δF to first order, B δK (U₀ − GF); with the break at the centre of an
+    odd lattice the two differ by a scalar factor on the broken contact (the reflections
+    x → −x, y → −y keep its source along x), which the normalisation removes: they agree to the
+    conjugate-gradient tolerance (4.6e-10 measured; 1e-7 here). λ_c = 1.5 (k ≠ 1) and ν = 0.25
+    (not the default) so that the flags reach the model."""
+    n, lam, nu = 21, 1.5, 0.25
+    out = shared_tmp_path / "interaction-dense"
+    assert main(["multicontact", "interaction", "--n", str(n), "--lambda-c", str(lam),
+                 "--nu", str(nu), "--out", str(out)]) == 0
+    s = _json(out)
+    assert s["parameters"] == {"n": n, "nu": nu, "lambda_c": lam, "spacing": 1.0, "E": 1.0,
+                               "contact_radius": 0.5}
+    sites, G = _half_space_lattice(n, 1.0, nu, 0.5)
+    k, N = 1.0 / lam, n * n
+    centre = (n // 2) * n + n // 2
+    U0 = np.tile([1.0, 0.0, 0.0], N)
+
+    def forces(stiffness):
+        return np.linalg.solve(np.eye(3 * N) + stiffness[:, None] * G, stiffness * U0)
+
+    removed = np.full(3 * N, k)
+    removed[3 * centre:3 * centre + 3] = 0.0
+    change = (forces(removed) - forces(np.full(3 * N, k))).reshape(N, 3)
+    magnitude = np.linalg.norm(change, axis=1) / np.linalg.norm(change[centre])
+    distance = np.hypot(*(sites - sites[centre]).T)
+    edges = np.geomspace(1.0, n / 4, 40)
+    r, dF = [], []
+    for low, high in zip(edges[:-1], edges[1:], strict=True):
+        inside = (distance >= low) & (distance < high)
+        if inside.any():
+            r.append(np.exp(np.mean(np.log(distance[inside]))))
+            dF.append(np.exp(np.mean(np.log(magnitude[inside]))))
+    np.testing.assert_allclose(s["r"], r, rtol=1e-14)
+    np.testing.assert_allclose(s["dF"], dF, rtol=1e-7)
+    # the far range the fit needs is there (at least two profile points past 3 λ_c)
+    assert np.count_nonzero(np.array(r) > 3 * lam) >= 2
+
+
+def test_interaction_refuses_exactly_the_lattices_too_small_for_the_far_fit(shared_tmp_path,
+                                                                            capsys):
+    """The guard counts the profile's points past 3 λ_c as the profile bins them (empty bins
+    dropped): n = 20 at λ_c = 1.5 has one such point and is refused in one line naming --n
+    (it used to pass the guard and fail inside the fit, naming no flag); n = 21 has two and
+    runs (the test above)."""
+    code = main(["multicontact", "interaction", "--n", "20", "--lambda-c", "1.5",
+                 "--out", str(shared_tmp_path / "interaction-small")])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert_one_error_line(err, "--n")
+    assert "--n >= 21" in err or MPI.COMM_WORLD.rank > 0  # rank 0 prints the line
+
+
+def test_stability_map_records_the_drive_and_parameters_it_ran_with(shared_tmp_path):
+    """The map's ``drive`` and ``parameters`` are what the flags said and what the runs used:
+    k = 2, x_c = 0.5, σ = 0.3 x_c, seed 3, a 0.08 threshold (none of them defaults), so a
+    record that echoes a default, or a mass that drops k or x_c, shows. The drive's mass is
+    1e-5 N k x_c/v² (docs/multicontact.md); both runs of the cell, rerun from the records
+    alone, give the map's figures to round-off."""
+    from fenicsfriction.studies.multicontact import EQModel, MasterEquation
+    out = shared_tmp_path / "map-drive"
+    N, k, x_c, K = 100, 2.0, 0.5, 30.0
+    assert main(["multicontact", "stability-map", "--N", str(N), "--k", str(k), "--x-s-mean",
+                 str(x_c), "--K", str(K), "--spreads", "0.3", "--seed", "3",
+                 "--drop-threshold", "0.08", "--out", str(out)]) == 0
+    s = _json(out)
+    drive = s["drive"]
+    assert drive["v"] == 1.0 and drive["damping_ratio"] == 0.1
+    assert drive["drive_distance"] == 6.0 and drive["steps_per_period"] == 20
+    assert drive["mass"] == pytest.approx(1e-5 * N * k * x_c / drive["v"] ** 2, rel=1e-14)
+    assert s["parameters"] == {"N": N, "k": k, "x_s_mean": x_c, "seed": 3}
+    assert s["drop_threshold"] == 0.08 and s["K"] == [K] and s["relative_spread"] == [0.3]
+    model = EQModel(n_contacts=N, k=k, x_s_mean=x_c, x_s_std=0.3 * x_c)
+    master = MasterEquation(model, 0.3 * x_c / 50).solve(2 * x_c + 10 * 0.3 * x_c)
+    assert s["K_star"][0] == pytest.approx(-np.min(np.gradient(master.F, master.h)), rel=1e-3)
+    v, m = drive["v"], drive["mass"]
+    t_end = (drive["drive_distance"] * x_c + master.static_force / K) / v
+    slow = model.spring_quasistatic(K=K, D_max=v * t_end, seed=3, drop_threshold=0.08)
+    assert s["onset_drop"][0][0] == pytest.approx(slow.onset_drop, rel=1e-12)
+    assert s["largest_late_drop"][0][0] == pytest.approx(slow.largest_late_drop, rel=1e-12)
+    assert s["jump_fraction"][0][0] == pytest.approx(slow.jump_fraction, rel=1e-12, abs=1e-15)
+    assert s["onset_stick_slip"][0][0] == (slow.onset_drop > 0.08)
+    assert s["sustained_stick_slip"][0][0] == (slow.largest_late_drop > 0.08)
+    period = 2 * np.pi * np.sqrt(m / (N * k + K))
+    run = model.spring_driven(K=K, v=v, mass=m,
+                              damping=2 * drive["damping_ratio"] * np.sqrt(m * (N * k + K)),
+                              t_end=t_end, dt=period / drive["steps_per_period"], seed=3)
+    assert s["max_speed"][0][0] == pytest.approx(run.X_dot.max() / v, rel=1e-12)
 
 
 @pytest.mark.parametrize(("argv", "name"), [

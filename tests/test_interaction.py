@@ -148,3 +148,32 @@ def test_in_plane_green_tensor_off_the_axes_is_cerrutis_solution(angle):
     u_y_from_y, u_x_from_y = _cerruti(1.0, y, x, 0.0, nu, E_ / (2 * (1 + nu)))
     assert G[1, 1] == pytest.approx(u_y_from_y, rel=1e-12)
     assert G[0, 1] == pytest.approx(u_x_from_y, rel=1e-12)
+
+
+def test_weak_coupling_break_response_is_cerrutis_point_load_solution():
+    """As k → 0 the others do not screen the break: B = 1 − kG + O(k²), so the response over
+    the broken contact's, |δF_j|/|δF_b|, tends to k |G(r_j − r_b) e_x|, the surface
+    displacement of Cerruti's tangential point load (Johnson 1985, §3.2, eq. 3.86, u_z from
+    its third line at z = 0: (1 − 2ν) x/(4π G r²)) times k. The error is first order in k:
+    measured 0.63 % at λ_c = a²E/k = 4096 a on a 17 × 17 lattice, and it quarters when λ_c
+    quadruples (ratio 3.9-4.0)."""
+    n, nu, E_ = 17, 0.3, 1.0
+    centre = (n // 2) * n + n // 2
+    shear = E_ / (2 * (1 + nu))
+    errors = []
+    for lam in (1024.0, 4096.0):
+        lattice = LatticeInteraction(n=n, spacing=1.0, E=E_, nu=nu, stiffness=E_ / lam,
+                                     contact_radius=0.5, rtol=1e-12)
+        response = lattice.break_response([1.0, 0.0, 0.0], centre)
+        ratio = np.linalg.norm(response, axis=1) / np.linalg.norm(response[centre])
+        worst = 0.0
+        for j, (x, y) in enumerate(lattice.positions - lattice.positions[centre]):
+            if j == centre:
+                continue
+            u_x, u_y = _cerruti(1.0, x, y, 0.0, nu, shear)
+            u_z = (1 - 2 * nu) * x / (4 * math.pi * shear * (x * x + y * y))
+            closed_form = lattice.stiffness * math.sqrt(u_x**2 + u_y**2 + u_z**2)
+            worst = max(worst, abs(ratio[j] / closed_form - 1))
+        errors.append(worst)
+    assert errors[1] < 0.01
+    assert 3.5 < errors[0] / errors[1] < 4.5

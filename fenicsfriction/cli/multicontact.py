@@ -78,8 +78,10 @@ def add_parser(commands: typing.Any) -> None:
                       help="couplings k/(E a) of interacting contacts (instead of --K; "
                            "N a square, e.g. --N 256)")
     smap.add_argument("--drop-threshold", type=float, default=0.05,
-                      help="with --couplings: the force drop in one avalanche, over the "
-                           "kinetic force, that is stick-slip (0.05)")
+                      help="the force drop in one event, over the force, that is stick-slip: "
+                           "with --K one slip of the slow drive over the peak (onset) or the "
+                           "late mean force; with --couplings one avalanche over the kinetic "
+                           "force (0.05)")
     smap.add_argument("--lives", type=float, default=8.0,
                       help="with --couplings: the distance moved, in contact lives (8)")
     smap.add_argument("--spreads", type=floats, default=[0.1, 0.3], metavar="S1,S2,...",
@@ -249,9 +251,12 @@ def _run_stability_map(args: argparse.Namespace, log: logging.Logger, comm: MPI.
     log.info(f"stability-map: {len(args.K)} stiffnesses × {len(args.spreads)} spreads, "
              f"{args.N} contacts")
     smap = instability_map(args.K, args.spreads, n_contacts=args.N, k=args.k,
-                           x_s_mean=args.x_s_mean, seed=args.seed)
-    results.write_summary(out / "multicontact.json", {"command": "stability-map",
-                                                   **smap.to_json()}, comm)
+                           x_s_mean=args.x_s_mean, drop_threshold=args.drop_threshold,
+                           seed=args.seed)
+    record = smap.to_json()
+    record["parameters"]["seed"] = args.seed  # the runs' thresholds, as the coupling map's
+    results.write_summary(out / "multicontact.json", {"command": "stability-map", **record},
+                          comm)
     columns = ("onset_stick_slip", "sustained_stick_slip", "onset_drop", "largest_late_drop",
                "jump_fraction", "fast_slip", "max_speed")
     write_rows(out / "map.csv", ({"relative_spread": s, "K": K, "K_star": smap.K_star[i],
@@ -316,11 +321,19 @@ def _run_coupling_map(args: argparse.Namespace, log: logging.Logger, comm: MPI.C
 # --- the elastic interaction of contacts --------------------------------------------------------
 
 def _far_bins(n: int, lambda_c: float) -> int:
-    """How many of the response's distance bins lie beyond 3 λ_c (the far law's range)."""
+    """How many points of the response's profile lie beyond 3 λ_c (the far law's range): the
+    lattice's distances from the centre contact, binned as the profile bins them (empty bins
+    dropped, each bin at the geometric mean of its distances), not the bins' own centres —
+    on a small lattice many bins are empty and a bin's sites sit off its centre."""
     import numpy as np
 
-    edges = np.geomspace(1.0, n / 4, 40)
-    return int(np.count_nonzero(np.sqrt(edges[1:] * edges[:-1]) > 3 * lambda_c))
+    from fenicsfriction.studies.multicontact import radial_profile
+
+    i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
+    positions = np.stack([i.ravel(), j.ravel()], axis=1).astype(float)
+    r, _ = radial_profile(positions, np.ones((n * n, 1)), (n // 2) * n + n // 2,
+                          edges=np.geomspace(1.0, n / 4, 40))
+    return int(np.count_nonzero(r > 3 * lambda_c))
 
 
 def _smallest_n(lambda_c: float) -> int:
