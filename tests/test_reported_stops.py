@@ -22,8 +22,10 @@ import time
 from petsc4py import PETSc
 
 import pytest
+import scipy.integrate
 
-from fenicsfriction.cli import main
+from fenicsfriction.cli import common, main
+from fenicsfriction.results import CsvRows
 from fenicsfriction.studies.oscillators import BeltOscillator
 from fenicsfriction.studies.oscillators.slider import SliderMotion
 
@@ -35,6 +37,8 @@ BELT = ["--m=2.0", "--k=3.0", "--N=1.5", "--v-belt=0.4", "--mu-s=0.6", "--mu-k=0
 CALLS_BEFORE_SIGNAL = 600
 #: the steps a failing segment may take (``-<prefix>ts_max_steps``)
 MAX_STEPS = 40
+#: rows of block dynamics' table before the signal (the initial state and 5 steps)
+BLOCK_ROWS = 6
 
 
 def _run(argv: list[str], summary: str = "summary.json", options: dict | None = None) -> dict:
@@ -61,6 +65,37 @@ def _run(argv: list[str], summary: str = "summary.json", options: dict | None = 
             rows = [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
     return {"code": code, "json": data, "rows": rows, "stdout": out.getvalue().splitlines(),
             "stderr": err.getvalue().splitlines(), "seconds": seconds}
+
+
+def _signalled_at_row(rows: int, signum: int, argv: list[str]) -> dict:
+    """:func:`_run` with ``signum`` sent to this process as the ``rows``-th row is written."""
+    write, written = CsvRows.write, [0]
+
+    def write_then_signal(self, row):
+        write(self, row)
+        written[0] += 1
+        if written[0] == rows:
+            os.kill(os.getpid(), signum)
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(CsvRows, "write", write_then_signal)
+        return _run(argv)
+
+
+def _signalled_in_set_up(signum: int, argv: list[str]) -> dict:
+    """:func:`_run` with ``signum`` sent to this process while the command creates its output
+    folder (its set-up, before any step)."""
+    folder, sent = common.output_folder, [False]
+
+    def signal_then_folder(*args, **kwargs):
+        if not sent[0]:
+            sent[0] = True
+            os.kill(os.getpid(), signum)
+        return folder(*args, **kwargs)
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(common, "output_folder", signal_then_folder)
+        return _run(argv)
 
 
 def _signalled(system: type, signum: int, argv: list[str]) -> dict:
@@ -98,6 +133,11 @@ def runs(tmp_path_factory):
         "slider failed": _run([*slider, "--out", str(root / "slider-failed")],
                               options={"hybrid_ts_max_steps": MAX_STEPS}),
         "rolling failed": _run(rolling, "rolling.json", options={"rolling_snes_max_it": 1}),
+        "block stopped": _signalled_at_row(
+            BLOCK_ROWS, signal.SIGINT, ["block", "dynamics", "--mu", "0.6", "--belt-speed",
+                                        "0.08", "--t-end", "0.2", "--out", str(root / "block")]),
+        "set-up stopped": _signalled_in_set_up(signal.SIGTERM, [*belt, "--out",
+                                                                str(root / "set-up")]),
     }
 
 
@@ -172,3 +212,58 @@ def test_failed_rolling_fe_summary_names_the_point_and_newtons_reason(runs):
     assert re.match(r"\s*1 SNES Function norm", monitor[-1])
     assert norm == pytest.approx(float(monitor[-1].split()[-1]), rel=5e-4)
     assert run["stderr"][-1] == f"fenicsfriction: rolling fe: {summary['failure']}"
+
+
+def test_stopped_block_dynamics_summary_says_the_signal_and_what_was_integrated(runs):
+    """Exit 130; ``interrupted`` names SIGINT, the last row's time (6 digits) and its step
+    (the rows less the initial state); ``stage`` "time integration", ``failure`` null;
+    ``steps`` = the rows' steps; ``wall_time_s`` within the command's time; ``statistics``
+    over what was integrated: its totals (steps, Newton iterations, rejected steps) summed
+    from the rows, ``duration`` and ``t_to`` the last row's time, the window from half of it
+    (``t_from``, the first row at or after t/2), the mean forces the trapezoidal time means of
+    the window's rows (1e-12) and ``apparent_coefficient`` their ratio; ``max_energy_error``
+    the rows' largest |energy_error|."""
+    run = runs["block stopped"]
+    summary, rows = run["json"], run["rows"]
+    assert run["code"] == 130 and len(rows) == BLOCK_ROWS
+    t_last, steps = rows[-1]["time"], len(rows) - 1
+    assert summary["interrupted"] == (f"interrupted by SIGINT after t = {t_last:.6g} s "
+                                      f"(step {steps})")
+    assert run["stderr"][-1] == (f"fenicsfriction: {summary['interrupted']}; the results so "
+                                 "far are written")
+    assert summary["stage"] == "time integration" and summary["failure"] is None
+    assert summary["steps"] == steps and summary["sampled_every"] == 1
+    assert 0 < summary["wall_time_s"] < run["seconds"]
+    stats = summary["statistics"]
+    assert stats["steps"] == steps
+    for key in ("newton_iterations", "rejected_steps"):
+        assert stats[key] == sum(r[key] for r in rows)
+    assert stats["duration"] == stats["t_to"] == t_last
+    window = [r for r in rows if r["time"] >= t_last / 2]
+    assert stats["t_from"] == window[0]["time"]
+    t = [r["time"] for r in window]
+    for key in ("normal_force", "friction_force"):
+        mean = float(scipy.integrate.trapezoid([r[key] for r in window], t)) / (t[-1] - t[0])
+        assert stats[f"mean_{key}"] == pytest.approx(mean, rel=1e-12)
+    assert stats["apparent_coefficient"] == pytest.approx(
+        stats["mean_friction_force"] / stats["mean_normal_force"], rel=1e-12)
+    assert stats["max_energy_error"] == max(abs(r["energy_error"]) for r in rows)
+
+
+def test_set_up_stopped_summary_says_the_stage_and_the_command(runs):
+    """A signal during the set-up (here while the output folder is made): exit 143, nothing
+    integrated; summary.json holds the command as typed, ``stage`` "set-up", ``interrupted``
+    naming SIGTERM and the last stage passed (the start-up), ``failure`` null; the closing
+    line says the run had not begun its steps."""
+    run = runs["set-up stopped"]
+    summary = run["json"]
+    assert run["code"] == 143 and run["rows"] is None
+    assert set(summary) - {"environment"} == {"command", "stage", "interrupted", "failure"}
+    assert summary["command"] == ["fenicsfriction", "oscillators", "belt", *BELT, "--t-end",
+                                  "1000", "--out", summary["command"][-1]]
+    assert summary["command"][-1].endswith("set-up")
+    assert summary["stage"] == "set-up" and summary["failure"] is None
+    assert summary["interrupted"] == ("interrupted by SIGTERM after the start-up (flags read, "
+                                      "MPI and PETSc loaded)")
+    assert run["stderr"][-1] == (f"fenicsfriction: {summary['interrupted']}; the run had not "
+                                 "begun its steps")
