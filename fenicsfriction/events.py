@@ -238,7 +238,6 @@ class _Segment:
         self.stalled = self.spurious = False
 
     def _rhs(self, ts: PETSc.TS, t: float, x: PETSc.Vec, f: PETSc.Vec) -> None:
-        self.history.rhs_evaluations += 1
         self.locating += 1  # reset by each accepted step
         if self.locating > _MAX_LOCATION_TRIES and self.failure is None:
             self.stalled = True
@@ -249,6 +248,7 @@ class _Segment:
                             f"{self.event_tol:g}) or scale the event functions")
         if self.failure is not None:
             raise _Stop  # ends TSSolve: converged reasons do not end the location loop
+        self.history.rhs_evaluations += 1  # counted here: a stopped call evaluates nothing
         f.setArray(self.system.rhs(t, x.getArray(readonly=True), self.mode))
 
     def _events(self, ts: PETSc.TS, t: float, x: PETSc.Vec, fvalue: np.ndarray) -> None:

@@ -153,7 +153,11 @@ def _fe_records(model: typing.Any, p: dict, args: argparse.Namespace,
     """(records, results) of the creepages ``xi`` in turn, each from the last."""
     records, solutions = [], []
     for k, value in enumerate(xi):
-        solution = model.solve((value, args.eta, args.phi))
+        try:
+            solution = model.solve((value, args.eta, args.phi))
+        except RuntimeError as err:  # say where: which point of the curve, which creepages
+            raise RuntimeError(f"point {k + 1}/{len(xi)} (ξ = {value:.6g}, η = {args.eta:.6g}, "
+                               f"φ = {args.phi:.6g}): {err}") from err
         bound = p["mu"] * solution.Fn
         lateral = "" if model.dim == 2 else (
             f"  Fy/(μFn) = {solution.Fy / bound:+.5f}  Mz = {solution.Mz:.6g}")
