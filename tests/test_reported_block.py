@@ -22,8 +22,11 @@ import dataclasses
 import json
 import logging
 import pathlib
+import time
+import typing
 
 from mpi4py import MPI
+from petsc4py import PETSc
 
 import numpy as np
 import pytest
@@ -253,17 +256,58 @@ def _run_logged(argv: list[str]) -> list[str]:
     return lines.lines
 
 
+def _residual_norm(solver: typing.Any) -> float:
+    """‖F(u)‖₂ of the steady residual vector at the solver's state, assembled afresh: the
+    integrals, the driver spring, the Dirichlet rows (u − g) — the discrete equations whose
+    norm Newton drives below its tolerance."""
+    from fenicsfriction import _compat
+    from fenicsfriction.assembly import assemble_residual
+
+    b = solver.b.duplicate()
+    x = _compat.petsc_vec(solver.u)
+    assemble_residual(b, solver.L, solver.a, solver.residual.bcs, x, solver.residual.springs,
+                      solver.couplings)
+    norm = b.norm(PETSc.NormType.NORM_2)
+    b.destroy()
+    return float(norm)
+
+
 @pytest.fixture(scope="module")
 def steady(tmp_path_factory):
+    """The run, with the continuation it makes watched: at each converged target (where it
+    calls ``observe``) the residual norm is assembled afresh at the state, and the clock
+    read; the clock is read again as each record's ``on_step`` returns."""
+    import fenicsfriction.steady
+
     out = _shared_folder(tmp_path_factory, "steady") / "out"
-    lines = _run_logged(["block", "steady", "--mu-max", "0.9", "--steps", "3", "--snapshots",
-                         "0", "--out", str(out)])
+    real = fenicsfriction.steady.continuation
+    watched: dict[str, list[float]] = {"norms": [], "converged_at": [], "step_ends": []}
+
+    def continuation(solver, parameter, targets, observe=None, on_step=None, **options):
+        def observed():
+            watched["converged_at"].append(time.perf_counter())
+            watched["norms"].append(_residual_norm(solver))
+            return observe()
+
+        def stepped(record):
+            on_step(record)
+            watched["step_ends"].append(time.perf_counter())
+
+        watched["step_ends"].append(time.perf_counter())  # the first step starts here
+        return real(solver, parameter, targets, observe=observed, on_step=stepped, **options)
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(fenicsfriction.steady, "continuation", continuation)
+        start = time.perf_counter()
+        lines = _run_logged(["block", "steady", "--mu-max", "0.9", "--steps", "3",
+                             "--snapshots", "0", "--out", str(out)])
+        watched["elapsed"] = [time.perf_counter() - start]
     return (json.loads((out / "steady.json").read_text()),
-            json.loads((out / "summary.json").read_text()), lines)
+            json.loads((out / "summary.json").read_text()), lines, watched)
 
 
 def test_steady_records_and_summary_are_what_they_say(steady):
-    records, summary, _ = steady
+    records, summary, _, _ = steady
     p = summary["parameters"]
     law = p["law"]
     L, B0, W = p["L"], p["B0"], p["weight"]
@@ -308,7 +352,7 @@ def test_steady_records_and_summary_are_what_they_say(steady):
 def test_steady_progress_lines_repeat_the_records(steady):
     """Each step's line prints its record's μ, Newton count, |R|, N, F_T and x_cp (to the
     digits shown), and the first line the dofs and both tipping limits of the summary."""
-    records, summary, lines = steady
+    records, summary, lines, _ = steady
     if COMM.rank != 0:
         assert lines == []
         return
@@ -325,6 +369,45 @@ def test_steady_progress_lines_repeat_the_records(steady):
         assert f"|R|={r['residual_norm']:.2e}" in line
         assert f"N={r['normal_force']:.4g}" in line and f"F_T={r['friction_force']:.4g}" in line
         assert f"x_cp={r['centre_of_pressure']:.4g}" in line
+        assert line.endswith(f"  {r['wall_time_s']:.2f} s")
+    _closing_line_lists_the_files_written(lines[-1])
+
+
+def _closing_line_lists_the_files_written(closing: str) -> None:
+    """"results in OUT/: a, b, ...": every file in OUT is listed (an XDMF file's heavy data
+    beside it), and every file listed is there."""
+    assert closing.startswith("results in ")
+    folder, files = closing[len("results in "):].split("/: ", 1)
+    listed = set(files.split(", "))
+    heavy = {name.replace(".xdmf", ".h5") for name in listed if name.endswith(".xdmf")}
+    assert {p.name for p in pathlib.Path(folder).iterdir()} == listed | heavy
+
+
+def test_steady_residual_norm_and_wall_time_are_what_they_say(steady):
+    """``residual_norm``: ‖F(u)‖₂ of the discrete steady equations (SNES's function norm,
+    Dirichlet rows included) at the state the step reports, assembled again at that state
+    during the run; it is below the step's ``atol``, which is no looser than the flags'
+    1e-10 of the load. ``wall_time_s``: the time of that step alone (not cumulative), from
+    the previous step's end to its convergence."""
+    records, summary, _, watched = steady
+    norms = watched["norms"]
+    assert len(norms) == len(records)
+    for r, norm in zip(records, norms, strict=True):
+        # the same vector assembled again: equal to round-off in the last bits
+        assert r["residual_norm"] == pytest.approx(norm, rel=1e-9, abs=1e-300)
+        assert 0 < r["residual_norm"] <= r["atol"]
+    if COMM.rank != 0:  # the records hold rank 0's clock
+        return
+    starts, ends = watched["step_ends"][:-1], watched["converged_at"]
+    for r, start, end in zip(records, starts, ends, strict=True):
+        # the step's own window: from the previous record's end to this one's convergence
+        # (besides the solves, only the loop's bookkeeping: microseconds; 20 ms for a
+        # loaded machine's scheduling)
+        assert end - start - 0.02 <= r["wall_time_s"] <= end - start
+    # the steps, the compilation and the set-up lie within the run's wall time, itself
+    # within the command's
+    assert sum(r["wall_time_s"] for r in records) + summary["jit_time_s"] < \
+        summary["wall_time_s"] < watched["elapsed"][0]
 
 
 @pytest.fixture(scope="module")
@@ -388,3 +471,4 @@ def test_stability_progress_lines_repeat_the_loci(stability):
     assert closing == [f"μ_crit: FE {data['fe']['mu_crit']}, rigid {data['rigid']['mu_crit']}; "
                        f"FE unstable intervals by mode {data['fe']['unstable_intervals']}; "
                        f"rigid {data['rigid']['unstable_intervals']}"]
+    _closing_line_lists_the_files_written(lines[-1])

@@ -302,11 +302,100 @@ def test_press_drag_summary_is_recomputed_from_its_energy_table(press_drag):
     assert np.all(e["kinetic"] >= 0) and np.all(e["elastic"] >= 0)
     # the load P: the Hertz load of a = R/10
     assert p["load"] == pytest.approx(0.1**2 * np.pi * E_STAR / 4, rel=1e-12)
-    assert s["dofs"] > 0 and s["contact_period"] > 0 and 0 < s["wall_time_s"] < elapsed
+    assert 0 < s["wall_time_s"] < elapsed
     if COMM.rank == 0:
+        # the first line: "press-drag: <dofs> dofs on <ranks> rank(s), ..., dt = <dt>
+        # (contact period <period>), t_end = <t_end>"
+        numbers = _headline(out, "press-drag:")
+        assert numbers[:2] == [s["dofs"], COMM.size]
+        assert numbers[-3:] == pytest.approx([s["dt"], s["contact_period"], 1.0], rel=5e-3)
         error, dissipated, penetration, steps, cutbacks, newton = _headline(
             out, "energy balance error")
         assert (error, dissipated, penetration) == pytest.approx(
             (s["energy_balance_error"], s["dissipated"], s["max_penetration"]), rel=1e-3)
         assert (steps, cutbacks, newton) == (s["steps"], s["rejected_steps"],
                                              s["newton_iterations"])
+
+
+def _press_drag_mesh(folder: pathlib.Path) -> dict[str, np.ndarray] | None:
+    """The press-drag scene's mesh, made again by gmsh (the scene's default h_contact = 0.05
+    R) and read back from its .msh file on rank 0 through gmsh's own API: node coordinates,
+    the triangles of both bodies and the segments of the slave arc and the master face, as
+    arrays of node indices (None on the other ranks)."""
+    from fenicsfriction.studies.contact import geometry
+
+    msh = folder / "press_drag.msh"
+    geometry.hertz_2d(COMM, R=1.0, h_contact=0.05, msh_file=str(msh))
+    if COMM.rank != 0:
+        return None
+    import gmsh
+
+    owns = not getattr(gmsh, "isInitialized", lambda: False)()  # gmsh < 4.11 lacks it
+    if owns:
+        gmsh.initialize(readConfigFiles=False)
+    gmsh.option.setNumber("General.Terminal", 0)
+    try:
+        gmsh.open(str(msh))
+        tags, coordinates, _ = gmsh.model.mesh.getNodes()
+        index = {int(t): k for k, t in enumerate(tags)}
+        x = np.asarray(coordinates).reshape(-1, 3)[:, :2]
+
+        def elements(dim: int, group: int, nodes: int) -> np.ndarray:
+            found = []
+            for entity in gmsh.model.getEntitiesForPhysicalGroup(dim, group):
+                types, _, connectivity = gmsh.model.mesh.getElements(dim, entity)
+                assert list(types) == [2 if dim == 2 else 1]  # linear triangles, segments
+                found.append(np.asarray(connectivity[0]).reshape(-1, nodes))
+            return np.vectorize(index.__getitem__)(np.concatenate(found))
+
+        return {"x": x, "cells": np.concatenate([elements(2, geometry.BODY1, 3),
+                                                 elements(2, geometry.BODY2, 3)]),
+                "slave": elements(1, geometry.SLAVE, 2),
+                "master": elements(1, geometry.MASTER, 2)}
+    finally:
+        gmsh.clear()
+        if owns:
+            gmsh.finalize()
+
+
+def test_press_drag_dofs_and_contact_period_are_what_they_say(press_drag, tmp_path_factory):
+    """dofs: two unknowns per node of the mesh. contact_period: 2π/ω with ω² the
+    contact springs' frequency bound on the row-sum lumped mass. Every slave node is taken in
+    contact, its spring the compliance c_n (linear law) over its tributary length,
+    k_i = c_n A_i. The springs sit between masses no lighter than the lightest node of the
+    slave arc or the master face: ω² = 2 max k_i / min m_j. The period and the bound are
+    recomputed here by hand from the mesh gmsh writes. The lumped mass of a P1 triangle
+    gives ρ|T|/3 to each corner, and a segment's length goes half to each end."""
+    out, _ = press_drag
+    s = _summary(out)
+    p = s["parameters"]
+    assert (p["h_contact"], p["radius"], p["passes"], p["formulation"]) == \
+        (0.05, 1.0, 1, "node-to-segment")
+    mesh = _press_drag_mesh(pathlib.Path(COMM.bcast(
+        str(tmp_path_factory.mktemp("msh")) if COMM.rank == 0 else None, root=0)))
+    if COMM.rank != 0:
+        return
+    assert mesh is not None
+    x, cells = mesh["x"], mesh["cells"]
+    used = np.unique(cells)
+    assert s["dofs"] == 2 * len(used)  # two components per node of the triangles
+    # the lumped (row-sum) mass: ρ |T| / 3 to each corner of each triangle
+    e1, e2 = x[cells[:, 1]] - x[cells[:, 0]], x[cells[:, 2]] - x[cells[:, 0]]
+    area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    mass = np.zeros(len(x))
+    np.add.at(mass, cells.ravel(), np.repeat(p["density"] * area / 3, 3))
+    # the slave nodes' tributary lengths: half of each segment to each end
+    slave = mesh["slave"]
+    length = np.linalg.norm(x[slave[:, 1]] - x[slave[:, 0]], axis=1)
+    tributary = np.zeros(len(x))
+    np.add.at(tributary, slave.ravel(), np.repeat(length / 2, 2))
+    assert tributary.sum() == pytest.approx(np.pi, rel=2e-3)  # the lower half-circle, πR
+    surfaces = np.unique(np.concatenate([slave.ravel(), mesh["master"].ravel()]))
+    omega2 = 2 * p["law"]["c_n"] * tributary.max() / mass[surfaces].min()
+    assert s["contact_period"] == pytest.approx(2 * np.pi / np.sqrt(omega2), rel=1e-10)
+    # the --dt given (0.05) is longer than an eighth of the period: the run said so, in one
+    # line naming the period and the longest step that resolves it
+    period, longest, steps = _headline(out, "warning: dt = 0.05 does not resolve")[1:]
+    assert (period, longest, steps) == pytest.approx(
+        (s["contact_period"], s["contact_period"] / 8, 8), rel=5e-3)
+    assert s["contact_period"] / 8 < 0.05
