@@ -17,11 +17,14 @@ closed-form frequencies. The ``statistics`` block of
 docs/verification.md, under "Reported figures".
 """
 
+import contextlib
 import csv
 import dataclasses
+import io
 import json
 import logging
 import pathlib
+import re
 import time
 import typing
 
@@ -281,7 +284,7 @@ def steady(tmp_path_factory):
 
     out = _shared_folder(tmp_path_factory, "steady") / "out"
     real = fenicsfriction.steady.continuation
-    watched: dict[str, list[float]] = {"norms": [], "converged_at": [], "step_ends": []}
+    watched: dict[str, typing.Any] = {"norms": [], "converged_at": [], "step_ends": []}
 
     def continuation(solver, parameter, targets, observe=None, on_step=None, **options):
         def observed():
@@ -296,12 +299,14 @@ def steady(tmp_path_factory):
         watched["step_ends"].append(time.perf_counter())  # the first step starts here
         return real(solver, parameter, targets, observe=observed, on_step=stepped, **options)
 
-    with pytest.MonkeyPatch.context() as patch:
+    printed = io.StringIO()  # PETSc's own monitor of each Newton iteration, with the lines
+    with pytest.MonkeyPatch.context() as patch, contextlib.redirect_stdout(printed):
         patch.setattr(fenicsfriction.steady, "continuation", continuation)
         start = time.perf_counter()
         lines = _run_logged(["block", "steady", "--mu-max", "0.9", "--steps", "3",
-                             "--snapshots", "0", "--out", str(out)])
+                             "--snapshots", "0", "--out", str(out), "-steady_snes_monitor"])
         watched["elapsed"] = [time.perf_counter() - start]
+    watched["printed"] = printed.getvalue().splitlines()
     return (json.loads((out / "steady.json").read_text()),
             json.loads((out / "summary.json").read_text()), lines, watched)
 
@@ -396,8 +401,18 @@ def test_steady_residual_norm_and_wall_time_are_what_they_say(steady):
         # the same vector assembled again: equal to round-off in the last bits
         assert r["residual_norm"] == pytest.approx(norm, rel=1e-9, abs=1e-300)
         assert 0 < r["residual_norm"] <= r["atol"]
-    if COMM.rank != 0:  # the records hold rank 0's clock
+    if COMM.rank != 0:  # the records hold rank 0's clock; PETSc's monitor prints there
         return
+    # PETSc's monitor: "k SNES Function norm <norm>" per iteration, k = 0 at each solve's
+    # start; a step's Newton iterations are its lines with k >= 1, its residual norm the last
+    # line's (printed to 13 digits)
+    monitor = [(int(k), float(norm)) for k, norm in re.findall(
+        r"^\s*(\d+) SNES Function norm (\S+)", "\n".join(watched["printed"]), re.MULTILINE)]
+    solves = [k for k, (it, _) in enumerate(monitor) if it == 0] + [len(monitor)]
+    assert len(solves) - 1 == len(records)  # one solve a step: no halving, no search round
+    for r, first, end in zip(records, solves[:-1], solves[1:], strict=True):
+        assert r["newton_iterations"] == end - first - 1 >= 1
+        assert r["residual_norm"] == pytest.approx(monitor[end - 1][1], rel=1e-12)
     starts, ends = watched["step_ends"][:-1], watched["converged_at"]
     for r, start, end in zip(records, starts, ends, strict=True):
         # the step's own window: from the previous record's end to this one's convergence
