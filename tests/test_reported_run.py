@@ -3,8 +3,9 @@
 block pressed on a belt, with a steady continuation in μ, the CEA and a short transient.
 Figures are recomputed from the tables, or compared with closed forms: the pressure's
 resultant, Coulomb's friction, the driver spring's rigid-body frequency and the growth
-exp(Re λ t) of an unstable mode. The audit table is in docs/verification.md, under
-"Reported figures".
+exp(Re λ t) of an unstable mode. The lines the run logs are parsed and compared with the
+files, and its closing line with the folder. The audit table is in docs/verification.md,
+under "Reported figures".
 """
 
 import csv
