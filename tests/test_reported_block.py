@@ -19,12 +19,14 @@ docs/verification.md, under "Reported figures".
 
 import contextlib
 import csv
+import ctypes
 import dataclasses
-import io
 import json
 import logging
+import os
 import pathlib
 import re
+import sys
 import time
 import typing
 
@@ -259,6 +261,28 @@ def _run_logged(argv: list[str]) -> list[str]:
     return lines.lines
 
 
+@contextlib.contextmanager
+def _stdout_into(path: pathlib.Path) -> typing.Iterator[None]:
+    """Everything printed, by Python (the progress lines) and by PETSc's C code (its SNES
+    monitor), into ``path`` in the order printed: file descriptor 1 is pointed at the file
+    and ``sys.stdout`` written through it line by line (PETSc flushes each print). petsc4py
+    sends PETSc's printing through ``sys.stdout`` under pytest's capture and straight to the
+    descriptor under ``pytest -s``: both land here."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    target = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
+    os.dup2(target, 1)
+    os.close(target)
+    try:
+        with open(1, "w", buffering=1, closefd=False) as stream, \
+                contextlib.redirect_stdout(stream):
+            yield
+    finally:
+        ctypes.CDLL(None).fflush(None)
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
 def _residual_norm(solver: typing.Any) -> float:
     """‖F(u)‖₂ of the steady residual vector at the solver's state, assembled afresh: the
     integrals, the driver spring, the Dirichlet rows (u − g) — the discrete equations whose
@@ -282,7 +306,8 @@ def steady(tmp_path_factory):
     read; the clock is read again as each record's ``on_step`` returns."""
     import fenicsfriction.steady
 
-    out = _shared_folder(tmp_path_factory, "steady") / "out"
+    folder = _shared_folder(tmp_path_factory, "steady")
+    out = folder / "out"
     real = fenicsfriction.steady.continuation
     watched: dict[str, typing.Any] = {"norms": [], "converged_at": [], "step_ends": []}
 
@@ -299,8 +324,8 @@ def steady(tmp_path_factory):
         watched["step_ends"].append(time.perf_counter())  # the first step starts here
         return real(solver, parameter, targets, observe=observed, on_step=stepped, **options)
 
-    printed = io.StringIO()  # PETSc's own monitor of each Newton iteration, with the lines
-    with pytest.MonkeyPatch.context() as patch, contextlib.redirect_stdout(printed):
+    printed = folder / f"stdout{COMM.rank}.txt"  # with PETSc's monitor of each iteration
+    with pytest.MonkeyPatch.context() as patch, _stdout_into(printed):
         patch.setattr(fenicsfriction.steady, "continuation", continuation)
         start = time.perf_counter()
         try:
@@ -309,7 +334,7 @@ def steady(tmp_path_factory):
         finally:  # the option stays in PETSc's database: the later solvers need not print
             PETSc.Options().delValue("steady_snes_monitor")
         watched["elapsed"] = [time.perf_counter() - start]
-    watched["printed"] = printed.getvalue().splitlines()
+    watched["printed"] = printed.read_text().splitlines()
     return (json.loads((out / "steady.json").read_text()),
             json.loads((out / "summary.json").read_text()), lines, watched)
 
@@ -418,10 +443,10 @@ def test_steady_residual_norm_and_wall_time_are_what_they_say(steady):
         assert r["residual_norm"] == pytest.approx(monitor[end - 1][1], rel=1e-12)
     starts, ends = watched["step_ends"][:-1], watched["converged_at"]
     for r, start, end in zip(records, starts, ends, strict=True):
-        # the step's own window: from the previous record's end to this one's convergence
-        # (besides the solves, only the loop's bookkeeping: microseconds; 20 ms for a
-        # loaded machine's scheduling)
-        assert end - start - 0.02 <= r["wall_time_s"] <= end - start
+        # the step's own window: from the previous record's end to this one's convergence.
+        # It holds the step's time and the loop's bookkeeping (microseconds; 0.1 s allowed
+        # for a loaded machine's scheduling); a time counted from an earlier start exceeds it
+        assert end - start - 0.1 <= r["wall_time_s"] <= end - start
     # the steps, the compilation and the set-up lie within the run's wall time, itself
     # within the command's
     assert sum(r["wall_time_s"] for r in records) + summary["jit_time_s"] < \
@@ -435,7 +460,8 @@ def stability(tmp_path_factory):
     lines = _run_logged(["block", "stability", "--mu-max", "0.2", "--steps", "1", "--out",
                          str(out)])
     data = json.loads((out / "stability.json").read_text())
-    assert 0 < data["wall_time_s"] < time.perf_counter() - start  # within the command's
+    if COMM.rank == 0:  # rank 0's clock, within the command's time
+        assert 0 < data["wall_time_s"] < time.perf_counter() - start
     return data, lines
 
 

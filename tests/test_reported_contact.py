@@ -13,12 +13,15 @@ docs/verification.md, under "Reported figures".
 
 import contextlib
 import csv
-import io
+import ctypes
 import json
 import logging
+import os
 import pathlib
 import re
+import sys
 import time
+import typing
 
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -47,21 +50,43 @@ class _Lines(logging.Handler):
         self.lines.append(record.getMessage())
 
 
+@contextlib.contextmanager
+def _stdout_into(path: pathlib.Path) -> typing.Iterator[None]:
+    """Everything printed, by Python (the progress lines) and by PETSc's C code (its SNES
+    monitor), into ``path`` in the order printed: file descriptor 1 is pointed at the file
+    and ``sys.stdout`` written through it line by line (PETSc flushes each print). petsc4py
+    sends PETSc's printing through ``sys.stdout`` under pytest's capture and straight to the
+    descriptor under ``pytest -s``: both land here."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    target = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
+    os.dup2(target, 1)
+    os.close(target)
+    try:
+        with open(1, "w", buffering=1, closefd=False) as stream, \
+                contextlib.redirect_stdout(stream):
+            yield
+    finally:
+        ctypes.CDLL(None).fflush(None)
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
 def _run(factory: pytest.TempPathFactory, name: str, argv: list[str], prefix: str = "contact_"
          ) -> tuple[pathlib.Path, float]:
     """Run ``contact NAME ARGV`` into a module-wide folder; (folder, elapsed seconds). The
     lines it logs are kept in ``folder/lines.json``. PETSc's own monitor of the Newton
-    iterations of the solvers of ``prefix`` prints among its printed lines
-    (``folder/stdout.txt``)."""
+    iterations of the solvers of ``prefix`` prints among its printed lines (kept beside
+    the folder, ``stdout<rank>.txt``)."""
     path = factory.mktemp(name) if COMM.rank == 0 else None
-    out = pathlib.Path(COMM.bcast(path, root=0)) / "out"
+    folder = pathlib.Path(COMM.bcast(path, root=0))
+    out = folder / "out"
     logger = get_logger(COMM)  # the package's handlers first, then ours
     lines = _Lines()
     logger.addHandler(lines)
-    printed = io.StringIO()
     start = time.perf_counter()
     try:
-        with contextlib.redirect_stdout(printed):
+        with _stdout_into(folder / f"stdout{COMM.rank}.txt"):
             assert main(["contact", name, *argv, "--out", str(out),
                          f"-{prefix}snes_monitor"]) == 0
     finally:
@@ -70,7 +95,6 @@ def _run(factory: pytest.TempPathFactory, name: str, argv: list[str], prefix: st
         PETSc.Options().delValue(f"{prefix}snes_monitor")
     if COMM.rank == 0:
         (out / "lines.json").write_text(json.dumps(lines.lines))
-        (out / "stdout.txt").write_text(printed.getvalue())
     COMM.Barrier()
     return out, time.perf_counter() - start
 
@@ -80,7 +104,7 @@ def _newton(out: pathlib.Path) -> list[tuple[str, int, int]]:
     solve's start), gathered before each other line: (that line, the Newton iterations since
     the line before, i.e. the monitor's lines with k >= 1, and the solves started, k = 0)."""
     found, iterations, solves = [], 0, 0
-    for line in (out / "stdout.txt").read_text().splitlines():
+    for line in (out.parent / "stdout0.txt").read_text().splitlines():
         step = re.match(r"\s*(\d+) SNES Function norm", line)
         if step is None:
             found.append((line, iterations, solves))
