@@ -167,6 +167,7 @@ def dynamics(tmp_path_factory):
         logger.removeHandler(lines)
     headline = [x for x in lines.lines if x.startswith("apparent friction coefficient")]
     if COMM.rank == 0:
+        _closing_line_lists_the_files_written(lines.lines[-1])
         summary = json.loads((out / "summary.json").read_text())["statistics"]
         # "apparent friction coefficient <4 decimals> (μ = <mu>), probe node sticks <%>"
         assert headline == [f"apparent friction coefficient "

@@ -125,6 +125,16 @@ def _headline(out: pathlib.Path, start: str) -> list[float]:
     return [float(v) for v in re.findall(number, lines[-1])]
 
 
+def _closing_line_lists_the_files_written(out: pathlib.Path) -> None:
+    """The last logged line, "results in OUT/: a, b, ...": every file the command wrote to
+    OUT is listed (an XDMF file's heavy data beside it), and every file listed is there."""
+    closing = json.loads((out / "lines.json").read_text())[-1]
+    assert closing.startswith(f"results in {out}/: ")
+    listed = set(closing.split("/: ", 1)[1].split(", "))
+    heavy = {name.replace(".xdmf", ".h5") for name in listed if name.endswith(".xdmf")}
+    assert {p.name for p in out.iterdir()} - {"lines.json"} == listed | heavy
+
+
 def _summary(out: pathlib.Path) -> dict:
     return json.loads((out / "contact.json").read_text())
 
@@ -184,6 +194,7 @@ def test_hertz_dofs_approach_and_wall_time_are_what_they_say(hertz):
     assert s["cutbacks"] == 0
     if COMM.rank == 0:  # the first line: "hertz 2D: <dofs> dofs on <ranks> rank(s), ..."
         assert _headline(out, "hertz 2D")[1:3] == [s["dofs"], COMM.size]
+        _closing_line_lists_the_files_written(out)
         # solves and Newton iterations: PETSc's count, one solve per approach the load
         # search tries, each approach's line saying its own
         newton = _newton(out)
@@ -245,6 +256,7 @@ def test_patch_figures_are_the_uniform_pressure_and_its_deviations(patch):
             elif line.startswith(("one pass:", "two pass:")):
                 current = None
         assert passes == s["newton_iterations"]
+        _closing_line_lists_the_files_written(out)
 
 
 # --- cattaneo ---------------------------------------------------------------------------------
@@ -344,6 +356,7 @@ def test_cattaneo_figures_against_the_table_and_cattaneo_mindlin(cattaneo):
         for (line, iterations), row in zip(increments, s["increments"], strict=True):
             assert row["newton_iterations"] == iterations
             assert line.endswith(f"Newton {iterations}")
+        _closing_line_lists_the_files_written(out)
 
 
 # --- press-drag ---------------------------------------------------------------------------------
@@ -402,6 +415,7 @@ def test_press_drag_summary_is_recomputed_from_its_energy_table(press_drag):
                                              s["newton_iterations"])
         # PETSc's count of the Newton iterations over the run
         assert s["newton_iterations"] == sum(k for _, k, _ in _newton(out))
+        _closing_line_lists_the_files_written(out)
 
 
 def _press_drag_mesh(folder: pathlib.Path) -> dict[str, np.ndarray] | None:
