@@ -204,8 +204,10 @@ def test_transient_grows_at_re_lambda_and_its_rate_is_the_tables(run):
     np.testing.assert_allclose(amplitude, 1e-6 * np.exp(top["re"] * t), rtol=1e-4)
 
 
-#: a number as the progress lines print it (not one inside a word, such as the 0 of contact0)
-NUMBER = r"(?<![\w.])[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?"
+#: a number as the progress lines print it
+VALUE = r"[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?"
+#: one standing alone (not inside a word, such as the 0 of contact0)
+NUMBER = r"(?<![\w.])" + VALUE
 
 
 def _nodes(xdmf: pathlib.Path) -> int:
@@ -236,7 +238,7 @@ def test_headline_lines_say_what_the_files_hold(run):
     for k, (line, row, step) in enumerate(zip(steps, summary["steady"], summary["cea"],
                                               strict=True)):
         assert line.startswith(f"step {k:3d}/2  mu=")
-        numbers = dict(re.findall(r"(\w+)=(" + NUMBER[len("(?<![\\w.])"):] + ")", line))
+        numbers = dict(re.findall(rf"(\w+)=({VALUE})", line))
         assert float(numbers["mu"]) == pytest.approx(row["mu"], abs=1e-6)
         for key in ("contact0_normal_force", "contact0_friction_force_x"):
             assert float(numbers[key]) == pytest.approx(row[key], rel=5e-4, abs=1e-12)
