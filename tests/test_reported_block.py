@@ -17,13 +17,21 @@ closed-form frequencies. The ``statistics`` block of
 docs/verification.md, under "Reported figures".
 """
 
+import contextlib
 import csv
+import ctypes
 import dataclasses
 import json
 import logging
+import os
 import pathlib
+import re
+import sys
+import time
+import typing
 
 from mpi4py import MPI
+from petsc4py import PETSc
 
 import numpy as np
 import pytest
@@ -159,6 +167,7 @@ def dynamics(tmp_path_factory):
         logger.removeHandler(lines)
     headline = [x for x in lines.lines if x.startswith("apparent friction coefficient")]
     if COMM.rank == 0:
+        _closing_line_lists_the_files_written(lines.lines[-1])
         summary = json.loads((out / "summary.json").read_text())["statistics"]
         # "apparent friction coefficient <4 decimals> (μ = <mu>), probe node sticks <%>"
         assert headline == [f"apparent friction coefficient "
@@ -253,17 +262,86 @@ def _run_logged(argv: list[str]) -> list[str]:
     return lines.lines
 
 
+@contextlib.contextmanager
+def _stdout_into(path: pathlib.Path) -> typing.Iterator[None]:
+    """Everything printed, by Python (the progress lines) and by PETSc's C code (its SNES
+    monitor), into ``path`` in the order printed: file descriptor 1 is pointed at the file
+    and ``sys.stdout`` written through it line by line (PETSc flushes each print). petsc4py
+    sends PETSc's printing through ``sys.stdout`` under pytest's capture and straight to the
+    descriptor under ``pytest -s``: both land here."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    target = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
+    os.dup2(target, 1)
+    os.close(target)
+    try:
+        with open(1, "w", buffering=1, closefd=False) as stream, \
+                contextlib.redirect_stdout(stream):
+            yield
+    finally:
+        ctypes.CDLL(None).fflush(None)
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
+def _residual_norm(solver: typing.Any) -> float:
+    """‖F(u)‖₂ of the steady residual vector at the solver's state, assembled afresh: the
+    integrals, the driver spring, the Dirichlet rows (u − g) — the discrete equations whose
+    norm Newton drives below its tolerance."""
+    from fenicsfriction import _compat
+    from fenicsfriction.assembly import assemble_residual
+
+    b = solver.b.duplicate()
+    x = _compat.petsc_vec(solver.u)
+    assemble_residual(b, solver.L, solver.a, solver.residual.bcs, x, solver.residual.springs,
+                      solver.couplings)
+    norm = b.norm(PETSc.NormType.NORM_2)
+    b.destroy()
+    return float(norm)
+
+
 @pytest.fixture(scope="module")
 def steady(tmp_path_factory):
-    out = _shared_folder(tmp_path_factory, "steady") / "out"
-    lines = _run_logged(["block", "steady", "--mu-max", "0.9", "--steps", "3", "--snapshots",
-                         "0", "--out", str(out)])
+    """The run, with the continuation it makes watched: at each converged target (where it
+    calls ``observe``) the residual norm is assembled afresh at the state, and the clock
+    read; the clock is read again as each record's ``on_step`` returns."""
+    import fenicsfriction.steady
+
+    folder = _shared_folder(tmp_path_factory, "steady")
+    out = folder / "out"
+    real = fenicsfriction.steady.continuation
+    watched: dict[str, typing.Any] = {"norms": [], "converged_at": [], "step_ends": []}
+
+    def continuation(solver, parameter, targets, observe=None, on_step=None, **options):
+        def observed():
+            watched["converged_at"].append(time.perf_counter())
+            watched["norms"].append(_residual_norm(solver))
+            return observe()
+
+        def stepped(record):
+            on_step(record)
+            watched["step_ends"].append(time.perf_counter())
+
+        watched["step_ends"].append(time.perf_counter())  # the first step starts here
+        return real(solver, parameter, targets, observe=observed, on_step=stepped, **options)
+
+    printed = folder / f"stdout{COMM.rank}.txt"  # with PETSc's monitor of each iteration
+    with pytest.MonkeyPatch.context() as patch, _stdout_into(printed):
+        patch.setattr(fenicsfriction.steady, "continuation", continuation)
+        start = time.perf_counter()
+        try:
+            lines = _run_logged(["block", "steady", "--mu-max", "0.9", "--steps", "3",
+                                 "--snapshots", "0", "--out", str(out), "-steady_snes_monitor"])
+        finally:  # the option stays in PETSc's database: the later solvers need not print
+            PETSc.Options().delValue("steady_snes_monitor")
+        watched["elapsed"] = [time.perf_counter() - start]
+    watched["printed"] = printed.read_text().splitlines()
     return (json.loads((out / "steady.json").read_text()),
-            json.loads((out / "summary.json").read_text()), lines)
+            json.loads((out / "summary.json").read_text()), lines, watched)
 
 
 def test_steady_records_and_summary_are_what_they_say(steady):
-    records, summary, _ = steady
+    records, summary, _, _ = steady
     p = summary["parameters"]
     law = p["law"]
     L, B0, W = p["L"], p["B0"], p["weight"]
@@ -308,7 +386,7 @@ def test_steady_records_and_summary_are_what_they_say(steady):
 def test_steady_progress_lines_repeat_the_records(steady):
     """Each step's line prints its record's μ, Newton count, |R|, N, F_T and x_cp (to the
     digits shown), and the first line the dofs and both tipping limits of the summary."""
-    records, summary, lines = steady
+    records, summary, lines, _ = steady
     if COMM.rank != 0:
         assert lines == []
         return
@@ -325,14 +403,69 @@ def test_steady_progress_lines_repeat_the_records(steady):
         assert f"|R|={r['residual_norm']:.2e}" in line
         assert f"N={r['normal_force']:.4g}" in line and f"F_T={r['friction_force']:.4g}" in line
         assert f"x_cp={r['centre_of_pressure']:.4g}" in line
+        assert line.endswith(f"  {r['wall_time_s']:.2f} s")
+    _closing_line_lists_the_files_written(lines[-1])
+
+
+def _closing_line_lists_the_files_written(closing: str) -> None:
+    """"results in OUT/: a, b, ...": every file in OUT is listed (an XDMF file's heavy data
+    beside it), and every file listed is there."""
+    assert closing.startswith("results in ")
+    folder, files = closing[len("results in "):].split("/: ", 1)
+    listed = set(files.split(", "))
+    heavy = {name.replace(".xdmf", ".h5") for name in listed if name.endswith(".xdmf")}
+    assert {p.name for p in pathlib.Path(folder).iterdir()} == listed | heavy
+
+
+def test_steady_residual_norm_and_wall_time_are_what_they_say(steady):
+    """``residual_norm``: ‖F(u)‖₂ of the discrete steady equations (SNES's function norm,
+    Dirichlet rows included) at the state the step reports, assembled again at that state
+    during the run, and PETSc's own monitor's last line of the step's solve; at most the
+    step's ``atol`` (1e-10 of the load, raised to the Jacobian's round-off floor where that
+    is higher: 4.5e-8 at μ = 0, 1.1e-5 to 3.3e-5 beyond, measured). ``newton_iterations``:
+    the monitor's iterations of that solve. ``wall_time_s``: the time of that step alone (not
+    cumulative), from the previous step's end to its convergence."""
+    records, summary, _, watched = steady
+    norms = watched["norms"]
+    assert len(norms) == len(records)
+    for r, norm in zip(records, norms, strict=True):
+        # the same vector assembled again: equal to round-off in the last bits
+        assert r["residual_norm"] == pytest.approx(norm, rel=1e-9, abs=1e-300)
+        assert 0 < r["residual_norm"] <= r["atol"]
+    if COMM.rank != 0:  # the records hold rank 0's clock; PETSc's monitor prints there
+        return
+    # PETSc's monitor: "k SNES Function norm <norm>" per iteration, k = 0 at each solve's
+    # start; a step's Newton iterations are its lines with k >= 1, its residual norm the last
+    # line's (printed to 13 digits)
+    monitor = [(int(k), float(norm)) for k, norm in re.findall(
+        r"^\s*(\d+) SNES Function norm (\S+)", "\n".join(watched["printed"]), re.MULTILINE)]
+    solves = [k for k, (it, _) in enumerate(monitor) if it == 0] + [len(monitor)]
+    assert len(solves) - 1 == len(records)  # one solve a step: no halving, no search round
+    for r, first, end in zip(records, solves[:-1], solves[1:], strict=True):
+        assert r["newton_iterations"] == end - first - 1 >= 1
+        assert r["residual_norm"] == pytest.approx(monitor[end - 1][1], rel=1e-12)
+    starts, ends = watched["step_ends"][:-1], watched["converged_at"]
+    for r, start, end in zip(records, starts, ends, strict=True):
+        # the step's own window: from the previous record's end to this one's convergence.
+        # It holds the step's time and the loop's bookkeeping (microseconds; 0.1 s allowed
+        # for a loaded machine's scheduling); a time counted from an earlier start exceeds it
+        assert end - start - 0.1 <= r["wall_time_s"] <= end - start
+    # the steps, the compilation and the set-up lie within the run's wall time, itself
+    # within the command's
+    assert sum(r["wall_time_s"] for r in records) + summary["jit_time_s"] < \
+        summary["wall_time_s"] < watched["elapsed"][0]
 
 
 @pytest.fixture(scope="module")
 def stability(tmp_path_factory):
     out = _shared_folder(tmp_path_factory, "stability") / "out"
+    start = time.perf_counter()
     lines = _run_logged(["block", "stability", "--mu-max", "0.2", "--steps", "1", "--out",
                          str(out)])
-    return json.loads((out / "stability.json").read_text()), lines
+    data = json.loads((out / "stability.json").read_text())
+    if COMM.rank == 0:  # rank 0's clock, within the command's time
+        assert 0 < data["wall_time_s"] < time.perf_counter() - start
+    return data, lines
 
 
 def test_stability_loci_at_mu_0_are_the_rigid_blocks_frequencies(stability):
@@ -388,3 +521,4 @@ def test_stability_progress_lines_repeat_the_loci(stability):
     assert closing == [f"μ_crit: FE {data['fe']['mu_crit']}, rigid {data['rigid']['mu_crit']}; "
                        f"FE unstable intervals by mode {data['fe']['unstable_intervals']}; "
                        f"rigid {data['rigid']['unstable_intervals']}"]
+    _closing_line_lists_the_files_written(lines[-1])

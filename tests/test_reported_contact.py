@@ -5,18 +5,26 @@ then recomputed from the tables written beside it (``surface.csv``, ``energy.csv
 mesh written (the node count in ``bodies.xdmf``), or compared with an independent closed
 form: a uniform pressure for the patch test, Hertz and Cattaneo-Mindlin (Johnson 1985,
 chapters 4 and 7), written out here rather than taken from the package's ``closed_forms``.
-Hertz's half-width, peak pressure and fits are checked in tests/test_cli_contact.py. The
-audit table is in docs/verification.md, under "Reported figures".
+Press-drag's contact period is recomputed by hand from the mesh gmsh writes. Newton
+counts are PETSc's own (its SNES monitor, printed during the run). Hertz's half-width, peak
+pressure and fits are checked in tests/test_cli_contact.py. The audit table is in
+docs/verification.md, under "Reported figures".
 """
 
+import contextlib
 import csv
+import ctypes
 import json
 import logging
+import os
 import pathlib
 import re
+import sys
 import time
+import typing
 
 from mpi4py import MPI
+from petsc4py import PETSc
 
 import numpy as np
 import pytest
@@ -42,24 +50,70 @@ class _Lines(logging.Handler):
         self.lines.append(record.getMessage())
 
 
-def _run(factory: pytest.TempPathFactory, name: str, argv: list[str]
+@contextlib.contextmanager
+def _stdout_into(path: pathlib.Path) -> typing.Iterator[None]:
+    """Everything printed, by Python (the progress lines) and by PETSc's C code (its SNES
+    monitor), into ``path`` in the order printed: file descriptor 1 is pointed at the file
+    and ``sys.stdout`` written through it line by line (PETSc flushes each print). petsc4py
+    sends PETSc's printing through ``sys.stdout`` under pytest's capture and straight to the
+    descriptor under ``pytest -s``: both land here."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    target = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
+    os.dup2(target, 1)
+    os.close(target)
+    try:
+        with open(1, "w", buffering=1, closefd=False) as stream, \
+                contextlib.redirect_stdout(stream):
+            yield
+    finally:
+        ctypes.CDLL(None).fflush(None)
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
+def _run(factory: pytest.TempPathFactory, name: str, argv: list[str], prefix: str = "contact_"
          ) -> tuple[pathlib.Path, float]:
     """Run ``contact NAME ARGV`` into a module-wide folder; (folder, elapsed seconds). The
-    lines it logs are kept in ``folder/lines.json``."""
+    lines it logs are kept in ``folder/lines.json``. PETSc's own monitor of the Newton
+    iterations of the solvers of ``prefix`` prints among its printed lines (kept beside
+    the folder, ``stdout<rank>.txt``)."""
     path = factory.mktemp(name) if COMM.rank == 0 else None
-    out = pathlib.Path(COMM.bcast(path, root=0)) / "out"
+    folder = pathlib.Path(COMM.bcast(path, root=0))
+    out = folder / "out"
     logger = get_logger(COMM)  # the package's handlers first, then ours
     lines = _Lines()
     logger.addHandler(lines)
     start = time.perf_counter()
     try:
-        assert main(["contact", name, *argv, "--out", str(out)]) == 0
+        with _stdout_into(folder / f"stdout{COMM.rank}.txt"):
+            assert main(["contact", name, *argv, "--out", str(out),
+                         f"-{prefix}snes_monitor"]) == 0
     finally:
         logger.removeHandler(lines)
+        # the option stays in PETSc's database: the later solvers need not print
+        PETSc.Options().delValue(f"{prefix}snes_monitor")
     if COMM.rank == 0:
         (out / "lines.json").write_text(json.dumps(lines.lines))
     COMM.Barrier()
     return out, time.perf_counter() - start
+
+
+def _newton(out: pathlib.Path) -> list[tuple[str, int, int]]:
+    """PETSc's monitor in the printed lines ("k SNES Function norm ...", k = 0 at each
+    solve's start), gathered before each other line: (that line, the Newton iterations since
+    the line before, i.e. the monitor's lines with k >= 1, and the solves started, k = 0)."""
+    found, iterations, solves = [], 0, 0
+    for line in (out.parent / "stdout0.txt").read_text().splitlines():
+        step = re.match(r"\s*(\d+) SNES Function norm", line)
+        if step is None:
+            found.append((line, iterations, solves))
+            iterations, solves = 0, 0
+        elif int(step.group(1)) == 0:
+            solves += 1
+        else:
+            iterations += 1
+    return [*found, ("", iterations, solves)]
 
 
 def _headline(out: pathlib.Path, start: str) -> list[float]:
@@ -69,6 +123,16 @@ def _headline(out: pathlib.Path, start: str) -> list[float]:
     assert lines, start
     number = r"(?<![\w.])[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?"
     return [float(v) for v in re.findall(number, lines[-1])]
+
+
+def _closing_line_lists_the_files_written(out: pathlib.Path) -> None:
+    """The last logged line, "results in OUT/: a, b, ...": every file the command wrote to
+    OUT is listed (an XDMF file's heavy data beside it), and every file listed is there."""
+    closing = json.loads((out / "lines.json").read_text())[-1]
+    assert closing.startswith(f"results in {out}/: ")
+    listed = set(closing.split("/: ", 1)[1].split(", "))
+    heavy = {name.replace(".xdmf", ".h5") for name in listed if name.endswith(".xdmf")}
+    assert {p.name for p in out.iterdir()} - {"lines.json"} == listed | heavy
 
 
 def _summary(out: pathlib.Path) -> dict:
@@ -127,9 +191,18 @@ def test_hertz_dofs_approach_and_wall_time_are_what_they_say(hertz):
     # the load search stops at a relative 1e-5 (rtol of Hertz.run): the force at the
     # reported approach is the reported load to that
     assert model.normal_force() == pytest.approx(s["load"], rel=2e-5)
-    assert s["solves"] >= 1 and s["newton_iterations"] >= s["solves"] and s["cutbacks"] == 0
+    assert s["cutbacks"] == 0
     if COMM.rank == 0:  # the first line: "hertz 2D: <dofs> dofs on <ranks> rank(s), ..."
         assert _headline(out, "hertz 2D")[1:3] == [s["dofs"], COMM.size]
+        _closing_line_lists_the_files_written(out)
+        # solves and Newton iterations: PETSc's count, one solve per approach the load
+        # search tries, each approach's line saying its own
+        newton = _newton(out)
+        approaches = [x for x in newton if x[0].startswith("approach ")]
+        assert s["solves"] == len(approaches) == sum(n for *_, n in newton) >= 1
+        assert s["newton_iterations"] == sum(k for _, k, _ in newton)
+        for line, iterations, solves in approaches:
+            assert solves == 1 and line.endswith(f", {iterations} Newton iterations")
 
 
 # --- patch ------------------------------------------------------------------------------------
@@ -172,6 +245,18 @@ def test_patch_figures_are_the_uniform_pressure_and_its_deviations(patch):
             deviation, iterations = _headline(out, name.replace("_", " ") + ":")
             assert deviation == pytest.approx(s["pressure_deviation"][name], rel=1e-3)
             assert iterations == s["newton_iterations"][name]
+        # PETSc's count: the monitor's iterations from the pass's first line to its last
+        passes = {"one_pass": 0, "two_pass": 0}
+        current = None
+        for line, iterations, _ in _newton(out):
+            if current is not None:
+                passes[current] += iterations
+            if line.startswith(("patch 2D, one pass", "patch 2D, two pass")):
+                current = "one_pass" if "one pass" in line else "two_pass"
+            elif line.startswith(("one pass:", "two pass:")):
+                current = None
+        assert passes == s["newton_iterations"]
+        _closing_line_lists_the_files_written(out)
 
 
 # --- cattaneo ---------------------------------------------------------------------------------
@@ -259,6 +344,19 @@ def test_cattaneo_figures_against_the_table_and_cattaneo_mindlin(cattaneo):
         assert err == pytest.approx(100 * s["traction_error_l2"], abs=6e-4)
         assert newton == s["newton_iterations"]
         assert seconds == pytest.approx(s["wall_time_s"], abs=0.06)
+        # PETSc's count of the Newton iterations: all of them; the load search's solves, one
+        # per approach line; each increment's own, as its line says
+        monitored = _newton(out)
+        assert s["newton_iterations"] == sum(k for _, k, _ in monitored)
+        first = next(k for k, x in enumerate(monitored) if "increment 1/" in x[0])
+        assert s["solves"] == sum(n for *_, n in monitored[:first]) == \
+            sum(x[0].startswith("approach ") for x in monitored[:first])
+        increments = [(line, k) for line, k, _ in monitored if "  increment " in line]
+        assert len(increments) == len(s["increments"])
+        for (line, iterations), row in zip(increments, s["increments"], strict=True):
+            assert row["newton_iterations"] == iterations
+            assert line.endswith(f"Newton {iterations}")
+        _closing_line_lists_the_files_written(out)
 
 
 # --- press-drag ---------------------------------------------------------------------------------
@@ -270,7 +368,7 @@ PRESS = ["--eps", "1e-4", "--dt", "0.05", "--t-end", "1.0", "--drag-start", "0.5
 
 @pytest.fixture(scope="module")
 def press_drag(tmp_path_factory):
-    return _run(tmp_path_factory, "press-drag", PRESS)
+    return _run(tmp_path_factory, "press-drag", PRESS, prefix="press_")
 
 
 def test_press_drag_summary_is_recomputed_from_its_energy_table(press_drag):
@@ -302,11 +400,103 @@ def test_press_drag_summary_is_recomputed_from_its_energy_table(press_drag):
     assert np.all(e["kinetic"] >= 0) and np.all(e["elastic"] >= 0)
     # the load P: the Hertz load of a = R/10
     assert p["load"] == pytest.approx(0.1**2 * np.pi * E_STAR / 4, rel=1e-12)
-    assert s["dofs"] > 0 and s["contact_period"] > 0 and 0 < s["wall_time_s"] < elapsed
+    assert 0 < s["wall_time_s"] < elapsed
     if COMM.rank == 0:
+        # the first line: "press-drag: <dofs> dofs on <ranks> rank(s), ..., dt = <dt>
+        # (contact period <period>), t_end = <t_end>"
+        numbers = _headline(out, "press-drag:")
+        assert numbers[:2] == [s["dofs"], COMM.size]
+        assert numbers[-3:] == pytest.approx([s["dt"], s["contact_period"], 1.0], rel=5e-3)
         error, dissipated, penetration, steps, cutbacks, newton = _headline(
             out, "energy balance error")
         assert (error, dissipated, penetration) == pytest.approx(
             (s["energy_balance_error"], s["dissipated"], s["max_penetration"]), rel=1e-3)
         assert (steps, cutbacks, newton) == (s["steps"], s["rejected_steps"],
                                              s["newton_iterations"])
+        # PETSc's count of the Newton iterations over the run
+        assert s["newton_iterations"] == sum(k for _, k, _ in _newton(out))
+        _closing_line_lists_the_files_written(out)
+
+
+def _press_drag_mesh(folder: pathlib.Path) -> dict[str, np.ndarray] | None:
+    """The press-drag scene's mesh, made again by gmsh (the scene's default h_contact = 0.05
+    R) and read back from its .msh file on rank 0 through gmsh's own API: node coordinates,
+    the triangles of both bodies and the segments of the slave arc and the master face, as
+    arrays of node indices (None on the other ranks)."""
+    from fenicsfriction.studies.contact import geometry
+
+    msh = folder / "press_drag.msh"
+    geometry.hertz_2d(COMM, R=1.0, h_contact=0.05, msh_file=str(msh))
+    if COMM.rank != 0:
+        return None
+    import gmsh
+
+    owns = not getattr(gmsh, "isInitialized", lambda: False)()  # gmsh < 4.11 lacks it
+    if owns:
+        gmsh.initialize(readConfigFiles=False)
+    gmsh.option.setNumber("General.Terminal", 0)
+    try:
+        gmsh.open(str(msh))
+        tags, coordinates, _ = gmsh.model.mesh.getNodes()
+        index = {int(t): k for k, t in enumerate(tags)}
+        x = np.asarray(coordinates).reshape(-1, 3)[:, :2]
+
+        def elements(dim: int, group: int, nodes: int) -> np.ndarray:
+            found = []
+            for entity in gmsh.model.getEntitiesForPhysicalGroup(dim, group):
+                types, _, connectivity = gmsh.model.mesh.getElements(dim, entity)
+                assert list(types) == [2 if dim == 2 else 1]  # linear triangles, segments
+                found.append(np.asarray(connectivity[0]).reshape(-1, nodes))
+            return np.vectorize(index.__getitem__)(np.concatenate(found))
+
+        return {"x": x, "cells": np.concatenate([elements(2, geometry.BODY1, 3),
+                                                 elements(2, geometry.BODY2, 3)]),
+                "slave": elements(1, geometry.SLAVE, 2),
+                "master": elements(1, geometry.MASTER, 2)}
+    finally:
+        gmsh.clear()
+        if owns:
+            gmsh.finalize()
+
+
+def test_press_drag_dofs_and_contact_period_are_what_they_say(press_drag, tmp_path_factory):
+    """dofs: two unknowns per node of the mesh. contact_period: 2π/ω with ω² the
+    contact springs' frequency bound on the row-sum lumped mass. Every slave node is taken in
+    contact, its spring the compliance c_n (linear law) over its tributary length,
+    k_i = c_n A_i. The springs sit between masses no lighter than the lightest node of the
+    slave arc or the master face: ω² = 2 max k_i / min m_j. The period and the bound are
+    recomputed here by hand from the mesh gmsh writes. The lumped mass of a P1 triangle
+    gives ρ|T|/3 to each corner, and a segment's length goes half to each end."""
+    out, _ = press_drag
+    s = _summary(out)
+    p = s["parameters"]
+    assert (p["h_contact"], p["radius"], p["passes"], p["formulation"]) == \
+        (0.05, 1.0, 1, "node-to-segment")
+    mesh = _press_drag_mesh(pathlib.Path(COMM.bcast(
+        str(tmp_path_factory.mktemp("msh")) if COMM.rank == 0 else None, root=0)))
+    if COMM.rank != 0:
+        return
+    assert mesh is not None
+    x, cells = mesh["x"], mesh["cells"]
+    used = np.unique(cells)
+    assert s["dofs"] == 2 * len(used)  # two components per node of the triangles
+    # the lumped (row-sum) mass: ρ |T| / 3 to each corner of each triangle
+    e1, e2 = x[cells[:, 1]] - x[cells[:, 0]], x[cells[:, 2]] - x[cells[:, 0]]
+    area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    mass = np.zeros(len(x))
+    np.add.at(mass, cells.ravel(), np.repeat(p["density"] * area / 3, 3))
+    # the slave nodes' tributary lengths: half of each segment to each end
+    slave = mesh["slave"]
+    length = np.linalg.norm(x[slave[:, 1]] - x[slave[:, 0]], axis=1)
+    tributary = np.zeros(len(x))
+    np.add.at(tributary, slave.ravel(), np.repeat(length / 2, 2))
+    assert tributary.sum() == pytest.approx(np.pi, rel=2e-3)  # the lower half-circle, πR
+    surfaces = np.unique(np.concatenate([slave.ravel(), mesh["master"].ravel()]))
+    omega2 = 2 * p["law"]["c_n"] * tributary.max() / mass[surfaces].min()
+    assert s["contact_period"] == pytest.approx(2 * np.pi / np.sqrt(omega2), rel=1e-10)
+    # the --dt given (0.05) is longer than an eighth of the period: the run said so, in one
+    # line naming the period and the longest step that resolves it
+    period, longest, steps = _headline(out, "warning: dt = 0.05 does not resolve")[1:]
+    assert (period, longest, steps) == pytest.approx(
+        (s["contact_period"], s["contact_period"] / 8, 8), rel=5e-3)
+    assert s["contact_period"] / 8 < 0.05

@@ -3,13 +3,16 @@
 block pressed on a belt, with a steady continuation in μ, the CEA and a short transient.
 Figures are recomputed from the tables, or compared with closed forms: the pressure's
 resultant, Coulomb's friction, the driver spring's rigid-body frequency and the growth
-exp(Re λ t) of an unstable mode. The audit table is in docs/verification.md, under
-"Reported figures".
+exp(Re λ t) of an unstable mode. The lines the run logs are parsed and compared with the
+files, and its closing line with the folder. The audit table is in docs/verification.md,
+under "Reported figures".
 """
 
 import csv
 import json
+import logging
 import pathlib
+import re
 import time
 
 from mpi4py import MPI
@@ -18,6 +21,7 @@ import numpy as np
 import pytest
 
 from fenicsfriction.cli import main
+from fenicsfriction.results import get_logger
 
 COMM = MPI.COMM_WORLD
 
@@ -71,6 +75,17 @@ stride = 1000
 """
 
 
+class _Lines(logging.Handler):
+    """The progress lines a command logs (rank 0's; the other ranks log warnings only)."""
+
+    def __init__(self) -> None:
+        super().__init__(logging.INFO)
+        self.lines: list[str] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.lines.append(record.getMessage())
+
+
 def _table(path: pathlib.Path) -> list[dict[str, str]]:
     with path.open() as table:
         return list(csv.DictReader(table))
@@ -84,10 +99,19 @@ def run(tmp_path_factory):
     if COMM.rank == 0:
         case.write_text(CASE)
     COMM.Barrier()
+    logger = get_logger(COMM)  # the package's handlers first, then ours
+    lines = _Lines()
+    logger.addHandler(lines)
     start = time.perf_counter()
-    assert main(["run", str(case), "--out", str(folder / "out")]) == 0
+    try:
+        assert main(["run", str(case), "--out", str(folder / "out")]) == 0
+    finally:
+        logger.removeHandler(lines)
     elapsed = time.perf_counter() - start
     out = folder / "out"
+    if COMM.rank == 0:
+        (out / "lines.json").write_text(json.dumps(lines.lines))
+    COMM.Barrier()
     return json.loads((out / "summary.json").read_text()), out, elapsed
 
 
@@ -178,3 +202,73 @@ def test_transient_grows_at_re_lambda_and_its_rate_is_the_tables(run):
     # (measured: the rate 1.6e-3 low, the amplitude within 1.6e-5 of the exponential)
     assert transient["growth_rate_measured"] == pytest.approx(top["re"], rel=1e-2)
     np.testing.assert_allclose(amplitude, 1e-6 * np.exp(top["re"] * t), rtol=1e-4)
+
+
+#: a number as the progress lines print it
+VALUE = r"[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?"
+#: one standing alone (not inside a word, such as the 0 of contact0)
+NUMBER = r"(?<![\w.])" + VALUE
+
+
+def _nodes(xdmf: pathlib.Path) -> int:
+    """The number of mesh nodes, read from the Geometry item of an XDMF file."""
+    geometry = re.search(r'<Geometry[^>]*>\s*<DataItem Dimensions="(\d+) \d+"',
+                         xdmf.read_text())
+    assert geometry is not None
+    return int(geometry.group(1))
+
+
+def test_headline_lines_say_what_the_files_hold(run):
+    """What ``run`` logs: the first line the unknowns (two per node of the mesh in
+    steady.xdmf, counted there) and the ranks; one line per μ with the steady row's forces, the
+    CEA's mode count, max Re λ and the growing modes (Re λ > growth_tol |λ|, recounted from
+    the modes); the onset line the first onset's μ, λ, its frequency Im λ/2π and the colliding
+    modes; the transient's first sample and its two rates; the closing line the files, each
+    of which exists. Each figure is compared at the digits printed."""
+    summary, out, elapsed = run
+    if COMM.rank != 0:  # rank 0 logs, the others do not
+        return
+    lines = json.loads((out / "lines.json").read_text())
+    first = lines[0]
+    assert first.startswith(f"square: {2 * _nodes(out / 'steady.xdmf')} dofs on {COMM.size} "
+                            "rank(s), JIT ")
+    assert 0 < float(re.findall(NUMBER, first)[-1]) < summary["wall_time_s"] < elapsed
+    steps = [x for x in lines if x.startswith("step ")]
+    assert len(steps) == len(summary["cea"]) == len(summary["steady"]) == 3
+    for k, (line, row, step) in enumerate(zip(steps, summary["steady"], summary["cea"],
+                                              strict=True)):
+        assert line.startswith(f"step {k:3d}/2  mu=")
+        numbers = dict(re.findall(rf"(\w+)=({VALUE})", line))
+        assert float(numbers["mu"]) == pytest.approx(row["mu"], abs=1e-6)
+        for key in ("contact0_normal_force", "contact0_friction_force_x"):
+            assert float(numbers[key]) == pytest.approx(row[key], rel=5e-4, abs=1e-12)
+        assert f"  {len(step['modes'])} modes  " in line
+        assert float(line.split("max Re λ=")[1].split()[0]) == pytest.approx(step["max_re"],
+                                                                              rel=5e-4)
+        growing = [m["mode"] for m in step["modes"]
+                   if m["re"] > 1e-6 * abs(complex(m["re"], m["im"]))]
+        assert line.endswith(f"growing: {growing}")
+    assert growing  # the last step grows: the onset lies before it
+    onset = summary["onsets"][0]
+    re_, im = onset["value"]
+    (line,) = [x for x in lines if x.startswith("onset at ")]
+    mu, lam_re, lam_im, hz, *modes = (float(v) for v in re.findall(NUMBER, line))
+    assert (mu, lam_re, lam_im) == pytest.approx((onset["mu_crit"], re_, im), rel=5e-4)
+    assert hz == pytest.approx(im / (2 * np.pi), rel=1e-5)
+    assert modes == [c["mode"] for c in onset["colliding"]]
+    transient = summary["transient"]
+    samples = [x for x in lines if x.startswith("t=")]  # every stride (1000) steps: the first
+    assert len(samples) == 1
+    t0, amplitude = (float(v) for v in re.findall(NUMBER, samples[0]))
+    assert (t0, amplitude) == pytest.approx((transient["time"][0], transient["amplitude"][0]),
+                                            rel=5e-4, abs=1e-12)
+    (line,) = [x for x in lines if x.startswith("transient: measured growth rate")]
+    measured, re_lambda = (float(v) for v in re.findall(NUMBER + r"(?= 1/s)", line))
+    assert (measured, re_lambda) == pytest.approx(
+        (transient["growth_rate_measured"], transient["growth_rate_re_lambda"]), rel=5e-5)
+    closing = lines[-1]
+    assert closing.startswith(f"results in {out}/: ")
+    listed = set(closing.split(": ", 1)[1].split(", "))
+    # every file written is listed (an XDMF file's heavy data beside it), and none else
+    heavy = {name.replace(".xdmf", ".h5") for name in listed if name.endswith(".xdmf")}
+    assert {p.name for p in out.iterdir()} - {"lines.json"} == listed | heavy

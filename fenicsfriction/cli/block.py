@@ -301,8 +301,10 @@ def run_steady(args: argparse.Namespace, log: logging.Logger) -> int:
     plotting.plot_steady_forces(records, out / "forces.png", scene.spring_height,
                                 scene.belt_direction, scene.tipping_limit, comm)
     comm.Barrier()  # every file exists on return, whichever rank asks
-    log.info(f"results in {out}/: steady.json, summary.json, steady.xdmf, deformed.png, forces.png"
-             + (", epsilon.json" if eps_records else ""))
+    # the figures drawn (rank 0's lists, where they are drawn and this line is logged)
+    log.info(f"results in {out}/: steady.json, summary.json, steady.xdmf"
+             + (", deformed.png" if snapshots else "") + (", forces.png" if records else "")
+             + (", epsilon.json" if eps_records is not None else ""))
     from fenicsfriction.cli.common import stopped
     return stopped(failure, interrupted)
 

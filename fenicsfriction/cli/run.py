@@ -55,6 +55,7 @@ def run(args: argparse.Namespace, log: logging.Logger) -> int:
     elif outcome.failure is not None:
         stop_line(outcome.failure, comm)
     log.info(f"results in {out}/: summary.json, steady.csv, steady.xdmf"
+             + (", continuation.png" if outcome.steady else "")
              + (", cea.csv, unstable_modes.xdmf, loci.png, growth.png, coupling_map.png"
                 if case.cea else "")
              + (", transient.csv, transient.png" if case.transient else ""))
