@@ -17,16 +17,11 @@ closed-form frequencies. The ``statistics`` block of
 docs/verification.md, under "Reported figures".
 """
 
-import contextlib
 import csv
-import ctypes
 import dataclasses
 import json
-import logging
-import os
 import pathlib
 import re
-import sys
 import time
 import typing
 
@@ -35,18 +30,12 @@ from petsc4py import PETSc
 
 import numpy as np
 import pytest
+from capture import logged_lines, shared_folder, stdout_into
 from scipy.integrate import quad, trapezoid
 
 from fenicsfriction.cli import main
-from fenicsfriction.results import get_logger
 
 COMM = MPI.COMM_WORLD
-
-
-def _shared_folder(factory: pytest.TempPathFactory, name: str) -> pathlib.Path:
-    """A module-wide folder seen by every rank (rank 0's, broadcast)."""
-    path = factory.mktemp(name) if COMM.rank == 0 else None
-    return pathlib.Path(COMM.bcast(path, root=0))
 
 
 # --- the observer on a rigid motion ------------------------------------------------------------
@@ -142,32 +131,15 @@ def test_each_column_of_a_rigid_motion_is_its_closed_form():
 KICK, DT = -0.01, 1e-5
 
 
-class _Lines(logging.Handler):
-    """The progress lines a command logs (rank 0's)."""
-
-    def __init__(self) -> None:
-        super().__init__(logging.INFO)
-        self.lines: list[str] = []
-
-    def emit(self, record: logging.LogRecord) -> None:
-        self.lines.append(record.getMessage())
-
-
 @pytest.fixture(scope="module")
 def dynamics(tmp_path_factory):
-    out = _shared_folder(tmp_path_factory, "dynamics") / "out"
-    logger = get_logger(COMM)
-    lines = _Lines()
-    logger.addHandler(lines)
-    try:
-        assert main(["block", "dynamics", "--mu", "0.6", "--t-end", "2e-4", "--dt", str(DT),
-                     "--b-n", "0.381e10", "--perturbation", str(KICK), "--stride", "100",
-                     "--out", str(out)]) == 0
-    finally:
-        logger.removeHandler(lines)
-    headline = [x for x in lines.lines if x.startswith("apparent friction coefficient")]
+    out = shared_folder(tmp_path_factory, "dynamics") / "out"
+    lines = _run_logged(["block", "dynamics", "--mu", "0.6", "--t-end", "2e-4", "--dt", str(DT),
+                         "--b-n", "0.381e10", "--perturbation", str(KICK), "--stride", "100",
+                         "--out", str(out)])
+    headline = [x for x in lines if x.startswith("apparent friction coefficient")]
     if COMM.rank == 0:
-        _closing_line_lists_the_files_written(lines.lines[-1])
+        _closing_line_lists_the_files_written(lines[-1])
         summary = json.loads((out / "summary.json").read_text())["statistics"]
         # "apparent friction coefficient <4 decimals> (μ = <mu>), probe node sticks <%>"
         assert headline == [f"apparent friction coefficient "
@@ -252,36 +224,9 @@ def test_dynamics_columns_are_recomputed_from_the_others(dynamics):
 
 def _run_logged(argv: list[str]) -> list[str]:
     """Run a command, returning the progress lines it logged (rank 0's; none elsewhere)."""
-    logger = get_logger(COMM)
-    lines = _Lines()
-    logger.addHandler(lines)
-    try:
+    with logged_lines() as lines:
         assert main(argv) == 0
-    finally:
-        logger.removeHandler(lines)
-    return lines.lines
-
-
-@contextlib.contextmanager
-def _stdout_into(path: pathlib.Path) -> typing.Iterator[None]:
-    """Everything printed, by Python (the progress lines) and by PETSc's C code (its SNES
-    monitor), into ``path`` in the order printed: file descriptor 1 is pointed at the file
-    and ``sys.stdout`` written through it line by line (PETSc flushes each print). petsc4py
-    sends PETSc's printing through ``sys.stdout`` under pytest's capture and straight to the
-    descriptor under ``pytest -s``: both land here."""
-    sys.stdout.flush()
-    saved = os.dup(1)
-    target = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
-    os.dup2(target, 1)
-    os.close(target)
-    try:
-        with open(1, "w", buffering=1, closefd=False) as stream, \
-                contextlib.redirect_stdout(stream):
-            yield
-    finally:
-        ctypes.CDLL(None).fflush(None)
-        os.dup2(saved, 1)
-        os.close(saved)
+    return lines
 
 
 def _residual_norm(solver: typing.Any) -> float:
@@ -307,7 +252,7 @@ def steady(tmp_path_factory):
     read; the clock is read again as each record's ``on_step`` returns."""
     import fenicsfriction.steady
 
-    folder = _shared_folder(tmp_path_factory, "steady")
+    folder = shared_folder(tmp_path_factory, "steady")
     out = folder / "out"
     real = fenicsfriction.steady.continuation
     watched: dict[str, typing.Any] = {"norms": [], "converged_at": [], "step_ends": []}
@@ -326,7 +271,7 @@ def steady(tmp_path_factory):
         return real(solver, parameter, targets, observe=observed, on_step=stepped, **options)
 
     printed = folder / f"stdout{COMM.rank}.txt"  # with PETSc's monitor of each iteration
-    with pytest.MonkeyPatch.context() as patch, _stdout_into(printed):
+    with pytest.MonkeyPatch.context() as patch, stdout_into(printed):
         patch.setattr(fenicsfriction.steady, "continuation", continuation)
         start = time.perf_counter()
         try:
@@ -458,7 +403,7 @@ def test_steady_residual_norm_and_wall_time_are_what_they_say(steady):
 
 @pytest.fixture(scope="module")
 def stability(tmp_path_factory):
-    out = _shared_folder(tmp_path_factory, "stability") / "out"
+    out = shared_folder(tmp_path_factory, "stability") / "out"
     start = time.perf_counter()
     lines = _run_logged(["block", "stability", "--mu-max", "0.2", "--steps", "1", "--out",
                          str(out)])

@@ -11,26 +11,20 @@ pressure and fits are checked in tests/test_cli_contact.py. The audit table is i
 docs/verification.md, under "Reported figures".
 """
 
-import contextlib
 import csv
-import ctypes
 import json
-import logging
-import os
 import pathlib
 import re
-import sys
 import time
-import typing
 
 from mpi4py import MPI
 from petsc4py import PETSc
 
 import numpy as np
 import pytest
+from capture import logged_lines, shared_folder, stdout_into, xdmf_nodes
 
 from fenicsfriction.cli import main
-from fenicsfriction.results import get_logger
 
 COMM = MPI.COMM_WORLD
 #: the mesh size at the contact of the Hertz and Cattaneo runs (a/5 at the default a = R/10)
@@ -39,62 +33,24 @@ H = 0.02
 E_STAR = 1.0 / (2 * (1 - 0.3**2))
 
 
-class _Lines(logging.Handler):
-    """The progress lines a command logs (rank 0's; the other ranks log warnings only)."""
-
-    def __init__(self) -> None:
-        super().__init__(logging.INFO)
-        self.lines: list[str] = []
-
-    def emit(self, record: logging.LogRecord) -> None:
-        self.lines.append(record.getMessage())
-
-
-@contextlib.contextmanager
-def _stdout_into(path: pathlib.Path) -> typing.Iterator[None]:
-    """Everything printed, by Python (the progress lines) and by PETSc's C code (its SNES
-    monitor), into ``path`` in the order printed: file descriptor 1 is pointed at the file
-    and ``sys.stdout`` written through it line by line (PETSc flushes each print). petsc4py
-    sends PETSc's printing through ``sys.stdout`` under pytest's capture and straight to the
-    descriptor under ``pytest -s``: both land here."""
-    sys.stdout.flush()
-    saved = os.dup(1)
-    target = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
-    os.dup2(target, 1)
-    os.close(target)
-    try:
-        with open(1, "w", buffering=1, closefd=False) as stream, \
-                contextlib.redirect_stdout(stream):
-            yield
-    finally:
-        ctypes.CDLL(None).fflush(None)
-        os.dup2(saved, 1)
-        os.close(saved)
-
-
 def _run(factory: pytest.TempPathFactory, name: str, argv: list[str], prefix: str = "contact_"
          ) -> tuple[pathlib.Path, float]:
     """Run ``contact NAME ARGV`` into a module-wide folder; (folder, elapsed seconds). The
     lines it logs are kept in ``folder/lines.json``. PETSc's own monitor of the Newton
     iterations of the solvers of ``prefix`` prints among its printed lines (kept beside
     the folder, ``stdout<rank>.txt``)."""
-    path = factory.mktemp(name) if COMM.rank == 0 else None
-    folder = pathlib.Path(COMM.bcast(path, root=0))
+    folder = shared_folder(factory, name)
     out = folder / "out"
-    logger = get_logger(COMM)  # the package's handlers first, then ours
-    lines = _Lines()
-    logger.addHandler(lines)
     start = time.perf_counter()
     try:
-        with _stdout_into(folder / f"stdout{COMM.rank}.txt"):
+        with logged_lines() as lines, stdout_into(folder / f"stdout{COMM.rank}.txt"):
             assert main(["contact", name, *argv, "--out", str(out),
                          f"-{prefix}snes_monitor"]) == 0
     finally:
-        logger.removeHandler(lines)
         # the option stays in PETSc's database: the later solvers need not print
         PETSc.Options().delValue(f"{prefix}snes_monitor")
     if COMM.rank == 0:
-        (out / "lines.json").write_text(json.dumps(lines.lines))
+        (out / "lines.json").write_text(json.dumps(lines))
     COMM.Barrier()
     return out, time.perf_counter() - start
 
@@ -145,14 +101,6 @@ def _table(path: pathlib.Path) -> dict[str, np.ndarray]:
     return {key: np.array([float(r[key]) for r in rows]) for key in rows[0]}
 
 
-def _nodes(xdmf: pathlib.Path) -> int:
-    """The number of mesh nodes, read from the Geometry item of an XDMF file."""
-    geometry = re.search(r'<Geometry[^>]*>\s*<DataItem Dimensions="(\d+) \d+"',
-                         xdmf.read_text())
-    assert geometry is not None
-    return int(geometry.group(1))
-
-
 def _tributary(x: np.ndarray) -> np.ndarray:
     """Each node's share of a line through sorted nodes (the lumped P1 weights)."""
     w = np.empty_like(x)
@@ -182,7 +130,7 @@ def test_hertz_dofs_approach_and_wall_time_are_what_they_say(hertz):
 
     out, elapsed = hertz
     s = _summary(out)
-    assert s["dofs"] == 2 * _nodes(out / "bodies.xdmf")
+    assert s["dofs"] == 2 * xdmf_nodes(out / "bodies.xdmf")
     assert 0 < s["wall_time_s"] < elapsed
     assert s["parameters"]["h_contact"] == H and s["ranks"] == COMM.size
     scene = Hertz(dim=2, h_contact=H)
@@ -218,7 +166,7 @@ def test_patch_figures_are_the_uniform_pressure_and_its_deviations(patch):
     p = s["parameters"]
     pressure = 0.01  # the scene's default, echoed as the load
     assert s["load"] == pressure and (p["n_upper"], p["n_lower"]) == (5, 7)
-    assert s["dofs"] == 2 * _nodes(out / "bodies.xdmf")
+    assert s["dofs"] == 2 * xdmf_nodes(out / "bodies.xdmf")
     table = _table(out / "surface.csv")
     for passes, name in ((1, "one_pass"), (2, "two_pass")):
         rows = table["passes"] == passes
@@ -272,7 +220,7 @@ def test_cattaneo_figures_against_the_table_and_cattaneo_mindlin(cattaneo):
     s = _summary(out)
     mu, q = 0.3, 0.5
     assert (s["mu"], s["q_ratio"], s["eps"], s["enforcement"]) == (mu, q, 1e-6, "compliance")
-    assert s["dofs"] == 2 * _nodes(out / "bodies.xdmf") and 0 < s["wall_time_s"] < elapsed
+    assert s["dofs"] == 2 * xdmf_nodes(out / "bodies.xdmf") and 0 < s["wall_time_s"] < elapsed
     # the default load: Hertz's a = R/10, reached to the search's 1e-5
     P = 0.1**2 * np.pi * E_STAR / 4
     assert s["load"] == pytest.approx(P, rel=1e-5)

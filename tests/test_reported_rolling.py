@@ -7,18 +7,19 @@ nodes, PETSc's Newton monitor) or, for an input, the flag it echoes.
 One run per command, shared by the module's tests; the audit table is in
 docs/verification.md, "Reported figures"."""
 
-import contextlib
-import io
 import json
 import math
+import pathlib
 import re
 import time
 
 from mpi4py import MPI
+from petsc4py import PETSc
 
 import numpy as np
 import pytest
 import scipy.integrate
+from capture import shared_folder, stdout_into, xdmf_nodes
 
 from fenicsfriction.cli import main
 from fenicsfriction.studies.rolling.kalker import creep_coefficients
@@ -45,17 +46,21 @@ def _flags(values: dict) -> list[str]:
 
 
 def _run(argv: list[str]) -> dict:
-    """``main(argv)``: its exit status, rolling.json, the printed lines and the run's time
-    (everything a test reads from it)."""
-    out = io.StringIO()
-    t0 = time.perf_counter()
-    with contextlib.redirect_stdout(out):
-        code = main(argv)
-    seconds = time.perf_counter() - t0
+    """``main(argv)``: its exit status, rolling.json, the printed lines (PETSc's monitor
+    among them, whether pytest captures or not) and the run's time (everything a test reads
+    from it)."""
     folder = argv[argv.index("--out") + 1]
+    printed = pathlib.Path(f"{folder}.stdout{COMM.rank}.txt")
+    t0 = time.perf_counter()
+    try:
+        with stdout_into(printed):
+            code = main(argv)
+    finally:  # the option stays in PETSc's database: the later solvers need not print
+        PETSc.Options().delValue("rolling_snes_monitor")
+    seconds = time.perf_counter() - t0
     with open(f"{folder}/rolling.json") as f:
         data = json.load(f)
-    return {"code": code, "json": data, "lines": out.getvalue().splitlines(),
+    return {"code": code, "json": data, "lines": printed.read_text().splitlines(),
             "seconds": seconds, "out": folder}
 
 
@@ -78,8 +83,7 @@ class _Runs(dict):
 def runs(tmp_path_factory):
     """The four runs, once: a FASTSIM point, a FASTSIM curve, a 2D and a 3D finite element
     point."""
-    root = tmp_path_factory.mktemp("rolling") if COMM.rank == 0 else None
-    root = COMM.bcast(root, root=0)
+    root = shared_folder(tmp_path_factory, "rolling")
     fe_common = ["--eps-sequence", ",".join(map(str, EPS_SEQUENCE))]
     return _Runs({
         "fastsim": ["rolling", "fastsim", *_flags(WHEEL), *_flags(SMALL), "--nx", "40",
@@ -272,20 +276,13 @@ def test_fe_3d_forces_are_kalkers_linear_theory_at_small_creepage(runs):
     assert record["Fn"] == pytest.approx(CIRCLE["Fn"], rel=0.1)
 
 
-def _xdmf_nodes(folder: str) -> int:
-    """The number of the mesh's nodes in rolling.xdmf (its geometry's first dimension)."""
-    with open(f"{folder}/rolling.xdmf") as f:
-        text = f.read()
-    return int(re.search(r'Dimensions="(\d+) \d+"[^>]*>[^<]*geometry', text).group(1))
-
-
 @pytest.mark.parametrize(("name", "dim"), [("fe2", 2), ("fe3", 3)])
 def test_fe_dofs_are_the_vector_P1_space_of_the_written_mesh(runs, name, dim):
     """dofs = dim × the nodes of the mesh written to rolling.xdmf (P1 displacement), and the
     first printed line says the same."""
     data = runs[name]["json"]
     records = data.get("records", [data])
-    dofs = dim * _xdmf_nodes(runs[name]["out"])
+    dofs = dim * xdmf_nodes(pathlib.Path(runs[name]["out"]) / "rolling.xdmf")
     assert all(r["dofs"] == dofs for r in records)
     if COMM.rank == 0:
         assert f"rolling fe {dim}D: {dofs} dofs on {COMM.size} rank(s)" in runs[name]["lines"]

@@ -10,7 +10,6 @@ under "Reported figures".
 
 import csv
 import json
-import logging
 import pathlib
 import re
 import time
@@ -19,9 +18,9 @@ from mpi4py import MPI
 
 import numpy as np
 import pytest
+from capture import logged_lines, shared_folder, xdmf_nodes
 
 from fenicsfriction.cli import main
-from fenicsfriction.results import get_logger
 
 COMM = MPI.COMM_WORLD
 
@@ -75,17 +74,6 @@ stride = 1000
 """
 
 
-class _Lines(logging.Handler):
-    """The progress lines a command logs (rank 0's; the other ranks log warnings only)."""
-
-    def __init__(self) -> None:
-        super().__init__(logging.INFO)
-        self.lines: list[str] = []
-
-    def emit(self, record: logging.LogRecord) -> None:
-        self.lines.append(record.getMessage())
-
-
 def _table(path: pathlib.Path) -> list[dict[str, str]]:
     with path.open() as table:
         return list(csv.DictReader(table))
@@ -93,24 +81,18 @@ def _table(path: pathlib.Path) -> list[dict[str, str]]:
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory):
-    path = tmp_path_factory.mktemp("run") if COMM.rank == 0 else None
-    folder = pathlib.Path(COMM.bcast(path, root=0))
+    folder = shared_folder(tmp_path_factory, "run")
     case = folder / "square.toml"
     if COMM.rank == 0:
         case.write_text(CASE)
     COMM.Barrier()
-    logger = get_logger(COMM)  # the package's handlers first, then ours
-    lines = _Lines()
-    logger.addHandler(lines)
     start = time.perf_counter()
-    try:
+    with logged_lines() as lines:
         assert main(["run", str(case), "--out", str(folder / "out")]) == 0
-    finally:
-        logger.removeHandler(lines)
     elapsed = time.perf_counter() - start
     out = folder / "out"
     if COMM.rank == 0:
-        (out / "lines.json").write_text(json.dumps(lines.lines))
+        (out / "lines.json").write_text(json.dumps(lines))
     COMM.Barrier()
     return json.loads((out / "summary.json").read_text()), out, elapsed
 
@@ -210,14 +192,6 @@ VALUE = r"[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?"
 NUMBER = r"(?<![\w.])" + VALUE
 
 
-def _nodes(xdmf: pathlib.Path) -> int:
-    """The number of mesh nodes, read from the Geometry item of an XDMF file."""
-    geometry = re.search(r'<Geometry[^>]*>\s*<DataItem Dimensions="(\d+) \d+"',
-                         xdmf.read_text())
-    assert geometry is not None
-    return int(geometry.group(1))
-
-
 def test_headline_lines_say_what_the_files_hold(run):
     """What ``run`` logs: the first line the unknowns (two per node of the mesh in
     steady.xdmf, counted there) and the ranks; one line per μ with the steady row's forces, the
@@ -230,7 +204,7 @@ def test_headline_lines_say_what_the_files_hold(run):
         return
     lines = json.loads((out / "lines.json").read_text())
     first = lines[0]
-    assert first.startswith(f"square: {2 * _nodes(out / 'steady.xdmf')} dofs on {COMM.size} "
+    assert first.startswith(f"square: {2 * xdmf_nodes(out / 'steady.xdmf')} dofs on {COMM.size} "
                             "rank(s), JIT ")
     assert 0 < float(re.findall(NUMBER, first)[-1]) < summary["wall_time_s"] < elapsed
     steps = [x for x in lines if x.startswith("step ")]
