@@ -6,6 +6,7 @@ import pathlib
 from mpi4py import MPI
 
 import pytest
+from capture import on_every_rank
 
 
 @pytest.fixture(autouse=True)
@@ -26,9 +27,8 @@ def shared_tmp_path(request) -> pathlib.Path:
 
     pytest's ``tmp_path`` is made per process, so under MPI each rank would get its own.
     """
-    comm = MPI.COMM_WORLD
-    path = request.getfixturevalue("tmp_path") if comm.rank == 0 else None
-    return pathlib.Path(comm.bcast(path, root=0))
+    return on_every_rank(request.getfixturevalue("tmp_path") if MPI.COMM_WORLD.rank == 0
+                         else None)
 
 
 @pytest.fixture
