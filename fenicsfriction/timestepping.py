@@ -172,7 +172,10 @@ class Alpha2Integrator:
         self.ts.setStepNumber(0)
         self.ts.setTimeStep(dt)
         self.ts.setMaxTime(t_end)
-        self.ts.setMaxSteps(10**9)
+        # no step limit unless the user set one (-PREFIX_ts_max_steps): then reaching it
+        # before t_end is a stop, reported as such
+        max_steps = PETSc.Options(self.ts.getOptionsPrefix()).getInt("ts_max_steps", 10**9)
+        self.ts.setMaxSteps(max_steps)
         records: list[dict] = []
         clock = [time.perf_counter(), 0, 0]
         last_time = [0.0]  # of the last accepted step
@@ -230,6 +233,10 @@ class Alpha2Integrator:
         if reason < 0:
             raise DynamicsError(f"TS stopped at t = {self.ts.getTime():.6g} with reason "
                                 f"{reason} after {self.ts.getStepNumber()} steps", records)
+        if reason == PETSc.TS.ConvergedReason.CONVERGED_ITS:
+            raise DynamicsError(f"TS stopped at t = {self.ts.getTime():.6g}, before t_end = "
+                                f"{t_end:.6g}: the step limit ts_max_steps = {max_steps} was "
+                                "reached", records)
         return records
 
 

@@ -65,6 +65,24 @@ def test_failed_slide_to_mu_in_dynamics_is_one_line_and_exit_1(tmp_path):
 
 
 @serial_only
+def test_a_step_limit_reached_before_t_end_is_a_stop_that_keeps_its_steps(tmp_path):
+    """The user's -dynamics_ts_max_steps is honoured (it was overridden by an internal limit
+    of 1e9): 5 steps of 1e-5 s end at t = 5e-5 s, short of t_end, which is a stop — exit 1,
+    the line and the summary say so, and the 5 steps and the initial row are written."""
+    result = _run(["block", "dynamics", "--mu", "0.6", "--t-end", "3e-4", "--dt", "1e-5",
+                   "--b-n", "0.381e10", "--stride", "1000", "--out", str(tmp_path),
+                   "-dynamics_ts_max_steps", "5"])
+    assert result.returncode == 1, result.stderr
+    line = _closing_line(result)
+    assert "the step limit ts_max_steps = 5 was reached" in line and "t = 5e-05" in line
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["stage"] == "time integration" and summary["steps"] == 5
+    assert summary["failure"] == line.removeprefix("fenicsfriction: ")
+    rows = _table(tmp_path / "timeseries.csv")
+    assert [r["time"] for r in rows] == pytest.approx([1e-5 * k for k in range(6)], rel=1e-9)
+
+
+@serial_only
 def test_failed_eps_sequence_keeps_the_steps_done_and_exits_1(tmp_path):
     """The continuation converges in at most 3 Newton iterations per step, the jump from
     ε = 1e-3 to 1e3 cm/s (from Coulomb to a viscous law) needs 4: the ε sequence fails at its
