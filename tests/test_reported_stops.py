@@ -147,12 +147,13 @@ def test_stopped_oscillator_summary_says_the_signal_and_the_last_row(runs, name,
     """Exit 128 + the signal's number; ``interrupted`` names the signal the test sent and the
     last sample (its time to 6 digits, the rows written); ``samples`` = the rows on disk;
     ``t_end`` = the last row's time (not the requested 1000); ``wall_seconds`` within the
-    command's time; no ``failure``; the one closing line on stderr says the same."""
+    command's time; ``failure`` null; the one closing line on stderr says the same."""
     run = runs[name]
     summary, rows = run["json"], run["rows"]
     assert run["code"] == 128 + signum
-    assert set(summary) - {"environment"} == {"interrupted", "samples", "t_end", "wall_seconds"}
-    assert summary["samples"] == len(rows) > 10
+    assert set(summary) - {"environment"} == {"interrupted", "failure", "samples", "t_end",
+                                              "wall_seconds"}
+    assert summary["failure"] is None and summary["samples"] == len(rows) > 10
     assert summary["t_end"] == rows[-1]["t"] < 1000
     where = f"t = {rows[-1]['t']:.6g} ({len(rows)} samples)"
     assert summary["interrupted"] == f"interrupted by {signal.Signals(signum).name} after {where}"
@@ -182,13 +183,15 @@ def test_failed_oscillator_summary_says_where_the_integration_stopped(runs, name
     stuck = rows[-1]["stick"] == 1
     assert (mode in ("'stick'", "(0,)")) is stuck, (mode, rows[-1])
     if name == "belt failed":
-        assert set(summary) - {"environment"} == {"failure", "samples", "t_end", "wall_seconds"}
-        assert summary["samples"] == len(rows)
+        assert set(summary) - {"environment"} == {"interrupted", "failure", "samples", "t_end",
+                                                  "wall_seconds"}
+        assert summary["interrupted"] is None and summary["samples"] == len(rows)
         assert 0 < summary["wall_seconds"] < run["seconds"]
         assert run["stderr"][-1].startswith(f"fenicsfriction: integration stopped after "
                                             f"t = {rows[-1]['t']:.6g}: {summary['failure']}")
     else:  # the slider summarises the run up to there: one segment, so its steps are the limit
         assert summary["events"] == 0 and summary["steps"] == MAX_STEPS
+        assert summary["interrupted"] is None and summary["samples"] == len(rows)
         assert 0 < summary["wall_seconds"] < run["seconds"]
         assert summary["failure"].startswith(f"integration stopped at t = {rows[-1]['t']:.6g}: ")
         assert run["stderr"][-1] == (f"fenicsfriction: {summary['failure']}; the results so "

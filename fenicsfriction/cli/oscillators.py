@@ -290,9 +290,10 @@ def run_oscillator(args: argparse.Namespace, log: logging.Logger) -> int:
     start = time.perf_counter()
 
     def stopped(key: str, why: Exception) -> dict:
-        """The summary of a run that ended early: what was sampled, and why it ended."""
-        return {key: str(why), "t_end": samples[0], "samples": samples[1],
-                "wall_seconds": time.perf_counter() - start}
+        """The summary of a run that ended early: what was sampled, and why it ended (both
+        keys, the other one null, as every command writes them)."""
+        return {"interrupted": None, "failure": None, key: str(why), "t_end": samples[0],
+                "samples": samples[1], "wall_seconds": time.perf_counter() - start}
 
     failure = None
     with StopSignals(comm) as stop, CsvRows(out / "timeseries.csv", comm) as table:
@@ -318,6 +319,8 @@ def run_oscillator(args: argparse.Namespace, log: logging.Logger) -> int:
                       "so far are written")
             return 1
     summary["wall_seconds"] = time.perf_counter() - start
+    if failure is not None:  # the slider's integration failed: its summary says where, too
+        summary.update(interrupted=None, samples=samples[1])
     run_stick = summary.get("stick_fraction_run", summary["stick_fraction"])  # belt, slider
     log.info(f"{summary['events']} events, stick fraction {run_stick:.3f} over the run, "
              f"{summary['wall_seconds']:.1f} s")
