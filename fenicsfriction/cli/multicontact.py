@@ -254,7 +254,6 @@ def _run_stability_map(args: argparse.Namespace, log: logging.Logger, comm: MPI.
                            x_s_mean=args.x_s_mean, drop_threshold=args.drop_threshold,
                            seed=args.seed)
     record = smap.to_json()
-    record["parameters"]["seed"] = args.seed  # the runs' thresholds, as the coupling map's
     results.write_summary(out / "multicontact.json", {"command": "stability-map", **record},
                           comm)
     columns = ("onset_stick_slip", "sustained_stick_slip", "onset_drop", "largest_late_drop",

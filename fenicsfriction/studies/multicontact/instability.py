@@ -82,7 +82,7 @@ class InstabilityMap(Record):
             :class:`~fenicsfriction.studies.multicontact.eq_model.SpringDrivenResult`).
         drop_threshold: the classification's threshold.
         drive: v, the mass, the damping ratio, t_end and the steps per period used.
-        parameters: N, k, x_s_mean (the rows vary x_s_std).
+        parameters: N, k, x_s_mean, seed (the rows vary x_s_std).
     """
 
     K: np.ndarray
@@ -171,7 +171,7 @@ def instability_map(K: typing.Sequence[float], relative_spread: typing.Sequence[
         drop_threshold=float(drop_threshold),
         drive={"v": v, "mass": m, "damping_ratio": damping_ratio,
                "drive_distance": drive_distance, "steps_per_period": steps_per_period},
-        parameters={"N": n_contacts, "k": k, "x_s_mean": x_s_mean})
+        parameters={"N": n_contacts, "k": k, "x_s_mean": x_s_mean, "seed": seed})
 
 
 @dataclasses.dataclass
