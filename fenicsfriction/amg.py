@@ -36,7 +36,8 @@ from dolfinx import fem
 from fenicsfriction.laws import check
 
 __all__ = ["AMG_TYPES", "LINEAR_SOLVER_PATHS", "amg_options", "attach_near_nullspace",
-           "bodies", "choose_linear_solver", "requested_amg", "rigid_body_modes", "uses_amg"]
+           "bodies", "choose_linear_solver", "requested_amg", "resolve_linear_solver",
+           "rigid_body_modes", "uses_amg"]
 
 #: the AMG preconditioners :func:`amg_options` configures (PETSc ``pc_type``)
 AMG_TYPES = ("gamg", "hypre")
@@ -217,6 +218,26 @@ def requested_amg(prefix: str) -> str | None:
     solver then takes the AMG path with that preconditioner's defaults."""
     pc_type = PETSc.Options(prefix).getString("pc_type", "")
     return pc_type if pc_type in AMG_TYPES else None
+
+
+def resolve_linear_solver(prefix: str, linear_solver: str, dim: int, size: int, ranks: int,
+                          splits: bool, contact: bool) -> tuple[str, dict]:
+    """A solver's ``linear_solver`` choice as the options and the problem's size settle it,
+    with the option defaults of the path (:class:`~fenicsfriction.steady.SteadySolver`'s and
+    :class:`~fenicsfriction.dynamics.DynamicsSolver`'s).
+
+    The AMG path, ``("amg", amg_options(dim, type))``, where ``-<prefix>pc_type gamg|hypre``
+    asks for it (that type; :func:`requested_amg`), where ``linear_solver`` is ``"amg"`` (GAMG),
+    or where it is ``"auto"`` and :func:`choose_linear_solver` (``dim``, ``size``, ``ranks``,
+    ``splits``, ``contact`` as there) picks AMG; else ``(linear_solver, {})``, ``"auto"``
+    left for the solver to settle among its factorisations.
+    """
+    amg_type = requested_amg(prefix)
+    if (amg_type is not None or linear_solver == "amg"
+            or (linear_solver == "auto" and choose_linear_solver(
+                dim, size, ranks, splits, contact=contact) == "amg")):
+        return "amg", amg_options(dim, amg_type or "gamg")
+    return linear_solver, {}
 
 
 def uses_amg(ksp: PETSc.KSP) -> bool:

@@ -37,13 +37,7 @@ import ufl
 from dolfinx import fem
 
 from fenicsfriction import _compat
-from fenicsfriction.amg import (
-    amg_options,
-    attach_near_nullspace,
-    choose_linear_solver,
-    requested_amg,
-    uses_amg,
-)
+from fenicsfriction.amg import attach_near_nullspace, resolve_linear_solver, uses_amg
 from fenicsfriction.assembly import (
     BulkWatcher,
     CoupledMatrix,
@@ -146,14 +140,10 @@ class DynamicsSolver(Alpha2Integrator):
         if self._coupled is not None:
             self.A = self._coupled.A
         dim = msh.geometry.dim
-        amg_type = requested_amg(prefix)
-        if amg_type is not None:  # -<prefix>pc_type gamg|hypre: the AMG path, its defaults
-            linear_solver = "amg"
-        if linear_solver == "auto":
-            linear_solver = choose_linear_solver(dim, self.b.getSize(), msh.comm.size, False,
-                                                 contact=bool(self.couplings))
-        if linear_solver == "amg":
-            options = {**amg_options(dim, amg_type or "gamg"), **(options or {})}
+        _, amg_defaults = resolve_linear_solver(prefix, linear_solver, dim, self.b.getSize(),
+                                                msh.comm.size, splits=False,
+                                                contact=bool(self.couplings))
+        options = {**amg_defaults, **(options or {})}
         super().__init__(msh.comm, prefix, self.b, self.A, options, atol, predictor)
         self.linear_solver, self.near_nullspace = "lu", None
         if uses_amg(self.ts.getSNES().getKSP()):

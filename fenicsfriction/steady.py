@@ -44,10 +44,9 @@ from dolfinx import fem
 
 from fenicsfriction import _compat
 from fenicsfriction.amg import (
-    amg_options,
     attach_near_nullspace,
-    choose_linear_solver,
     requested_amg,
+    resolve_linear_solver,
     uses_amg,
 )
 from fenicsfriction.assembly import (
@@ -227,15 +226,13 @@ class SteadySolver:
             self.A = self._coupled.A
         comm = self.u.function_space.mesh.comm
         dim = self.u.function_space.mesh.geometry.dim
-        amg_type = requested_amg(prefix)
-        if amg_type is not None:  # -<prefix>pc_type gamg|hypre: the AMG path, its defaults
-            linear_solver = "amg"
-        split = (None if linear_solver == "lu" or self.couplings
+        # the constant bulk and the interface: not for the LU per iteration (unless the options
+        # ask for AMG), nor with contact couplings
+        split = (None if self.couplings or (linear_solver == "lu" and requested_amg(prefix) is None)
                  else interface_split(jacobian, self.u))
-        if linear_solver == "auto" and choose_linear_solver(
-                dim, self.A.getSize()[0], comm.size, splits=split is not None,
-                contact=bool(self.couplings)) == "amg":
-            linear_solver = "amg"
+        linear_solver, amg_defaults = resolve_linear_solver(
+            prefix, linear_solver, dim, self.A.getSize()[0], comm.size,
+            splits=split is not None, contact=bool(self.couplings))
         self.preconditioner: InterfaceCondensation | ReusedFactorisation | None = None
         if split is not None and linear_solver in ("auto", "condensed"):
             nonzeros = self.A.getInfo(PETSc.Mat.InfoType.GLOBAL_SUM)["nz_allocated"]
@@ -254,7 +251,7 @@ class SteadySolver:
         self.snes.setFunction(self._F, self.b)
         self.snes.setJacobian(self._J, self.A)
         defaults = {**DEFAULT_OPTIONS, **(KRYLOV_OPTIONS if self.preconditioner else {}),
-                    **(amg_options(dim, amg_type or "gamg") if linear_solver == "amg" else {}),
+                    **amg_defaults,
                     **(options or {})}
         with options_with_defaults(prefix, defaults):
             self.snes.setFromOptions()

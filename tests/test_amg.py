@@ -219,6 +219,28 @@ def test_auto_takes_amg_beyond_the_crossover(monkeypatch):
     assert hypre.snes.getKSP().getPC().getHYPREType() == "boomeramg"
 
 
+def test_the_steady_and_dynamics_solvers_settle_the_path_by_one_rule():
+    """resolve_linear_solver, which both solvers call: the AMG path, with its defaults for the
+    preconditioner asked for, wherever the options ask for AMG, ``"amg"`` is chosen, or
+    ``"auto"`` is past the crossover without contact; any other choice is left alone."""
+    gamg3, hypre3 = amg.amg_options(3, "gamg"), amg.amg_options(3, "hypre")
+    assert hypre3["pc_type"] == "hypre" and gamg3["pc_type"] == "gamg"
+    big = 10 * amg.AMG_MIN_UNKNOWNS_3D
+    assert amg.resolve_linear_solver("r_", "auto", 3, big, 1, False, False) == ("amg", gamg3)
+    assert amg.resolve_linear_solver("r_", "auto", 3, big, 1, False, True) == ("auto", {})
+    assert amg.resolve_linear_solver("r_", "auto", 3, 10, 1, True, False) == ("auto", {})
+    assert amg.resolve_linear_solver("r_", "amg", 2, 10, 1, True, True) == (
+        "amg", amg.amg_options(2, "gamg"))
+    for choice in ("lu", "reused-lu", "condensed"):
+        assert amg.resolve_linear_solver("r_", choice, 3, big, 1, True, False) == (choice, {})
+    opts = PETSc.Options()
+    opts["r_pc_type"] = "hypre"
+    try:
+        assert amg.resolve_linear_solver("r_", "lu", 3, 10, 1, False, True) == ("amg", hypre3)
+    finally:
+        opts.delValue("r_pc_type")
+
+
 def test_an_unknown_linear_solver_is_refused_by_name():
     model = ff.BlockOnBelt(refine=1).build(MPI.COMM_WORLD, with_friction=True)
     with pytest.raises(ValueError, match="linear_solver='multigrid' is invalid: use one of"):

@@ -241,9 +241,12 @@ def test_contact_area_is_the_projected_area_of_the_nodes_in_contact():
     """The default quarter sphere moved rigidly by δ into the block (no solve): the slave
     nodes below z = δ penetrate. Their projected tributary areas, all nodes together, tile
     the polygon of the surface's rim on the plane (the faceted surface is a graph over it;
-    the shoelace area of the rim nodes, to round-off); the nodes in contact make a quarter
-    disc whose radius is that of the rigid indentation, √(2Rδ − δ²), to within half an
-    element (the area's rim runs midway between the nodes in and out of contact)."""
+    the shoelace area of the rim nodes, to round-off), in the gathered surface values too
+    (whose unprojected weights tile the faceted hemisphere, twice the disc); the contact area
+    sums those of exactly the nodes below z = δ, and the nodes in contact make a quarter disc
+    whose radius is that of the rigid indentation, √(2Rδ − δ²), to within half an element
+    (the area's rim runs midway between the nodes in and out of contact); the gap changes
+    sign on the plane z = δ (the rigid gap z − δ, linear along each edge)."""
     from fenicsfriction.studies.contact import geometry
     from fenicsfriction.studies.contact.validation import Hertz
 
@@ -261,13 +264,24 @@ def test_contact_area_is_the_projected_area_of_the_nodes_in_contact():
     assert weights.sum() == pytest.approx(polygon, rel=1e-10)
     assert polygon == pytest.approx(np.pi * R**2 / 4, rel=0.02)  # the rim is inscribed
     body1 = model._body1_dofs
+    values = model.surface_values()
+    assert values.projected_weight.sum() == pytest.approx(polygon, rel=1e-10)
+    # the faceted hemisphere 2πR²/4 over the quarter disc πR²/4, both inscribed (measured 2.017)
+    assert values.weight.sum() == pytest.approx(2 * polygon, rel=0.03)
     for rho in (0.06, 0.1, 0.14):
         delta = R - np.sqrt(R**2 - rho**2)
         model.u.x.array[:] = 0.0
         model.u.x.array[body1] = -delta
         model.u.x.scatter_forward()
-        radius = np.sqrt(4 * model.contact_area() / np.pi)
+        values = model.surface_values()
+        below = values.x[:, 2] < delta
+        assert model.contact_area(values) == pytest.approx(
+            values.projected_weight[below].sum(), rel=1e-12)
+        assert model.contact_area() == model.contact_area(values)
+        radius = np.sqrt(4 * model.contact_area(values) / np.pi)
         assert abs(radius - rho) < h / 2, (rho, radius)
+        edge = model.contact_edge(values)
+        assert len(edge) > 0 and np.allclose(edge[:, 2], delta, rtol=0, atol=1e-12 * R)
     assert geometry.SLAVE in model.geometry.facet_tags.values
 
 

@@ -154,11 +154,12 @@ def test_hertz_pressures_agree_on_one_and_two_ranks():
     """The quarter sphere pressed to Hertz's a = R/10 on this communicator (the contact
     partition) and on each rank alone: the nodal pressures agree to 1e-8 of the peak (Newton
     converges quadratically, its last step leaves round-off; the search is the same), and so
-    do the recovered contact area (summed over the ranks) and the pressure on the axis
-    (projected from the gathered nodal values)."""
+    do the recovered contact area (summed over the nodes) and the pressure on the axis
+    (projected from the gathered nodal values), and the points where the gap changes sign
+    (interpolated along the facets' edges from each rank's owned and ghost nodes)."""
     scene = Hertz(dim=3)
     delta = (scene.radius / 10) ** 2 / scene.radius
-    pressures, recovered = [], []
+    pressures, recovered, edges = [], [], []
     for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
         model = scene.model(_hertz_mesh(comm), fix_load_face=False)
         model.solve_at(delta)
@@ -166,7 +167,9 @@ def test_hertz_pressures_agree_on_one_and_two_ranks():
         # by coordinates rounded off (a partition's coordinates may differ by 1e-17)
         order = np.lexsort(np.round(values.x, 12).T[::-1])
         pressures.append((values.x[order], values.pressure[order]))
-        area = model.contact_area()
+        area = model.contact_area(values)
+        edge = model.contact_edge(values)
+        edges.append(edge[np.lexsort(np.round(edge, 9).T[::-1])])
         r = np.linalg.norm(values.x[:, :2], axis=1)
         # the whole zone: this coarse mesh has few nodes near the axis
         recovered.append((area, pressure_on_axis(r, values.pressure, values.load_weight,
@@ -179,6 +182,8 @@ def test_hertz_pressures_agree_on_one_and_two_ranks():
     assert area1 > 0
     assert area1 == pytest.approx(area2, rel=1e-12)  # the same nodes in contact
     assert axis1 == pytest.approx(axis2, rel=1e-8)
+    assert len(edges[0]) > 0 and edges[0].shape == edges[1].shape
+    assert np.allclose(edges[0], edges[1], rtol=0, atol=1e-6 * scene.radius)
 
 
 def _mortar_contacts(u: fem.Function, mesh: geometry.TwoBodyMesh) -> list[SegmentToSegment]:

@@ -100,6 +100,8 @@ class SurfaceValues:
             force a unit pressure puts on the node (degree 1: ``weight``; degree 2 in 2D: 1/6
             and 2/3 of a facet's length at its vertices and midpoint, in 3D 0 and 1/3 of a
             triangle's area).
+        projected_weight: the node's tributary length or area projected on the contact plane
+            (:meth:`TwoBodyModel.contact_area`).
     """
 
     x: np.ndarray
@@ -109,6 +111,7 @@ class SurfaceValues:
     traction: np.ndarray
     force: np.ndarray
     load_weight: np.ndarray
+    projected_weight: np.ndarray
 
 
 class TwoBodyModel:
@@ -353,7 +356,9 @@ class TwoBodyModel:
                            f"load {load:.6g} within {max_solves} solves (max_solves)")
 
     def surface_values(self) -> SurfaceValues:
-        """Nodal values on the slave surface of the first pass (see :class:`SurfaceValues`)."""
+        """Nodal values on the slave surface of the first pass (see :class:`SurfaceValues`),
+        after one contact search at the current state: pass them to :meth:`contact_area` and
+        :meth:`contact_edge` to measure that state without searching again."""
         contact = self.contacts[0]
         contact.update()
         weight = contact.nodal_weights
@@ -361,7 +366,7 @@ class TwoBodyModel:
         if contact.traction is None:
             values = np.column_stack([values, np.zeros((len(weight), self.dim))])
         force = self._contact_force()
-        owned = np.flatnonzero(weight > 0)
+        owned, order, _ = self._surface_order
         x = contact.nodal_space.tabulate_dof_coordinates()[owned, :self.dim]
         load = self._load_weight[owned]
         loaded = load > 1e-12 * self.comm.allreduce(float(load.max(initial=0.0)), op=MPI.MAX)
@@ -369,15 +374,39 @@ class TwoBodyModel:
             / self.comm.allreduce(int(np.count_nonzero(loaded)))
         local = np.column_stack([x, weight[owned], values[owned],
                                  force[owned] / np.where(loaded, load, mean)[:, None],
-                                 np.where(loaded, load, 0.0)])
-        rows = np.vstack(self.comm.allgather(local))
-        rows = rows[np.lexsort(rows[:, :self.dim].T[::-1])]  # by x, then y (then z)
+                                 np.where(loaded, load, 0.0), self._projected_weight[owned]])
+        rows = np.vstack(self.comm.allgather(local))[order]
         d = self.dim
         return SurfaceValues(x=rows[:, :d], weight=rows[:, d], gap=rows[:, d + 1],
                              pressure=rows[:, d + 2], traction=rows[:, d + 3:2 * d + 3],
-                             force=rows[:, 2 * d + 3:3 * d + 3], load_weight=rows[:, 3 * d + 3])
+                             force=rows[:, 2 * d + 3:3 * d + 3], load_weight=rows[:, 3 * d + 3],
+                             projected_weight=rows[:, 3 * d + 4])
 
-    def contact_area(self) -> float:
+    @functools.cached_property
+    def _surface_order(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The rows of :meth:`surface_values`: the owned slave nodes of the first pass (local
+        indices, nodal weight > 0); the order that sorts their gathered list (over the ranks
+        in turn) by x, then y (then z); and each local node's row in the sorted list (owned and
+        ghost nodes; -1 off the slave surface)."""
+        space = self.contacts[0].nodal_space
+        index_map = space.dofmap.index_map
+        owned = np.flatnonzero(self.contacts[0].nodal_weights > 0)
+        x = np.vstack(self.comm.allgather(space.tabulate_dof_coordinates()[owned, :self.dim]))
+        order = np.lexsort(x.T[::-1])
+        numbers = np.concatenate(self.comm.allgather(
+            index_map.local_to_global(owned.astype(np.int32)).astype(np.int64)))[order]
+        local = np.arange(index_map.size_local + index_map.num_ghosts, dtype=np.int32)
+        wanted = index_map.local_to_global(local).astype(np.int64)
+        by_number = np.argsort(numbers)
+        found = np.minimum(np.searchsorted(numbers, wanted, sorter=by_number),
+                           max(len(numbers) - 1, 0))
+        row = np.full(len(local), -1, dtype=np.int64)
+        if len(numbers):
+            hit = numbers[by_number[found]] == wanted
+            row[hit] = by_number[found[hit]]
+        return owned, order, row
+
+    def contact_area(self, values: SurfaceValues | None = None) -> float:
         r"""The contact zone's area as the contact's nodal rule integrates it (2D: length),
         on the contact plane :math:`x_d = 0` (the master's surface, normal :math:`e_d`):
 
@@ -389,12 +418,15 @@ class TwoBodyModel:
         tributary area projected on the plane. The zone's boundary then runs about midway
         between the last nodes in contact and the first open ones, so its error is of either
         sign and averages out along a 3D zone's rim (where the gap's sign change, which hugs
-        the last contact node, is biased inwards by about h/2). Summed over the ranks."""
-        contact = self.contacts[0]
-        contact.update()
-        pressure = self._surface_nodal()[:, 1]
-        inside = pressure > 0
-        return self.comm.allreduce(float(self._projected_weight[inside].sum()))
+        the last contact node, is biased inwards by about h/2). Summed over all the nodes (the
+        same sum on every rank and on any number of ranks).
+
+        Args:
+            values: :meth:`surface_values` at the current state (``None``: evaluated here,
+                with a contact search).
+        """
+        values = self.surface_values() if values is None else values
+        return float(values.projected_weight[values.pressure > 0].sum())
 
     @functools.cached_property
     def _projected_weight(self) -> np.ndarray:
@@ -429,18 +461,24 @@ class TwoBodyModel:
         contact's current pairing and mirrors (``update`` them first)."""
         return self._gap_nodal()[:, 0]
 
-    def contact_edge(self) -> np.ndarray:
+    def contact_edge(self, values: SurfaceValues | None = None) -> np.ndarray:
         """Points where the gap changes sign along the slave facets' edges (linear
-        interpolation of the nodal gaps), gathered on every rank: the contact zone's boundary
-        (its two ends in 2D, a ring in 3D), second-order accurate where the gap is smooth."""
+        interpolation of the nodal gaps), one per edge of each facet (an edge inside the
+        surface: twice), gathered on every rank (the same points on any number of ranks): the
+        contact zone's boundary (its two ends in 2D, a ring in 3D), second-order accurate where
+        the gap is smooth.
+
+        Args:
+            values: :meth:`surface_values` at the current state (``None``: evaluated here,
+                with a contact search).
+        """
         contact = self.contacts[0]
-        contact.update()
-        gap = fem.Function(contact.nodal_space)
-        owned = self.nodal_gap()
-        gap.x.array[:len(owned)] = owned
-        gap.x.scatter_forward()
+        values = self.surface_values() if values is None else values
+        row = self._surface_order[2]
+        # each local node's gap (owned and ghost; 0 off the slave surface)
+        gap = np.where(row >= 0, values.gap[row], 0.0)
         edges = _surface_edges(contact.nodal_space, self.geometry.facet_tags, SLAVE)
-        g = gap.x.array[edges]
+        g = gap[edges]
         crossing = g[:, 0] * g[:, 1] < 0
         x = contact.nodal_space.tabulate_dof_coordinates()[:, :self.dim]
         a, b = edges[crossing, 0], edges[crossing, 1]
@@ -478,9 +516,10 @@ class TwoBodyModel:
 
 def _surface_edges(V: fem.FunctionSpace, facet_tags: mesh.MeshTags, tag: int) -> np.ndarray:
     """Pairs of nodes of ``V`` (local indices) joined by an edge of the linear sub-facets of
-    the facets tagged ``tag``: the facets' edges (degree 1), or the edges of the segments
-    (2D) and four triangles (3D) that the midside nodes cut each facet into (degree 2,
-    straight facets: a midside node is the midpoint of its two vertices)."""
+    the owned facets tagged ``tag`` (each facet on one rank): the facets' edges (degree 1), or
+    the edges of the segments (2D) and four triangles (3D) that the midside nodes cut each
+    facet into (degree 2, straight facets: a midside node is the midpoint of its two
+    vertices)."""
     msh = V.mesh
     tdim = msh.topology.dim
     msh.topology.create_connectivity(tdim - 1, tdim)
@@ -490,7 +529,9 @@ def _surface_edges(V: fem.FunctionSpace, facet_tags: mesh.MeshTags, tag: int) ->
     layout = V.dofmap.dof_layout
     x = V.tabulate_dof_coordinates()
     edges = []
-    for facet in facet_tags.indices[facet_tags.values == tag]:
+    owned = msh.topology.index_map(tdim - 1).size_local
+    tagged = facet_tags.indices[facet_tags.values == tag]
+    for facet in tagged[tagged < owned]:
         cell = f_to_c.links(facet)[0]
         local = int(np.flatnonzero(c_to_f.links(cell) == facet)[0])
         nodes = V.dofmap.cell_dofs(cell)[layout.entity_closure_dofs(tdim - 1, local)]

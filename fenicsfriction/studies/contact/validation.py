@@ -216,15 +216,16 @@ class Hertz(_Bodies):
         # the quarter model carries a quarter of the load
         share = 1.0 if self.dim == 2 else 0.25
         solved = model.solve_for_load(share * self.load, guess=a**2 / self.radius, rtol=1e-5)
-        edge = model.contact_edge()
-        values = model.surface_values()
+        values = model.surface_values()  # one contact search for every figure below
+        edge = model.contact_edge(values)
         # where the interpolated nodal gap changes sign: next to the last contact node
         crossing = (np.ptp(edge[:, 0]) / 2 if self.dim == 2
                     else float(np.mean(np.linalg.norm(edge[:, :2], axis=1))))
         width = "half_width" if self.dim == 2 else "contact_radius"
         # 2D: the sign change; 3D: the radius of the nodal rule's contact area on the quarter
         # model (four quarters make the circle πa²)
-        measured = crossing if self.dim == 2 else math.sqrt(4 * model.contact_area() / math.pi)
+        measured = (crossing if self.dim == 2
+                    else math.sqrt(4 * model.contact_area(values) / math.pi))
         r = values.x[:, 0] if self.dim == 2 else np.linalg.norm(values.x[:, :2], axis=1)
         # the pressure each node transmits (its force over its load weight; nodes of zero
         # load weight, a 6-node triangle's vertices, carry none): node-to-segment's law

@@ -31,6 +31,7 @@ object with their ``pdf``, ``cdf``, ``sf``, ``ppf`` and ``isf`` methods. Random 
 
 from __future__ import annotations
 
+import abc
 import dataclasses
 import typing
 
@@ -239,18 +240,19 @@ class SpringDrivenResult(Record):
     parameters: dict
 
 
-class SpringDrives:
+class SpringDrives(abc.ABC):
     """The slider pulled through a spring, whatever holds its contacts: a model gives
     :meth:`contacts` (a fresh realisation) and :meth:`parameters`, and the drives are these
-    (:class:`EQModel`'s independent contacts, the interacting models' coupled ones)."""
+    (:class:`EQModel`'s independent contacts, the interacting models' coupled ones). An
+    abstract base: a model that lacks either cannot be made."""
 
+    @abc.abstractmethod
     def contacts(self, rng: np.random.Generator) -> Contacts:
         """A fresh realisation of the contacts, every contact relaxed at X = 0."""
-        raise NotImplementedError
 
+    @abc.abstractmethod
     def parameters(self) -> dict[str, typing.Any]:
         """The model's parameters, which go into every result."""
-        raise NotImplementedError
 
     def spring_driven(self, K: float, v: float, mass: float, damping: float, t_end: float,
                       dt: float, seed: int | None = 0, late_from: float | None = None,

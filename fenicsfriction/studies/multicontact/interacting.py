@@ -57,6 +57,7 @@ nearest image (Strang 1986, "A proposal for Toeplitz matrix calculations"). Set-
 
 from __future__ import annotations
 
+import abc
 import dataclasses
 import math
 import typing
@@ -363,19 +364,19 @@ class InteractingQuasistaticResult(QuasistaticResult):
 
 class _Interface(SpringDrives):
     """The drives of interacting contacts, whatever holds their stiffness (the spring drives
-    are :class:`~fenicsfriction.studies.multicontact.eq_model.SpringDrives`')."""
+    are :class:`~fenicsfriction.studies.multicontact.eq_model.SpringDrives`'; abstract: a
+    model gives ``interface_stiffness``, ``parameters`` and ``contacts``)."""
 
     model: EQModel
 
     @property
+    @abc.abstractmethod
     def interface_stiffness(self) -> float:
-        raise NotImplementedError
+        """S, the friction force's slope dF/dX between breaks."""
 
-    def parameters(self) -> dict[str, typing.Any]:
-        raise NotImplementedError
-
+    @abc.abstractmethod
     def contacts(self, rng: np.random.Generator) -> CoupledContacts:
-        raise NotImplementedError
+        """A fresh realisation of the coupled contacts, every contact relaxed at X = 0."""
 
     def quasistatic(self, X_max: float, n_points: int = 401, realisations: int = 1,
                     seed: int | None = 0, kinetic_from: float | None = None,
