@@ -44,12 +44,12 @@ imported only for that comparison), three ways:
   c_d = √(area/π) (c_d², c_d³, c_d⁴ as for c) instead of c = √(ab).
 
 The elements whose centre lies inside give a staircase contact whose area jumps by up to
-±3 % between neighbouring grids; the coefficients follow (their scatter is that large), so the
-three-grid Richardson order is that scatter, not an asymptotic order, and the fits over many
+±1 % between neighbouring grids (n >= 10); the coefficients follow, so the three-grid
+Richardson order mostly measures that scatter, not an asymptotic order, and the fits over many
 grids are the estimates to read. Writes ``bench_kalker_bem.json`` and ``bench_kalker_bem.png``
 (every coefficient / the table's value against 1/n) to ``--out``, and prints a markdown table.
-Serial; about 7 minutes with the default grids (n = 48: 7,200 elements, 3,600 on the half
-y > 0 solved, about 20 s per ellipse and ν).
+Serial; about 6 minutes and 2 GB with the default grids (n = 48: 7,232 elements, 3,616 on the
+half y > 0 solved, about 15 s per ellipse and ν).
 """
 
 from __future__ import annotations
