@@ -319,6 +319,18 @@ def _run_coupling_map(args: argparse.Namespace, log: logging.Logger, comm: MPI.C
 
 # --- the elastic interaction of contacts --------------------------------------------------------
 
+def _profile_edges(n: int) -> typing.Any:
+    """The distance bins of the break response's radial profile on an n × n lattice."""
+    import numpy as np
+
+    return np.geomspace(1.0, n / 4, 40)
+
+
+def _centre(n: int) -> int:
+    """The index of the contact that breaks: the lattice's centre."""
+    return (n // 2) * n + n // 2
+
+
 def _far_bins(n: int, lambda_c: float) -> int:
     """How many points of the response's profile lie beyond 3 λ_c (the far law's range): the
     lattice's distances from the centre contact, binned as the profile bins them (empty bins
@@ -330,8 +342,7 @@ def _far_bins(n: int, lambda_c: float) -> int:
 
     i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
     positions = np.stack([i.ravel(), j.ravel()], axis=1).astype(float)
-    r, _ = radial_profile(positions, np.ones((n * n, 1)), (n // 2) * n + n // 2,
-                          edges=np.geomspace(1.0, n / 4, 40))
+    r, _ = radial_profile(positions, np.ones((n * n, 1)), _centre(n), edges=_profile_edges(n))
     return int(np.count_nonzero(r > 3 * lambda_c))
 
 
@@ -357,7 +368,6 @@ def _run_interaction(args: argparse.Namespace, log: logging.Logger, comm: MPI.Co
     )
 
     lam = args.lambda_c
-    edges = np.geomspace(1.0, args.n / 4, 40)
     check("--n", args.n, _far_bins(args.n, lam) >= 2,
           f"a lattice reaching past 3 λ_c = {3 * lam:g} spacings, where the far law is "
           f"fitted (with --lambda-c {lam:g}: --n >= {_smallest_n(lam)})")
@@ -367,9 +377,9 @@ def _run_interaction(args: argparse.Namespace, log: logging.Logger, comm: MPI.Co
     log.info(f"interaction: {args.n} x {args.n} contacts (spacing a = 1, E = 1, ν = "
              f"{args.nu:g}), k = 1/λ_c: λ_c = a²E/k = {lam:g} a; the centre contact breaks "
              "under a uniform shear")
-    broken = (args.n // 2) * args.n + args.n // 2
+    broken = _centre(args.n)
     response = lattice.break_response((1.0, 0.0, 0.0), broken)
-    r, f = radial_profile(lattice.positions, response, broken, edges=edges)
+    r, f = radial_profile(lattice.positions, response, broken, edges=_profile_edges(args.n))
     f = f / np.linalg.norm(response[broken])
     near = max(lam / 4, 2.0)  # at least two distance bins for the near law
     fit = fit_power_laws(r, f, near, 3 * lam)
