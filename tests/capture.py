@@ -5,6 +5,7 @@ check reported figures (``test_reported_*.py``) read a run through these, one wa
 from __future__ import annotations
 
 import contextlib
+import csv
 import ctypes
 import logging
 import os
@@ -84,3 +85,39 @@ def xdmf_nodes(xdmf: pathlib.Path) -> int:
                          xdmf.read_text())
     assert geometry is not None
     return int(geometry.group(1))
+
+
+def run_main(argv: list[str], summary: str = "summary.json",
+             options: dict | None = None) -> dict:
+    """``main(argv)`` in this process, with the PETSc ``options`` set for it alone: its exit
+    status (``code``), the JSON ``summary`` it wrote (``json``), the rows of its
+    timeseries.csv as floats (``rows``; None without one), the lines it printed to stdout
+    and stderr (``stdout``, ``stderr``) and its time (``seconds``)."""
+    import io
+    import json
+    import time
+
+    from petsc4py import PETSc
+
+    from fenicsfriction.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    database = PETSc.Options()
+    for name, value in (options or {}).items():
+        database.setValue(name, value)
+    t0 = time.perf_counter()
+    try:
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            code = main(argv)
+    finally:
+        for name in options or {}:
+            database.delValue(name)
+    seconds = time.perf_counter() - t0
+    folder = pathlib.Path(argv[argv.index("--out") + 1])
+    data = json.loads((folder / summary).read_text())
+    rows = None
+    if (folder / "timeseries.csv").exists():
+        with open(folder / "timeseries.csv") as table:
+            rows = [{k: float(v) for k, v in row.items()} for row in csv.DictReader(table)]
+    return {"code": code, "json": data, "rows": rows, "stdout": out.getvalue().splitlines(),
+            "stderr": err.getvalue().splitlines(), "seconds": seconds}

@@ -8,21 +8,16 @@ Floquet exponent by SciPy's Runge-Kutta instead of PETSc TS).
 One run per command, shared by the module's tests; the audit table is in
 docs/verification.md, "Reported figures"."""
 
-import contextlib
-import csv
 import dataclasses
-import io
-import json
 import math
 import re
-import time
 
 import numpy as np
 import pytest
 import scipy.integrate
+from capture import run_main
 
 from fenicsfriction import laws
-from fenicsfriction.cli import main
 from fenicsfriction.events import integrate_hybrid
 from fenicsfriction.petsc_options import EVENTS_LOCATED_TO_RESOLUTION
 from fenicsfriction.studies.oscillators import BeltOscillator
@@ -44,22 +39,9 @@ def _flags(values: dict) -> list[str]:
 
 
 def _run(argv: list[str], name: str) -> dict:
-    """``main(argv)``: exit status, the JSON, the rows of timeseries.csv, printed lines and
-    the run's time."""
-    out = io.StringIO()
-    t0 = time.perf_counter()
-    with contextlib.redirect_stdout(out):
-        code = main(argv)
-    seconds = time.perf_counter() - t0
-    folder = argv[argv.index("--out") + 1]
-    with open(f"{folder}/{name}") as f:
-        data = json.load(f)
-    rows = None
-    if name == "summary.json":
-        with open(f"{folder}/timeseries.csv") as f:
-            rows = [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
-    return {"code": code, "json": data, "rows": rows, "lines": out.getvalue().splitlines(),
-            "seconds": seconds}
+    """:func:`capture.run_main`, its JSON ``name``; the printed lines as ``lines``."""
+    run = run_main(argv, name)
+    return {**run, "lines": run["stdout"]}
 
 
 def _run_logging_calls(argv: list[str], name: str) -> dict:

@@ -10,21 +10,17 @@ wrapper around the model's right-hand side (as a terminal's Ctrl-C would arrive 
 failures are forced by a PETSc limit (``ts_max_steps``, ``snes_max_it``) that the test removes
 again. The audit table is in docs/verification.md, "Reported figures"."""
 
-import contextlib
-import csv
-import io
-import json
 import os
 import re
 import signal
-import time
 
 from petsc4py import PETSc
 
 import pytest
 import scipy.integrate
+from capture import run_main
 
-from fenicsfriction.cli import common, main
+from fenicsfriction.cli import common
 from fenicsfriction.results import CsvRows
 from fenicsfriction.studies.oscillators import BeltOscillator
 from fenicsfriction.studies.oscillators.slider import SliderMotion
@@ -41,32 +37,6 @@ MAX_STEPS = 40
 BLOCK_ROWS = 6
 
 
-def _run(argv: list[str], summary: str = "summary.json", options: dict | None = None) -> dict:
-    """``main(argv)`` with the PETSc ``options`` set for it alone: exit status, the summary,
-    the rows of timeseries.csv (if any), stdout and stderr lines and the command's time."""
-    out, err = io.StringIO(), io.StringIO()
-    database = PETSc.Options()
-    for name, value in (options or {}).items():
-        database.setValue(name, value)
-    t0 = time.perf_counter()
-    try:
-        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-            code = main(argv)
-    finally:
-        for name in options or {}:
-            database.delValue(name)
-    seconds = time.perf_counter() - t0
-    folder = argv[argv.index("--out") + 1]
-    with open(f"{folder}/{summary}") as f:
-        data = json.load(f)
-    rows = None
-    if os.path.exists(f"{folder}/timeseries.csv"):
-        with open(f"{folder}/timeseries.csv") as f:
-            rows = [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
-    return {"code": code, "json": data, "rows": rows, "stdout": out.getvalue().splitlines(),
-            "stderr": err.getvalue().splitlines(), "seconds": seconds}
-
-
 def _signalled_at_row(rows: int, signum: int, argv: list[str]) -> dict:
     """:func:`_run` with ``signum`` sent to this process as the ``rows``-th row is written."""
     write, written = CsvRows.write, [0]
@@ -79,7 +49,7 @@ def _signalled_at_row(rows: int, signum: int, argv: list[str]) -> dict:
 
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(CsvRows, "write", write_then_signal)
-        return _run(argv)
+        return run_main(argv)
 
 
 def _signalled_in_set_up(signum: int, argv: list[str]) -> dict:
@@ -95,7 +65,7 @@ def _signalled_in_set_up(signum: int, argv: list[str]) -> dict:
 
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(common, "output_folder", signal_then_folder)
-        return _run(argv)
+        return run_main(argv)
 
 
 def _signalled(system: type, signum: int, argv: list[str]) -> dict:
@@ -111,7 +81,7 @@ def _signalled(system: type, signum: int, argv: list[str]) -> dict:
 
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(system, "rhs", rhs_then_signal)
-        return _run(argv)
+        return run_main(argv)
 
 
 @pytest.fixture(scope="module")
@@ -128,11 +98,11 @@ def runs(tmp_path_factory):
                                    [*belt, "--out", str(root / "belt-stopped")]),
         "slider stopped": _signalled(SliderMotion, signal.SIGINT,
                                      [*slider, "--out", str(root / "slider-stopped")]),
-        "belt failed": _run([*belt, "--out", str(root / "belt-failed")],
+        "belt failed": run_main([*belt, "--out", str(root / "belt-failed")],
                             options={"belt_ts_max_steps": MAX_STEPS}),
-        "slider failed": _run([*slider, "--out", str(root / "slider-failed")],
+        "slider failed": run_main([*slider, "--out", str(root / "slider-failed")],
                               options={"hybrid_ts_max_steps": MAX_STEPS}),
-        "rolling failed": _run(rolling, "rolling.json", options={"rolling_snes_max_it": 1}),
+        "rolling failed": run_main(rolling, "rolling.json", options={"rolling_snes_max_it": 1}),
         "block stopped": _signalled_at_row(
             BLOCK_ROWS, signal.SIGINT, ["block", "dynamics", "--mu", "0.6", "--belt-speed",
                                         "0.08", "--t-end", "0.2", "--out", str(root / "block")]),
