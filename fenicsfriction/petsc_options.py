@@ -14,7 +14,7 @@ from petsc4py import PETSc
 import numpy as np
 
 __all__ = ["EVENTS_LOCATED_TO_RESOLUTION", "RoundoffConvergence", "callback_error",
-           "options_with_defaults"]
+           "options_inserted", "options_with_defaults"]
 
 
 @contextlib.contextmanager
@@ -35,6 +35,28 @@ def options_with_defaults(prefix: str, defaults: dict) -> typing.Iterator[PETSc.
     finally:
         for key in added:
             opts.delValue(key)
+
+
+@contextlib.contextmanager
+def options_inserted(text: str) -> typing.Iterator[None]:
+    """Insert ``text`` (``-name value`` pairs, as on a command line) into the PETSc options
+    database for the duration of the block, then put the database back as it was: the
+    options added are removed and those overridden get their old values again.
+
+    The command line's PETSc options belong to its one run; without this a second run in
+    the same process (a notebook, a test) would inherit, say, the first's ``snes_max_it``.
+    """
+    opts = PETSc.Options()
+    before = opts.getAll()
+    opts.insertString(text)
+    try:
+        yield
+    finally:
+        for key, value in opts.getAll().items():
+            if key not in before:
+                opts.delValue(key)
+            elif before[key] != value:
+                opts.setValue(key, before[key])
 
 
 def callback_error(error: PETSc.Error) -> BaseException:

@@ -11,6 +11,7 @@ import tempfile
 import time
 
 from mpi4py import MPI
+from petsc4py import PETSc
 
 import numpy as np
 import pytest
@@ -209,6 +210,24 @@ def test_bad_parameter_value_is_reported_by_name(out_dir, capsys, flag, value, n
     err = capsys.readouterr().err
     if MPI.COMM_WORLD.rank == 0:
         assert name in err and value in err
+
+
+def test_a_runs_petsc_options_end_with_it(out_dir):
+    """The PETSc options on a command line are that run's: called in-process (a notebook, a
+    test), the database afterwards is the one before, an option the run overrode back at its
+    old value and one it added gone, whether the run succeeds or stops on a user error."""
+    opts = PETSc.Options()
+    opts["steady_snes_rtol"] = "1e-11"  # the process's own, set before the run
+    try:
+        for extra, code in (([], 0), (["--steps", "0"], 2)):
+            argv = ["block", "steady", "--mu-max", "0.3", "--steps", "2", "--out",
+                    str(out_dir), *extra, "-steady_snes_rtol", "1e-12",
+                    "-steady_snes_max_it", "40"]
+            assert main(argv) == code
+            assert opts.getString("steady_snes_rtol") == "1e-11"
+            assert not opts.hasName("steady_snes_max_it")
+    finally:
+        opts.delValue("steady_snes_rtol")
 
 
 @pytest.mark.skipif(MPI.COMM_WORLD.size > 1,

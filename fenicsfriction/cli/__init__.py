@@ -106,9 +106,15 @@ def _main(argv: list[str]) -> int:
     if hint is not None:
         parser.exit(2, f"fenicsfriction: {hint}\n")
     args = parser.parse_args(argv[:split])
-    if split < len(argv):
-        from petsc4py import PETSc
-        PETSc.Options().insertString(" ".join(argv[split:]))
+    if split == len(argv):
+        return _run(args, argv)
+    from fenicsfriction.petsc_options import options_inserted
+    with options_inserted(" ".join(argv[split:])):  # this run's only, not the process's
+        return _run(args, argv)
+
+
+def _run(args: typing.Any, argv: list[str]) -> int:
+    """The command of the parsed ``args``, its set-up's signals and errors handled."""
     from mpi4py import MPI
 
     from fenicsfriction.cli.common import stop_line
