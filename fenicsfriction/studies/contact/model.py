@@ -304,7 +304,8 @@ class TwoBodyModel:
         overlap, the wider the deeper, Newton must shrink to the elastic contact zone by
         about one node per iteration; with two passes both surfaces' overlaps). Returns
         ``approach``, ``load`` (reached), ``newton_iterations`` (all solves, failed ones
-        included), ``solves`` and ``cutbacks``.
+        included), ``solves``, ``cutbacks``, and the last solve's ``residual_norm`` and
+        ``atol`` (the bound it met: how far from equilibrium the state returned may be).
 
         Raises:
             SolveError: a solve still failed after ``max_cutbacks`` cut-backs (the state is
@@ -346,7 +347,8 @@ class TwoBodyModel:
                 history.append((np.log(delta), np.log(force)))
             if abs(force / load - 1) < rtol:
                 return {"approach": delta, "load": force, "newton_iterations": iterations,
-                        "solves": solves, "cutbacks": cutbacks}
+                        "solves": solves, "cutbacks": cutbacks,
+                        "residual_norm": report.residual_norm, "atol": report.atol}
             if len(history) < 2:
                 delta *= 2.0 if force <= 0 else (load / force) ** 0.7
                 continue

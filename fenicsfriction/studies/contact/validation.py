@@ -323,6 +323,7 @@ class Patch(_Bodies):
             "dofs": model.dofs, "ranks": comm.size,
             "pressure_deviation": float(np.max(np.abs(transmitted - expected))),
             "newton_iterations": solved["newton_iterations"],
+            "residual_norm": solved["residual_norm"], "atol": solved["atol"],
             "wall_time_s": time.perf_counter() - t0,
         }
         return summary, model
