@@ -4,6 +4,8 @@ exist, so that the catalogue cannot silently go stale as the code moves on."""
 
 import importlib.util
 import pathlib
+import subprocess
+import sys
 
 import pytest
 
@@ -33,3 +35,17 @@ def test_every_room_listed_has_a_handful():
     for bug in BUGS:
         rooms[bug["room"]] = rooms.get(bug["room"], 0) + 1
     assert all(count >= 3 for count in rooms.values()), rooms
+
+
+def test_the_catching_test_is_named_from_pytests_own_summary(tmp_path):
+    """``caught_by`` reads the id of the first failing test out of a real pytest run's
+    output, run as the script runs it (-x -q -rfE)."""
+    (tmp_path / "test_probe.py").write_text(
+        "def test_passes():\n    pass\n\n\ndef test_fails():\n    assert 1 == 2\n\n\n"
+        "def test_never_reached():\n    assert False\n")
+    run = subprocess.run([sys.executable, "-m", "pytest", "-x", "-q", "-rfE", "-p",
+                          "no:cacheprovider", "test_probe.py"], cwd=tmp_path,
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 1
+    assert plant_bugs.caught_by(run.stdout) == "test_probe.py::test_fails"
+    assert plant_bugs.caught_by("1 passed in 0.01s") is None

@@ -5,11 +5,12 @@ room, small plausible mistakes (a constant, a sign, a dropped factor, a swapped 
 exact text to change, its replacement, and the test files that should notice. This script
 copies the checkout (tracked and modified files, as they are now) into a temporary folder,
 applies each bug there alone, runs its test files with ``pytest -x`` and reports whether they
-failed (caught) or passed (the bug SURVIVED). The working tree itself never holds a planted bug.
+failed (caught, and by which test first) or passed (the bug SURVIVED). The working tree itself
+never holds a planted bug.
 
     python tools/plant_bugs.py                      # every bug in the catalogue
     python tools/plant_bugs.py --room rolling       # one room
-    python tools/plant_bugs.py --out DIR            # also write DIR/planted_bugs.json
+    python tools/plant_bugs.py --out DIR            # also DIR/planted_bugs.json, bug by bug
 
 Exit status 0 when every bug is caught, 1 when one survived, 2 for a catalogue entry that no
 longer applies (its text is not found exactly once: the code moved on, mend the entry).
@@ -72,25 +73,40 @@ def _copy_checkout(target: pathlib.Path) -> None:
             shutil.copy2(source, target / name)
 
 
-def plant(bug: dict, tree: pathlib.Path, timeout: float) -> tuple[str, float, str]:
-    """Run ``bug``'s tests in ``tree`` with the bug in place; (verdict, seconds, last line)."""
+def caught_by(stdout: str) -> str | None:
+    """The test that failed first, from pytest's short summary (``-rfE``: "FAILED id - ..."
+    or "ERROR id - ..."), or None (a collection error names no test)."""
+    for line in stdout.splitlines():
+        for mark in ("FAILED ", "ERROR "):
+            if line.startswith(mark):
+                return line[len(mark):].split(" - ")[0].strip()
+    return None
+
+
+def plant(bug: dict, tree: pathlib.Path, timeout: float) -> dict:
+    """Run ``bug``'s tests in ``tree`` with the bug in place: ``verdict`` ("caught" or
+    "survived"), ``caught_by`` (the first failing test's id), ``seconds``, ``last_line``."""
     source = tree / bug["file"]
     original = source.read_text()
     source.write_text(original.replace(bug["old"], bug["new"], 1))
     env = dict(os.environ, PYTHONPATH=str(tree), PYTHONDONTWRITEBYTECODE="1")
     start = time.perf_counter()
+    by = None
     try:
-        run = subprocess.run([sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider",
-                              *bug["tests"]], cwd=tree, env=env, capture_output=True,
-                             text=True, timeout=timeout)
+        run = subprocess.run([sys.executable, "-m", "pytest", "-x", "-q", "-rfE", "-p",
+                              "no:cacheprovider", *bug["tests"]], cwd=tree, env=env,
+                             capture_output=True, text=True, timeout=timeout)
         verdict = "survived" if run.returncode == 0 else "caught"
         lines = [line for line in run.stdout.splitlines() if line.strip()]
         last = lines[-1] if lines else run.stderr.strip()[-200:]
+        if verdict == "caught":
+            by = caught_by(run.stdout)
     except subprocess.TimeoutExpired:
         verdict, last = "caught", f"the tests ran past {timeout:.0f} s (a hang counts as caught)"
     finally:
         source.write_text(original)
-    return verdict, time.perf_counter() - start, last
+    return {"verdict": verdict, "caught_by": by, "seconds": round(time.perf_counter() - start, 1),
+            "last_line": last}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -115,22 +131,27 @@ def main(argv: list[str] | None = None) -> int:
     if stale:
         return 2
 
-    results = []
+    results: list[dict] = []
+    if args.out:
+        args.out.mkdir(parents=True, exist_ok=True)
+
+    def write() -> None:  # after every bug: an interrupted run keeps what it found
+        if args.out:
+            (args.out / "planted_bugs.json").write_text(json.dumps(results, indent=1))
+
     with tempfile.TemporaryDirectory(prefix="planted-bugs-") as folder:
         tree = pathlib.Path(folder)
         _copy_checkout(tree)
         for i, bug in enumerate(bugs, 1):
-            verdict, seconds, last = plant(bug, tree, args.timeout)
-            results.append({**bug, "verdict": verdict, "seconds": round(seconds, 1),
-                            "last_line": last})
-            print(f"[{i}/{len(bugs)}] {verdict.upper():8s} {bug['room']:14s} {bug['why']} "
-                  f"({seconds:.0f} s)", flush=True)
+            outcome = plant(bug, tree, args.timeout)
+            results.append({**bug, **outcome})
+            write()
+            by = f" by {outcome['caught_by']}" if outcome["caught_by"] else ""
+            print(f"[{i}/{len(bugs)}] {outcome['verdict'].upper():8s} {bug['room']:14s} "
+                  f"{bug['why']}{by} ({outcome['seconds']:.0f} s)", flush=True)
     survived = [r for r in results if r["verdict"] == "survived"]
     print(f"{len(results) - len(survived)} of {len(results)} planted bugs caught"
           + (f"; SURVIVED: {'; '.join(r['why'] for r in survived)}" if survived else ""))
-    if args.out:
-        args.out.mkdir(parents=True, exist_ok=True)
-        (args.out / "planted_bugs.json").write_text(json.dumps(results, indent=1))
     return 1 if survived else 0
 
 
