@@ -617,7 +617,7 @@ def main() -> int:
                        f"({' '.join(map(str, DEFAULT_OFFSETS))})")
     flags.add_argument("--fast", action="store_true",
                        help=f"a smoke test: the grids {' '.join(map(str, FAST_GRIDS))}, all "
-                       "fitted, offset 0 only (about 2 min)")
+                       "fitted, offset 0 only (about 1 min; limits to about 0.6 %)")
     flags.add_argument("--fit-from", type=int, default=64,
                        help="the fits use the grids n >= this (64)")
     flags.add_argument("--rtol", type=float, default=1e-10,
