@@ -97,21 +97,15 @@ def run_main(argv: list[str], summary: str = "summary.json",
     import json
     import time
 
-    from petsc4py import PETSc
-
     from fenicsfriction.cli import main
+    from fenicsfriction.petsc_options import options_inserted
 
     out, err = io.StringIO(), io.StringIO()
-    database = PETSc.Options()
-    for name, value in (options or {}).items():
-        database.setValue(name, value)
+    text = " ".join(f"-{name} {value}" for name, value in (options or {}).items())
     t0 = time.perf_counter()
-    try:
-        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-            code = main(argv)
-    finally:
-        for name in options or {}:
-            database.delValue(name)
+    with options_inserted(text), contextlib.redirect_stdout(out), \
+            contextlib.redirect_stderr(err):
+        code = main(argv)
     seconds = time.perf_counter() - t0
     folder = pathlib.Path(argv[argv.index("--out") + 1])
     data = json.loads((folder / summary).read_text())
